@@ -1,0 +1,101 @@
+#include "tool.h"
+
+#include "temporal/parallel.h"
+
+#include <unistd.h>
+
+#include <cstdio>
+#include <iostream>
+#include <optional>
+
+#ifndef TEMPORAL_VERSION
+#define TEMPORAL_VERSION "0.0.0"
+#endif
+
+namespace temporal::tool {
+
+int exit_code_for(const Error& error) {
+  switch (error.kind) {
+    case ErrorKind::Usage: return kExitUsage;
+    case ErrorKind::Input: return kExitInput;
+    case ErrorKind::Output: return kExitOutput;
+    case ErrorKind::Internal: return kExitInternal;
+  }
+  return kExitInternal;
+}
+
+Tool::Tool(std::string name, std::string description) : name_(std::move(name)), app_(std::move(description), name_) {
+  app_.option_defaults()->always_capture_default();
+  app_.set_version_flag("--version", std::string(name_) + " " TEMPORAL_VERSION);
+  app_.add_option("--threads", threads_, "Worker threads; 0 uses every core")->check(CLI::NonNegativeNumber);
+  app_.add_flag("--verbose", verbose_, "Print what the tool does to stderr");
+  app_.footer(
+      "Exit codes: 0 success, 1 usage error, 2 input error, 3 threshold failed, 4 output error, 5 internal error.\n"
+      "Conventions (layers, units, motion vectors, jitter): docs/conventions.md");
+}
+
+std::string Tool::signature() const { return name_ + " " TEMPORAL_VERSION; }
+
+int Tool::run(int argc, char** argv, const std::function<Status()>& body) {
+  for (int i = 1; i < argc; ++i) {
+    if (i > 1) command_line_ += ' ';
+    command_line_ += argv[i];
+  }
+  try {
+    app_.parse(argc, argv);
+  } catch (const CLI::Success& e) {  // --help, --version
+    return app_.exit(e);
+  } catch (const CLI::ParseError& e) {
+    std::cerr << name_ << ": " << e.what() << "\n" << name_ << ": run `" << name_ << " --help` for the options\n";
+    return kExitUsage;
+  }
+  std::optional<ThreadLimit> limit;
+  if (threads_ > 0) limit.emplace(threads_);
+  try {
+    const Status status = body();
+    if (status) return kExitOk;
+    print_error(status.error());
+    if (status.error().kind == ErrorKind::Usage)
+      std::cerr << name_ << ": run `" << name_ << " --help` for the options\n";
+    return exit_code_for(status.error());
+  } catch (const std::bad_alloc&) {
+    print_error(Error{ErrorKind::Input, {}, "out of memory: process fewer frames or smaller images"});
+    return kExitInput;
+  } catch (const std::exception& e) {
+    print_error(Error::internal(std::string("unexpected exception: ") + e.what() + " (please report this)"));
+    return kExitInternal;
+  }
+}
+
+void Tool::print_error(const Error& error) const {
+  if (error.file.empty())
+    std::cerr << name_ << ": " << error.message << "\n";
+  else
+    std::cerr << name_ << ": " << error.file << ": " << error.message << "\n";
+}
+
+void Tool::print_warning(const std::string& file, const std::string& message) const {
+  std::cerr << name_ << ": " << (file.empty() ? "" : file + ": ") << "warning: " << message << "\n";
+}
+
+void Tool::log(const std::string& message) const {
+  if (verbose_) std::cerr << name_ << ": " << message << "\n";
+}
+
+Progress::Progress(std::string tool, int total)
+    : tool_(std::move(tool)), total_(total), enabled_(isatty(STDERR_FILENO) != 0), start_(std::chrono::steady_clock::now()) {}
+
+Progress::~Progress() {
+  if (enabled_ && done_ > 0) std::fprintf(stderr, "\r\033[K");
+}
+
+void Progress::step(int frame) {
+  ++done_;
+  if (!enabled_) return;
+  const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+  std::fprintf(stderr, "\r\033[K%s: frame %d (%d/%d, %.1f frames/s)", tool_.c_str(), frame, done_, total_,
+               s > 0 ? done_ / s : 0.0);
+  std::fflush(stderr);
+}
+
+}  // namespace temporal::tool

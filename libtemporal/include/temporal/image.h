@@ -1,0 +1,114 @@
+// Planar multi-channel images.
+//
+// An Image is a width x height raster with any number of named channels. Every channel is its own
+// contiguous plane (row-major, no padding, 64-byte aligned), so per-pixel loops over one channel are
+// unit-stride and vectorise. Channels are float32 except integer data such as the material `id`, which is
+// stored exactly as uint32 (a float would round ids above 2^24).
+//
+// Channel names follow OpenEXR: `layer.channel` (`N.X`, `motion.Y`, `depth.Z`) or bare `R,G,B,A` for the
+// colour layer; docs/conventions.md lists every name the tools use.
+#pragma once
+
+#include "temporal/error.h"
+#include "temporal/metadata.h"
+
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace temporal {
+
+enum class ChannelType { Float, UInt };
+
+// A rectangle of pixels: [x, x + width) x [y, y + height).
+struct Rect {
+  int x = 0, y = 0, width = 0, height = 0;
+};
+
+// A non-owning view of one float plane, possibly a crop: element (x, y) is data[y * row_stride + x].
+template <typename T>
+struct PlaneView {
+  T* data = nullptr;
+  int width = 0;
+  int height = 0;
+  std::ptrdiff_t row_stride = 0;  // in elements
+
+  T& operator()(int x, int y) const { return data[y * row_stride + x]; }
+  T* row(int y) const { return data + y * row_stride; }
+  explicit operator bool() const { return data != nullptr; }
+  PlaneView crop(const Rect& r) const { return {data + r.y * row_stride + r.x, r.width, r.height, row_stride}; }
+};
+
+class Image {
+ public:
+  Image() = default;
+  Image(int width, int height);
+  Image(const Image& other);
+  Image& operator=(const Image& other);
+  Image(Image&&) noexcept = default;
+  Image& operator=(Image&&) noexcept = default;
+  ~Image() = default;
+
+  int width() const { return width_; }
+  int height() const { return height_; }
+  std::size_t pixel_count() const { return std::size_t(width_) * std::size_t(height_); }
+  bool empty() const { return pixel_count() == 0; }
+
+  // Adds a channel filled with `fill` and returns its plane. Adding an existing name returns the existing
+  // plane unchanged (and nullptr if it exists with the other type).
+  float* add_channel(std::string_view name, float fill = 0.0f);
+  std::uint32_t* add_uint_channel(std::string_view name, std::uint32_t fill = 0);
+  void remove_channel(std::string_view name);
+
+  bool has_channel(std::string_view name) const { return find(name) >= 0; }
+  ChannelType channel_type(std::string_view name) const;
+  // Plane of a float channel; nullptr when absent or not float.
+  float* plane(std::string_view name);
+  const float* plane(std::string_view name) const;
+  // Plane of a uint channel; nullptr when absent or not uint.
+  std::uint32_t* uint_plane(std::string_view name);
+  const std::uint32_t* uint_plane(std::string_view name) const;
+  // Views (whole image) of a channel, for code that also works on crops.
+  PlaneView<float> view(std::string_view name);
+  PlaneView<const float> view(std::string_view name) const;
+
+  std::size_t channel_count() const { return channels_.size(); }
+  const std::string& channel_name(std::size_t i) const { return channels_[i].name; }
+  std::vector<std::string> channel_names() const;
+  // Channels whose name is `layer.*`, or the bare colour channels when layer is empty.
+  std::vector<std::string> layer_channels(std::string_view layer) const;
+
+  // A copy of a sub-rectangle with every channel.
+  Image crop(const Rect& r) const;
+
+  // Interleaved <-> planar conversion for the named channels (in that order). `interleaved` holds
+  // pixel_count() * names.size() values. Missing or non-float channels are an error.
+  Status to_interleaved(std::span<const std::string> names, std::span<float> interleaved) const;
+  Status from_interleaved(std::span<const std::string> names, std::span<const float> interleaved);
+
+  FrameMetadata& metadata() { return metadata_; }
+  const FrameMetadata& metadata() const { return metadata_; }
+
+ private:
+  struct Channel {
+    std::string name;
+    ChannelType type = ChannelType::Float;
+    std::shared_ptr<void> storage;  // 64-byte aligned, pixel_count() elements of 4 bytes
+  };
+  int find(std::string_view name) const;
+  void* add(std::string_view name, ChannelType type);
+
+  int width_ = 0;
+  int height_ = 0;
+  std::vector<Channel> channels_;
+  FrameMetadata metadata_;
+};
+
+// Counts the non-finite values (NaN, +-Inf) of a float plane.
+std::size_t count_non_finite(std::span<const float> plane);
+
+}  // namespace temporal

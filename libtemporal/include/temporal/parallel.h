@@ -1,0 +1,43 @@
+// Parallel per-pixel loops (oneTBB). Work is split into bands of rows; the body receives a half-open row
+// range and runs a plain inner loop over x that the compiler can vectorise.
+#pragma once
+
+#include <cstddef>
+#include <memory>
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+namespace temporal {
+
+// Limits the threads used by every parallel loop while it lives. 0 means every core.
+class ThreadLimit {
+ public:
+  explicit ThreadLimit(int threads);
+  ~ThreadLimit();
+  ThreadLimit(const ThreadLimit&) = delete;
+  ThreadLimit& operator=(const ThreadLimit&) = delete;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+// Threads a parallel loop may use now.
+int max_threads();
+
+// Calls body(y_begin, y_end) for bands of rows in [0, height), in parallel.
+template <typename Body>
+void parallel_rows(int height, Body&& body, int grain_rows = 4) {
+  tbb::parallel_for(tbb::blocked_range<int>(0, height, grain_rows),
+                    [&](const tbb::blocked_range<int>& r) { body(r.begin(), r.end()); });
+}
+
+// Calls body(begin, end) for chunks of [0, count), in parallel.
+template <typename Body>
+void parallel_chunks(std::size_t count, Body&& body, std::size_t grain = 4096) {
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, count, grain),
+                    [&](const tbb::blocked_range<std::size_t>& r) { body(r.begin(), r.end()); });
+}
+
+}  // namespace temporal

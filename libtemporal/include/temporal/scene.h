@@ -1,0 +1,144 @@
+// Animated glTF 2.0 scenes, evaluated on the CPU at any time t.
+//
+// A Scene is loaded once (tinygltf) and validated; evaluate(t) returns everything a rasteriser needs for
+// that instant: one PrimitiveInstance per drawn glTF primitive (in the same order at every t, so two
+// evaluations can be paired index by index for motion vectors), the camera and the lights.
+// Only what a primitive needs is computed: rigid primitives carry a model matrix and share their rest-pose
+// vertex buffers; only skinned or morphed primitives get deformed world-space vertices (CPU skinning,
+// glTF 2.0 section 3.7.3, and morph targets, section 3.7.2.2).
+#pragma once
+
+#include "temporal/error.h"
+
+#include <glm/mat4x4.hpp>
+#include <glm/vec2.hpp>
+#include <glm/vec3.hpp>
+#include <glm/vec4.hpp>
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace temporal {
+
+struct SceneTexture {
+  int width = 0;
+  int height = 0;
+  std::vector<std::uint8_t> rgba8;  // row 0 is the top row of the image (glTF UV v = 0 is the top)
+  bool srgb = true;                 // base colour textures are sRGB-encoded
+  bool repeat_s = true, repeat_t = true;
+  bool mirror_s = false, mirror_t = false;
+  bool nearest = false;             // magnification filter NEAREST
+};
+
+struct SceneMaterial {
+  std::string name;
+  glm::vec4 base_color_factor{1.0f};
+  int base_color_texture = -1;      // index into Scene::textures(), -1: none
+  int base_color_texcoord = 0;
+  float metallic = 0.0f;
+  float roughness = 1.0f;
+  glm::vec3 emissive{0.0f};
+  enum class AlphaMode { Opaque, Mask, Blend } alpha_mode = AlphaMode::Opaque;
+  float alpha_cutoff = 0.5f;
+  bool double_sided = false;
+};
+
+// Rest-pose geometry of one glTF primitive (triangles only; strips and fans are converted on load).
+struct ScenePrimitive {
+  std::vector<glm::vec3> positions;  // object space
+  std::vector<glm::vec3> normals;    // object space; generated (flat) when the file has none
+  std::vector<glm::vec2> texcoords;  // TEXCOORD_0, empty when absent
+  std::vector<std::uint32_t> indices;
+  int material = -1;                 // index into Scene::materials(), -1: default material
+  bool skinned = false;              // has JOINTS_0/WEIGHTS_0 and its node has a skin
+  bool morphed = false;              // has morph targets
+};
+
+// One drawn primitive at one instant.
+struct PrimitiveInstance {
+  int primitive = -1;                // index into Scene::primitives()
+  int node = -1;                     // glTF node that draws it
+  std::uint32_t id = 0;              // material id + 1 (0 is the background, docs/conventions.md)
+  glm::mat4 model{1.0f};             // object to world (rigid primitives)
+  bool deformed = false;             // true: use the world-space vertices below instead of model
+  std::vector<glm::vec3> world_positions;  // skinned/morphed only, world space
+  std::vector<glm::vec3> world_normals;    // skinned/morphed only, world space, normalised
+};
+
+struct CameraState {
+  glm::mat4 view{1.0f};              // world to camera (OpenGL: looks down -Z)
+  float yfov = 0.8f;                 // radians
+  float aspect = 0.0f;               // 0: use the image's aspect
+  float znear = 0.1f;
+  float zfar = 100.0f;
+  std::string name;
+};
+
+struct LightState {
+  enum class Type { Directional, Point, Spot } type = Type::Directional;
+  glm::vec3 position{0.0f};          // world space (point, spot)
+  glm::vec3 direction{0.0f, -1.0f, 0.0f};  // world space, direction the light travels (directional, spot)
+  glm::vec3 color{1.0f};
+  float intensity = 1.0f;            // KHR_lights_punctual units (lux for directional, candela otherwise)
+  float range = 0.0f;                // 0: infinite
+  float inner_cone = 0.0f, outer_cone = 0.785398f;
+};
+
+struct FrameState {
+  double time = 0.0;
+  std::vector<PrimitiveInstance> instances;
+  CameraState camera;
+  std::vector<LightState> lights;    // never empty: an automatic key light when the scene has none
+};
+
+// How the camera is chosen and moved.
+struct CameraOptions {
+  std::string camera;                // glTF camera name or index; empty: the first camera, or an automatic one
+  enum class Path { Fixed, Orbit, Dolly } path = Path::Fixed;  // a path forces the automatic camera
+  double path_period_s = 8.0;        // orbit: seconds per turn; dolly: seconds per back-and-forth
+};
+
+struct SceneLoadOptions {
+  std::string clip;                  // animation name or index; empty: the first animation (if any)
+  CameraOptions camera;
+};
+
+class Scene {
+ public:
+  // Loads .gltf or .glb. Errors (Input) name the file and what is wrong: malformed JSON, missing buffer or
+  // image, accessor out of range, unsupported required extension (named), no triangles to draw.
+  static Expected<Scene> load(const std::string& path, const SceneLoadOptions& options = {});
+
+  const std::vector<ScenePrimitive>& primitives() const { return primitives_; }
+  const std::vector<SceneMaterial>& materials() const { return materials_; }
+  const std::vector<SceneTexture>& textures() const { return textures_; }
+  // Axis-aligned bounds of the scene in its rest pose at t = 0, world space.
+  glm::vec3 bounds_min() const { return bounds_min_; }
+  glm::vec3 bounds_max() const { return bounds_max_; }
+  // Duration of the selected animation clip in seconds (0 when static).
+  double clip_duration() const { return clip_duration_; }
+  std::vector<std::string> clip_names() const;
+  std::vector<std::string> camera_names() const;
+
+  // The scene at time t (seconds; animation time wraps at the clip's end, so sequences can run longer).
+  // Thread-safe: const and allocation-local.
+  FrameState evaluate(double time_s) const;
+
+  Scene();
+  Scene(Scene&&) noexcept;
+  Scene& operator=(Scene&&) noexcept;
+  ~Scene();
+
+ private:
+  struct Impl;  // nodes, skins, animation samplers: see src/render/scene.cpp
+  std::unique_ptr<Impl> impl_;
+  std::vector<ScenePrimitive> primitives_;
+  std::vector<SceneMaterial> materials_;
+  std::vector<SceneTexture> textures_;
+  glm::vec3 bounds_min_{0.0f}, bounds_max_{0.0f};
+  double clip_duration_ = 0.0;
+};
+
+}  // namespace temporal

@@ -1,0 +1,386 @@
+// OpenEXR I/O through OpenImageIO: multi-part files (one part per layer), planar images, atomic writes.
+#include "temporal/exr.h"
+
+#include <OpenImageIO/imageio.h>
+
+#include <glm/gtc/type_ptr.hpp>
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <cstring>
+#include <filesystem>
+#include <map>
+#include <set>
+
+namespace temporal {
+namespace {
+
+namespace fs = std::filesystem;
+using OIIO::ImageInput;
+using OIIO::ImageOutput;
+using OIIO::ImageSpec;
+using OIIO::TypeDesc;
+
+constexpr const char* kColourPart = "rgba";
+
+// Layer of a channel: the text before the last '.', or "" for bare channels (R, G, B, A, Z, id).
+std::string layer_of(const std::string& channel) {
+  const auto dot = channel.rfind('.');
+  return dot == std::string::npos ? std::string() : channel.substr(0, dot);
+}
+
+bool is_colour_channel(const std::string& c) { return c == "R" || c == "G" || c == "B" || c == "A"; }
+
+bool selected(const ExrSelection& selection, const std::string& channel) {
+  if (selection.layers.empty()) return true;
+  const std::string layer = layer_of(channel);
+  for (const auto& s : selection.layers) {
+    if (s == channel) return true;
+    if (!layer.empty() && s == layer) return true;
+    if ((s == "rgb" && (channel == "R" || channel == "G" || channel == "B")) || (s == "rgba" && is_colour_channel(channel)))
+      return true;
+  }
+  return false;
+}
+
+// True when a selection entry matched none of the channels.
+std::vector<std::string> unmatched(const ExrSelection& selection, const std::vector<std::string>& channels) {
+  std::vector<std::string> missing;
+  for (const auto& s : selection.layers) {
+    ExrSelection one{{s}};
+    bool found = false;
+    for (const auto& c : channels) found = found || selected(one, c);
+    if (!found) missing.push_back(s);
+  }
+  return missing;
+}
+
+std::string describe_layers(const std::vector<std::string>& channels) {
+  std::set<std::string> layers;
+  for (const auto& c : channels) {
+    const std::string l = layer_of(c);
+    layers.insert(l.empty() ? c : l);
+  }
+  std::string text;
+  for (const auto& l : layers) text += (text.empty() ? "" : ", ") + l;
+  return text.empty() ? "none" : text;
+}
+
+std::string oiio_error(const std::string& fallback) {
+  std::string e = OIIO::geterror();
+  if (e.empty()) e = fallback;
+  // OIIO prefixes messages with the file name we already print.
+  while (!e.empty() && (e.back() == '\n' || e.back() == ' ')) e.pop_back();
+  return e;
+}
+
+// --- metadata <-> header ------------------------------------------------------------------------------
+
+void put_matrix(ImageSpec& spec, const char* name, const glm::mat4& m) {
+  // OpenEXR stores row-vector matrices (p' = p M). glm is column-vector and column-major, so its memory is
+  // already the row-major layout of the transposed matrix: copy it unchanged.
+  spec.attribute(name, OIIO::TypeMatrix44, glm::value_ptr(m));
+}
+
+void write_metadata(ImageSpec& spec, const FrameMetadata& md) {
+  if (md.world_to_camera) put_matrix(spec, "worldToCamera", *md.world_to_camera);
+  if (md.world_to_ndc) put_matrix(spec, "worldToNDC", *md.world_to_ndc);
+  if (md.near_clip) spec.attribute("clipNear", *md.near_clip);
+  if (md.far_clip) spec.attribute("clipFar", *md.far_clip);
+  if (md.frame) spec.attribute("temporal:frame", *md.frame);
+  if (md.fps) spec.attribute("temporal:fps", float(*md.fps));
+  if (md.time) spec.attribute("temporal:time", float(*md.time));
+  if (md.jitter) spec.attribute("temporal:jitter", TypeDesc(TypeDesc::FLOAT, TypeDesc::VEC2), glm::value_ptr(*md.jitter));
+  if (md.jitter_factor) spec.attribute("temporal:jitterFactor", *md.jitter_factor);
+  if (md.jitter_index) spec.attribute("temporal:jitterIndex", *md.jitter_index);
+  if (md.camera_cut) spec.attribute("temporal:cameraCut", *md.camera_cut ? 1 : 0);
+  if (md.compute_ms) spec.attribute("temporal:computeMs", float(*md.compute_ms));
+  if (!md.tool.empty()) spec.attribute("temporal:tool", md.tool);
+  if (!md.parameters.empty()) spec.attribute("temporal:parameters", md.parameters);
+  for (const auto& [name, ms] : md.timings_ms) spec.attribute("temporal:ms:" + name, float(ms));
+  for (const auto& [key, value] : md.extra) spec.attribute("temporal:" + key, value);
+}
+
+std::optional<glm::mat4> get_matrix(const ImageSpec& spec, const char* name) {
+  const OIIO::ParamValue* p = spec.find_attribute(name, OIIO::TypeMatrix44, false);
+  if (!p) return std::nullopt;
+  glm::mat4 m;
+  std::memcpy(glm::value_ptr(m), p->data(), sizeof(float) * 16);
+  return m;
+}
+
+std::optional<float> get_float(const ImageSpec& spec, const char* name) {
+  const OIIO::ParamValue* p = spec.find_attribute(name, TypeDesc::UNKNOWN, false);
+  if (!p || p->type().aggregate != TypeDesc::SCALAR) return std::nullopt;
+  return p->get_float();
+}
+
+std::optional<int> get_int(const ImageSpec& spec, const char* name) {
+  const OIIO::ParamValue* p = spec.find_attribute(name, TypeDesc::UNKNOWN, false);
+  if (!p || p->type().aggregate != TypeDesc::SCALAR) return std::nullopt;
+  return p->get_int();
+}
+
+FrameMetadata read_metadata(const ImageSpec& spec) {
+  FrameMetadata md;
+  md.world_to_camera = get_matrix(spec, "worldToCamera");
+  md.world_to_ndc = get_matrix(spec, "worldToNDC");
+  md.near_clip = get_float(spec, "clipNear");
+  md.far_clip = get_float(spec, "clipFar");
+  md.frame = get_int(spec, "temporal:frame");
+  if (auto v = get_float(spec, "temporal:fps")) md.fps = *v;
+  if (auto v = get_float(spec, "temporal:time")) md.time = *v;
+  if (const auto* p = spec.find_attribute("temporal:jitter", TypeDesc::UNKNOWN, false);
+      p && p->type().basetype == TypeDesc::FLOAT && p->type().basevalues() == 2) {
+    const auto* f = static_cast<const float*>(p->data());
+    md.jitter = glm::vec2(f[0], f[1]);
+  }
+  md.jitter_factor = get_int(spec, "temporal:jitterFactor");
+  md.jitter_index = get_int(spec, "temporal:jitterIndex");
+  if (auto v = get_int(spec, "temporal:cameraCut")) md.camera_cut = *v != 0;
+  if (auto v = get_float(spec, "temporal:computeMs")) md.compute_ms = *v;
+  static const std::set<std::string> known = {"temporal:frame",       "temporal:fps",         "temporal:time",
+                                              "temporal:jitter",      "temporal:jitterFactor", "temporal:jitterIndex",
+                                              "temporal:cameraCut",   "temporal:computeMs",   "temporal:tool",
+                                              "temporal:parameters"};
+  md.tool = spec.get_string_attribute("temporal:tool");
+  md.parameters = spec.get_string_attribute("temporal:parameters");
+  for (const auto& p : spec.extra_attribs) {
+    const std::string name = p.name().string();
+    if (name.rfind("temporal:", 0) != 0 || known.count(name)) continue;
+    if (name.rfind("temporal:ms:", 0) == 0 && p.type().aggregate == TypeDesc::SCALAR)
+      md.timings_ms[name.substr(12)] = p.get_float();
+    else if (p.type() == OIIO::TypeString)
+      md.extra[name.substr(9)] = p.get_string();
+  }
+  return md;
+}
+
+const char* compression_name(ExrCompression c) {
+  switch (c) {
+    case ExrCompression::None: return "none";
+    case ExrCompression::Zip: return "zip";
+    case ExrCompression::Piz: return "piz";
+    case ExrCompression::Dwaa: return "dwaa";
+  }
+  return "zip";
+}
+
+struct Part {
+  std::string name;
+  std::vector<std::string> channels;
+  bool uint_data = false;
+  bool half = false;
+};
+
+}  // namespace
+
+Expected<ExrCompression> parse_compression(const std::string& name) {
+  if (name == "none") return ExrCompression::None;
+  if (name == "zip") return ExrCompression::Zip;
+  if (name == "piz") return ExrCompression::Piz;
+  if (name == "dwaa") return ExrCompression::Dwaa;
+  return Error::usage("unknown compression '" + name + "': use none, zip, piz or dwaa (dwaa applies to colour only)");
+}
+
+Expected<ExrInfo> read_exr_info(const std::string& path) {
+  if (!fs::exists(path)) return Error::input(path, "no such file");
+  auto in = ImageInput::open(path);
+  if (!in) return Error::input(path, "cannot read as OpenEXR: " + oiio_error("unknown error") + " (is it truncated or corrupt?)");
+  ExrInfo info;
+  const ImageSpec& first = in->spec();
+  info.width = first.width;
+  info.height = first.height;
+  info.metadata = read_metadata(first);
+  for (int s = 0; in->seek_subimage(s, 0); ++s)
+    for (const auto& c : in->spec().channelnames) info.channels.push_back(c);
+  return info;
+}
+
+Expected<Image> read_exr(const std::string& path, const ExrSelection& selection) {
+  if (!fs::exists(path)) return Error::input(path, "no such file");
+  auto in = ImageInput::open(path);
+  if (!in) return Error::input(path, "cannot read as OpenEXR: " + oiio_error("unknown error") + " (is it truncated or corrupt?)");
+
+  const ImageSpec first = in->spec();
+  Image image(first.width, first.height);
+  image.metadata() = read_metadata(first);
+
+  std::vector<std::string> all_channels;
+  std::vector<float> scratch;
+  std::vector<std::uint32_t> scratch_uint;
+  for (int s = 0; in->seek_subimage(s, 0); ++s) {
+    const ImageSpec& spec = in->spec();
+    for (const auto& c : spec.channelnames) all_channels.push_back(c);
+    if (spec.width != first.width || spec.height != first.height)
+      return Error::input(path, "part " + std::to_string(s) + " is " + std::to_string(spec.width) + "x" +
+                                    std::to_string(spec.height) + " but part 0 is " + std::to_string(first.width) +
+                                    "x" + std::to_string(first.height) + "; the tools need equal-size parts");
+    // Contiguous runs of selected channels with one pixel type are read in one call each.
+    const int nch = spec.nchannels;
+    int c = 0;
+    while (c < nch) {
+      if (!selected(selection, spec.channelnames[c]) || image.has_channel(spec.channelnames[c])) {
+        ++c;
+        continue;
+      }
+      const TypeDesc type = spec.channelformat(c);
+      const bool as_uint = type.basetype == TypeDesc::UINT32 || type.basetype == TypeDesc::INT32;
+      int end = c + 1;
+      while (end < nch && selected(selection, spec.channelnames[end]) && !image.has_channel(spec.channelnames[end]) &&
+             ((spec.channelformat(end).basetype == TypeDesc::UINT32 || spec.channelformat(end).basetype == TypeDesc::INT32) == as_uint))
+        ++end;
+      const int n = end - c;
+      const std::size_t count = image.pixel_count();
+      if (n == 1) {
+        // One channel: read straight into its plane, no scratch copy.
+        void* dst = as_uint ? static_cast<void*>(image.add_uint_channel(spec.channelnames[c]))
+                            : static_cast<void*>(image.add_channel(spec.channelnames[c]));
+        if (!in->read_image(s, 0, c, end, as_uint ? OIIO::TypeUInt : OIIO::TypeFloat, dst))
+          return Error::input(path, "cannot read channel " + spec.channelnames[c] + ": " +
+                                        oiio_error(in->geterror()) + " (is the file truncated or corrupt?)");
+      } else if (as_uint) {
+        scratch_uint.resize(count * n);
+        if (!in->read_image(s, 0, c, end, OIIO::TypeUInt, scratch_uint.data()))
+          return Error::input(path, "cannot read part " + std::to_string(s) + ": " + oiio_error(in->geterror()) +
+                                        " (is the file truncated or corrupt?)");
+        for (int k = 0; k < n; ++k) {
+          std::uint32_t* dst = image.add_uint_channel(spec.channelnames[c + k]);
+          for (std::size_t i = 0; i < count; ++i) dst[i] = scratch_uint[i * n + k];
+        }
+      } else {
+        scratch.resize(count * n);
+        if (!in->read_image(s, 0, c, end, OIIO::TypeFloat, scratch.data()))
+          return Error::input(path, "cannot read part " + std::to_string(s) + ": " + oiio_error(in->geterror()) +
+                                        " (is the file truncated or corrupt?)");
+        std::vector<std::string> names(spec.channelnames.begin() + c, spec.channelnames.begin() + end);
+        if (auto st = image.from_interleaved(names, scratch); !st) return Error::input(path, st.error().message);
+      }
+      c = end;
+    }
+  }
+  if (auto missing = unmatched(selection, all_channels); !missing.empty()) {
+    std::string list;
+    for (const auto& m : missing) list += (list.empty() ? "" : ", ") + m;
+    return Error::input(path, "no layer '" + list + "' (have: " + describe_layers(all_channels) +
+                                  "); produce it upstream (e.g. render-gbuffer --outputs) or pick another --layer");
+  }
+  return image;
+}
+
+Status write_exr(const std::string& path, const Image& image, const ExrWriteOptions& options) {
+  if (image.empty()) return Error::output(path, "refusing to write an empty image");
+  if (image.channel_count() == 0) return Error::output(path, "refusing to write an image without channels");
+
+  // Group channels into parts: the colour part first (viewers and idiff show part 0), then one per layer.
+  std::vector<Part> parts;
+  std::map<std::string, std::size_t> part_of_layer;
+  auto part_for = [&](const std::string& layer, bool uint_data) -> Part& {
+    const std::string key = (layer.empty() ? std::string(kColourPart) : layer) + (uint_data ? "#u" : "");
+    auto it = part_of_layer.find(key);
+    if (it == part_of_layer.end()) {
+      std::string name = layer.empty() ? std::string(kColourPart) : layer;
+      if (uint_data && !layer.empty()) name = layer;
+      it = part_of_layer.emplace(key, parts.size()).first;
+      parts.push_back(Part{name, {}, uint_data, false});
+    }
+    return parts[it->second];
+  };
+  // Bare channels: colour R,G,B,A share the colour part; any other bare channel (id, Z) gets its own part.
+  for (const auto& name : image.channel_names()) {
+    const bool is_uint = image.channel_type(name) == ChannelType::UInt;
+    std::string layer = layer_of(name);
+    if (layer.empty() && !is_colour_channel(name)) layer = name;
+    part_for(layer, is_uint).channels.push_back(name);
+  }
+  std::stable_partition(parts.begin(), parts.end(), [](const Part& p) { return p.name == kColourPart; });
+  // Part names must be unique in a multi-part file.
+  std::set<std::string> names_seen;
+  for (auto& p : parts) {
+    while (!names_seen.insert(p.name).second) p.name += "_";
+    for (const auto& h : options.half_layers)
+      if (!p.uint_data && (h == p.name || (h == "rgba" && p.name == kColourPart) ||
+                           std::find(p.channels.begin(), p.channels.end(), h) != p.channels.end()))
+        p.half = true;
+  }
+
+  std::vector<ImageSpec> specs;
+  for (const auto& p : parts) {
+    const TypeDesc format = p.uint_data ? OIIO::TypeUInt : (p.half ? OIIO::TypeHalf : OIIO::TypeFloat);
+    ImageSpec spec(image.width(), image.height(), int(p.channels.size()), format);
+    spec.channelnames = p.channels;
+    spec.alpha_channel = -1;
+    for (std::size_t i = 0; i < p.channels.size(); ++i)
+      if (p.channels[i] == "A") spec.alpha_channel = int(i);
+    spec.attribute("oiio:subimagename", p.name);
+    // DWA is lossy and treats any `*.Y` channel as luminance: colour only, data stays lossless.
+    const ExrCompression c =
+        options.compression == ExrCompression::Dwaa && p.name != kColourPart ? ExrCompression::Zip : options.compression;
+    spec.attribute("compression", compression_name(c));
+    write_metadata(spec, image.metadata());
+    specs.push_back(std::move(spec));
+  }
+
+  const fs::path target(path);
+  std::error_code ec;
+  if (target.has_parent_path()) fs::create_directories(target.parent_path(), ec);
+  // The temporary name keeps the .exr extension so OIIO picks the OpenEXR writer, and starts with a dot
+  // so sequence scans never see it.
+  const fs::path tmp = target.parent_path() / ("." + target.filename().string() + ".tmp" + std::to_string(getpid()) + ".exr");
+
+  auto out = ImageOutput::create("openexr");
+  if (!out) return Error::output(path, "OpenImageIO has no OpenEXR writer: " + oiio_error("unknown error"));
+  const bool multi = specs.size() > 1;
+  if (multi && !out->supports("multiimage"))
+    return Error::output(path, "this OpenImageIO cannot write multi-part EXR");
+  bool ok = multi ? out->open(tmp.string(), int(specs.size()), specs.data()) : out->open(tmp.string(), specs[0]);
+  std::vector<float> buffer;
+  std::vector<std::uint32_t> buffer_uint;
+  for (std::size_t s = 0; ok && s < parts.size(); ++s) {
+    if (s > 0) ok = out->open(tmp.string(), specs[s], ImageOutput::AppendSubimage);
+    if (!ok) break;
+    const Part& p = parts[s];
+    const std::size_t n = p.channels.size(), count = image.pixel_count();
+    if (p.uint_data) {
+      const void* data = nullptr;
+      if (n == 1) {
+        data = image.uint_plane(p.channels[0]);
+      } else {
+        buffer_uint.resize(count * n);
+        for (std::size_t k = 0; k < n; ++k) {
+          const std::uint32_t* src = image.uint_plane(p.channels[k]);
+          for (std::size_t i = 0; i < count; ++i) buffer_uint[i * n + k] = src[i];
+        }
+        data = buffer_uint.data();
+      }
+      ok = out->write_image(OIIO::TypeUInt, data);
+    } else {
+      const void* data = nullptr;
+      if (n == 1) {
+        data = image.plane(p.channels[0]);
+      } else {
+        buffer.resize(count * n);
+        if (auto st = image.to_interleaved(p.channels, buffer); !st) return Error::output(path, st.error().message);
+        data = buffer.data();
+      }
+      ok = out->write_image(OIIO::TypeFloat, data);
+    }
+  }
+  const std::string write_error = ok ? std::string() : out->geterror();
+  ok = out->close() && ok;
+  out.reset();
+  if (!ok) {
+    fs::remove(tmp, ec);
+    return Error::output(path, "cannot write: " + (write_error.empty() ? oiio_error("unknown error") : write_error) +
+                                   " (is the disk full or the folder read-only?)");
+  }
+  fs::rename(tmp, target, ec);
+  if (ec) {
+    fs::remove(tmp, ec);
+    return Error::output(path, "cannot move the finished file into place: " + ec.message());
+  }
+  return {};
+}
+
+}  // namespace temporal

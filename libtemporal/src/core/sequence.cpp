@@ -1,0 +1,163 @@
+#include "temporal/sequence.h"
+
+#include <algorithm>
+#include <charconv>
+#include <filesystem>
+#include <set>
+
+namespace temporal {
+namespace {
+
+bool parse_int(std::string_view s, int& out) {
+  if (s.empty()) return false;
+  const auto* end = s.data() + s.size();
+  auto [p, ec] = std::from_chars(s.data(), end, out);
+  return ec == std::errc() && p == end;
+}
+
+std::string_view trim(std::string_view s) {
+  while (!s.empty() && s.front() == ' ') s.remove_prefix(1);
+  while (!s.empty() && s.back() == ' ') s.remove_suffix(1);
+  return s;
+}
+
+}  // namespace
+
+Expected<FrameRange> FrameRange::parse(std::string_view text) {
+  text = trim(text);
+  // A leading '-' belongs to a negative first frame, so look for the separator after the first character.
+  const auto dash = text.find('-', 1);
+  FrameRange r;
+  if (dash == std::string_view::npos) {
+    if (!parse_int(text, r.first))
+      return Error::usage("--frames '" + std::string(text) + "' is not a frame range: write A-B (e.g. 0-39) or A");
+    r.last = r.first;
+    return r;
+  }
+  if (!parse_int(trim(text.substr(0, dash)), r.first) || !parse_int(trim(text.substr(dash + 1)), r.last))
+    return Error::usage("--frames '" + std::string(text) + "' is not a frame range: write A-B (e.g. 0-39) or A");
+  if (r.last < r.first)
+    return Error::usage("--frames " + std::string(text) + ": the last frame comes before the first; write A-B with A <= B");
+  return r;
+}
+
+Expected<SequencePattern> SequencePattern::parse(std::string pattern) {
+  SequencePattern p;
+  p.pattern_ = pattern;
+  const auto hash = pattern.find('#');
+  const auto pct = pattern.find('%');
+  if (hash != std::string::npos) {
+    auto end = pattern.find_first_not_of('#', hash);
+    if (end == std::string::npos) end = pattern.size();
+    if (pattern.find('#', end) != std::string::npos)
+      return Error::usage("'" + pattern + "' has more than one run of '#': use one placeholder such as name.####.exr");
+    p.prefix_ = pattern.substr(0, hash);
+    p.suffix_ = pattern.substr(end);
+    p.width_ = int(end - hash);
+    return p;
+  }
+  if (pct != std::string::npos) {
+    // %d, %4d or %04d
+    std::size_t i = pct + 1;
+    int width = 0;
+    while (i < pattern.size() && std::isdigit(static_cast<unsigned char>(pattern[i]))) width = width * 10 + (pattern[i++] - '0');
+    if (i >= pattern.size() || pattern[i] != 'd')
+      return Error::usage("'" + pattern + "': only %d or %0Nd placeholders are understood (or a run of '#')");
+    p.prefix_ = pattern.substr(0, pct);
+    p.suffix_ = pattern.substr(i + 1);
+    p.width_ = width;
+    if (p.suffix_.find('%') != std::string::npos)
+      return Error::usage("'" + pattern + "' has more than one placeholder");
+    return p;
+  }
+  p.prefix_ = pattern;
+  return p;
+}
+
+std::string SequencePattern::path(int frame) const {
+  if (width_ < 0) return pattern_;
+  std::string digits = std::to_string(frame < 0 ? -frame : frame);
+  if (int(digits.size()) < width_) digits.insert(0, std::size_t(width_) - digits.size(), '0');
+  return prefix_ + (frame < 0 ? "-" : "") + digits + suffix_;
+}
+
+std::vector<int> SequencePattern::frames_on_disk() const {
+  std::vector<int> frames;
+  if (width_ < 0) return frames;
+  namespace fs = std::filesystem;
+  const fs::path prefix_path(prefix_);
+  fs::path dir = prefix_path.parent_path();
+  const std::string file_prefix = prefix_path.filename().string();
+  const std::string& suffix = suffix_;
+  std::error_code ec;
+  if (dir.empty()) dir = ".";
+  for (auto it = fs::directory_iterator(dir, ec); !ec && it != fs::directory_iterator(); it.increment(ec)) {
+    const std::string name = it->path().filename().string();
+    if (name.size() <= file_prefix.size() + suffix.size()) continue;
+    if (name.compare(0, file_prefix.size(), file_prefix) != 0) continue;
+    if (name.compare(name.size() - suffix.size(), suffix.size(), suffix) != 0) continue;
+    const std::string_view digits(name.data() + file_prefix.size(), name.size() - file_prefix.size() - suffix.size());
+    int frame = 0;
+    if (!parse_int(digits, frame)) continue;
+    if (width_ > 0 && digits.size() < std::size_t(width_)) continue;
+    frames.push_back(frame);
+  }
+  std::sort(frames.begin(), frames.end());
+  frames.erase(std::unique(frames.begin(), frames.end()), frames.end());
+  return frames;
+}
+
+Expected<std::vector<int>> resolve_frames(const SequencePattern& pattern, const std::optional<FrameRange>& range) {
+  namespace fs = std::filesystem;
+  std::vector<int> frames;
+  if (!pattern.has_placeholder()) {
+    if (!fs::exists(pattern.pattern()))
+      return Error::input(pattern.pattern(), "no such file (for a sequence, put #### or %04d where the frame number goes)");
+    if (range) {
+      for (int f = range->first; f <= range->last; ++f) frames.push_back(f);
+      return frames;
+    }
+    return std::vector<int>{0};
+  }
+  if (range) {
+    for (int f = range->first; f <= range->last; ++f) {
+      if (!fs::exists(pattern.path(f)))
+        return Error::input(pattern.path(f), "missing: frame " + std::to_string(f) + " of --frames " +
+                                                 std::to_string(range->first) + "-" + std::to_string(range->last) +
+                                                 " does not exist; render it or narrow --frames");
+      frames.push_back(f);
+    }
+    return frames;
+  }
+  frames = pattern.frames_on_disk();
+  if (frames.empty())
+    return Error::input(pattern.pattern(), "no frames found on disk matching this pattern; check the folder and the "
+                                           "number of # (their count is the zero-padded width)");
+  for (std::size_t i = 1; i < frames.size(); ++i) {
+    if (frames[i] != frames[i - 1] + 1)
+      return Error::input(pattern.path(frames[i - 1] + 1),
+                          "missing: the sequence has a gap (frames " + std::to_string(frames.front()) + "-" +
+                              std::to_string(frames[i - 1]) + " then " + std::to_string(frames[i]) +
+                              "); render the missing frames or pick a contiguous range with --frames");
+  }
+  return frames;
+}
+
+Expected<std::vector<int>> parse_frame_list(std::string_view text) {
+  std::set<int> frames;
+  while (!text.empty()) {
+    const auto comma = text.find(',');
+    const std::string_view item = trim(text.substr(0, comma));
+    if (!item.empty()) {
+      auto range = FrameRange::parse(item);
+      if (!range) return Error::usage("frame list '" + std::string(text) + "': " + range.error().message);
+      if (range->count() > 10'000'000) return Error::usage("frame list item '" + std::string(item) + "' is too large");
+      for (int f = range->first; f <= range->last; ++f) frames.insert(f);
+    }
+    if (comma == std::string_view::npos) break;
+    text.remove_prefix(comma + 1);
+  }
+  return std::vector<int>(frames.begin(), frames.end());
+}
+
+}  // namespace temporal

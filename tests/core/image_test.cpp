@@ -1,0 +1,103 @@
+#include "temporal/image.h"
+#include "temporal/parallel.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdint>
+#include <limits>
+
+namespace temporal {
+namespace {
+
+TEST(Image, ChannelsArePlanarAndAligned) {
+  Image image(7, 3);
+  float* r = image.add_channel("R", 1.0f);
+  float* g = image.add_channel("G", 2.0f);
+  ASSERT_NE(r, nullptr);
+  ASSERT_NE(g, nullptr);
+  EXPECT_EQ(reinterpret_cast<std::uintptr_t>(r) % 64, 0u);
+  EXPECT_EQ(reinterpret_cast<std::uintptr_t>(g) % 64, 0u);
+  EXPECT_EQ(image.pixel_count(), 21u);
+  EXPECT_EQ(r[20], 1.0f);
+  EXPECT_EQ(g[0], 2.0f);
+  // Re-adding returns the same plane, untouched.
+  r[5] = 9.0f;
+  EXPECT_EQ(image.add_channel("R", 0.0f), r);
+  EXPECT_EQ(r[5], 9.0f);
+  // A uint channel is not visible as float and vice versa.
+  image.add_uint_channel("id", 7u);
+  EXPECT_EQ(image.plane("id"), nullptr);
+  EXPECT_EQ(image.uint_plane("R"), nullptr);
+  EXPECT_EQ(image.uint_plane("id")[3], 7u);
+  EXPECT_EQ(image.add_channel("id"), nullptr);
+}
+
+TEST(Image, CopyIsDeep) {
+  Image a(2, 2);
+  a.add_channel("R", 1.0f);
+  Image b = a;
+  b.plane("R")[0] = 5.0f;
+  EXPECT_EQ(a.plane("R")[0], 1.0f);
+}
+
+TEST(Image, LayerChannels) {
+  Image image(1, 1);
+  for (const char* c : {"R", "G", "B", "N.X", "N.Y", "N.Z", "motion.X", "motion.Y", "id"}) image.add_channel(c);
+  EXPECT_EQ(image.layer_channels("N"), (std::vector<std::string>{"N.X", "N.Y", "N.Z"}));
+  EXPECT_EQ(image.layer_channels("motion"), (std::vector<std::string>{"motion.X", "motion.Y"}));
+  EXPECT_EQ(image.layer_channels("rgb"), (std::vector<std::string>{"R", "G", "B", "id"}));
+}
+
+TEST(Image, CropCopiesTheRectangleAndZeroFillsOutside) {
+  Image image(4, 3);
+  float* v = image.add_channel("V");
+  for (int i = 0; i < 12; ++i) v[i] = float(i);
+  Image c = image.crop({1, 1, 2, 2});
+  ASSERT_EQ(c.width(), 2);
+  EXPECT_EQ(c.plane("V")[0], 5.0f);
+  EXPECT_EQ(c.plane("V")[1], 6.0f);
+  EXPECT_EQ(c.plane("V")[2], 9.0f);
+  EXPECT_EQ(c.plane("V")[3], 10.0f);
+  Image outside = image.crop({3, 2, 2, 2});
+  EXPECT_EQ(outside.plane("V")[0], 11.0f);
+  EXPECT_EQ(outside.plane("V")[1], 0.0f);
+  EXPECT_EQ(outside.plane("V")[3], 0.0f);
+  // Views crop without copying.
+  auto view = image.view("V").crop({1, 1, 2, 2});
+  EXPECT_EQ(view(1, 1), 10.0f);
+  EXPECT_EQ(view.row(1), v + 9);
+}
+
+TEST(Image, InterleavedRoundTrip) {
+  Image image(3, 2);
+  const std::vector<std::string> names{"R", "G", "B"};
+  std::vector<float> data(18);
+  for (int i = 0; i < 18; ++i) data[i] = float(i);
+  ASSERT_TRUE(image.from_interleaved(names, data));
+  EXPECT_EQ(image.plane("G")[1], 4.0f);  // pixel 1, channel 1 = 1*3 + 1
+  std::vector<float> back(18);
+  ASSERT_TRUE(image.to_interleaved(names, back));
+  EXPECT_EQ(back, data);
+  const std::vector<std::string> missing{"X"};
+  EXPECT_FALSE(image.to_interleaved(missing, back));
+}
+
+TEST(Image, CountsNonFinite) {
+  std::vector<float> v{0.0f, std::numeric_limits<float>::quiet_NaN(), std::numeric_limits<float>::infinity(),
+                       -std::numeric_limits<float>::infinity(), 1e30f};
+  EXPECT_EQ(count_non_finite(v), 3u);
+}
+
+TEST(Parallel, RowsCoverEveryRowOnce) {
+  std::vector<int> hits(1000, 0);
+  parallel_rows(1000, [&](int y0, int y1) {
+    for (int y = y0; y < y1; ++y) ++hits[y];
+  });
+  for (int h : hits) EXPECT_EQ(h, 1);
+  ThreadLimit limit(1);
+  EXPECT_EQ(max_threads(), 1);
+}
+
+}  // namespace
+}  // namespace temporal

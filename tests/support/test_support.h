@@ -1,0 +1,42 @@
+// Helpers shared by the test suites: scratch folders, optional third-party assets, image comparisons that
+// write a difference EXR when they fail.
+#pragma once
+
+#include "temporal/image.h"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace temporal::test {
+
+// A fresh, empty folder under the build tree for one test (removed and recreated on each call).
+std::filesystem::path scratch_dir(const std::string& name);
+
+// ../shared/assets beside the project, when present. Tests that need it call GTEST_SKIP() otherwise:
+//   auto assets = shared_assets(); if (!assets) GTEST_SKIP() << "../shared/assets is absent";
+std::optional<std::filesystem::path> shared_assets();
+
+// The project's source folder (for assets/ and docs/).
+std::filesystem::path source_dir();
+// The build folder (for the built tools: binary_dir() / "apps/compare/compare").
+std::filesystem::path binary_dir();
+// Path of a built tool, e.g. tool_path("compare").
+std::filesystem::path tool_path(const std::string& tool);
+
+// An image with the named float channels, every value `fill`.
+Image make_image(int width, int height, const std::vector<std::string>& channels, float fill = 0.0f);
+
+// Compares the named float channels. Passes when max |a - e| <= max_abs_error for every channel; otherwise
+// writes `<scratch>/<label>.diff.exr` (per-channel absolute difference) and reports the worst pixel.
+::testing::AssertionResult images_near(const Image& actual, const Image& expected,
+                                       const std::vector<std::string>& channels, float max_abs_error,
+                                       const std::string& label);
+
+// Runs a shell command, returns its exit code; stdout+stderr are captured into `output` when given.
+int run_command(const std::string& command, std::string* output = nullptr);
+
+}  // namespace temporal::test
