@@ -30,6 +30,7 @@ struct SceneTexture {
   bool repeat_s = true, repeat_t = true;
   bool mirror_s = false, mirror_t = false;
   bool nearest = false;             // magnification filter NEAREST
+  bool mipmaps = true;              // minification filter uses mipmaps (or is unset); false for NEAREST/LINEAR
 };
 
 struct SceneMaterial {
@@ -49,9 +50,11 @@ struct SceneMaterial {
 struct ScenePrimitive {
   std::vector<glm::vec3> positions;  // object space
   std::vector<glm::vec3> normals;    // object space; generated (flat) when the file has none
-  std::vector<glm::vec2> texcoords;  // TEXCOORD_0, empty when absent
+  std::vector<glm::vec2> texcoords;  // TEXCOORD_n of the material's base colour texture (normally TEXCOORD_0),
+                                     // empty when absent
   std::vector<std::uint32_t> indices;
-  int material = -1;                 // index into Scene::materials(), -1: default material
+  int material = -1;                 // index into Scene::materials(); after load never -1: primitives without
+                                     // a material get a "default" one appended to Scene::materials()
   bool skinned = false;              // has JOINTS_0/WEIGHTS_0 and its node has a skin
   bool morphed = false;              // has morph targets
 };
@@ -90,18 +93,25 @@ struct FrameState {
   double time = 0.0;
   std::vector<PrimitiveInstance> instances;
   CameraState camera;
-  std::vector<LightState> lights;    // never empty: an automatic key light when the scene has none
+  std::vector<LightState> lights;    // never empty: an automatic key light when the scene has none (directional,
+                                     // white, intensity pi, from above and behind the camera's left at t = 0)
 };
 
 // How the camera is chosen and moved.
 struct CameraOptions {
-  std::string camera;                // glTF camera name or index; empty: the first camera, or an automatic one
+  std::string camera;                // glTF camera name or index; empty: the first perspective camera, or an
+                                     // automatic one. Orthographic cameras are refused (Usage error) and skipped
+                                     // when choosing the first camera.
   enum class Path { Fixed, Orbit, Dolly } path = Path::Fixed;  // a path forces the automatic camera
   double path_period_s = 8.0;        // orbit: seconds per turn; dolly: seconds per back-and-forth
+  // The automatic camera frames the bounding sphere at t = 0 (yfov 0.8 rad) from direction (0.45, 0.35, 1)
+  // of its centre; orbit turns it about the vertical axis through the centre, dolly moves it along its view
+  // direction between 100 % and 65 % of the framing distance (cosine ease).
 };
 
 struct SceneLoadOptions {
-  std::string clip;                  // animation name or index; empty: the first animation (if any)
+  std::string clip;                  // animation name or index; empty: the first animation (if any);
+                                     // "all": every animation of the file at once
   CameraOptions camera;
 };
 
@@ -125,6 +135,12 @@ class Scene {
   // The scene at time t (seconds; animation time wraps at the clip's end, so sequences can run longer).
   // Thread-safe: const and allocation-local.
   FrameState evaluate(double time_s) const;
+  // The same, reusing `out`'s storage (instances and deformed vertex arrays keep their capacity; the
+  // per-call scratch is a few matrices per node): for per-frame loops.
+  void evaluate(double time_s, FrameState& out) const;
+
+  // What the loader skipped or changed (points/lines primitives, ignored channels, ...), one line each.
+  const std::vector<std::string>& warnings() const;
 
   Scene();
   Scene(Scene&&) noexcept;
@@ -132,7 +148,8 @@ class Scene {
   ~Scene();
 
  private:
-  struct Impl;  // nodes, skins, animation samplers: see src/render/scene.cpp
+  static Expected<Scene> load_checked(const std::string& path, const SceneLoadOptions& options);
+  struct Impl;  // nodes, skins, animation samplers: see src/scene/scene_impl.h
   std::unique_ptr<Impl> impl_;
   std::vector<ScenePrimitive> primitives_;
   std::vector<SceneMaterial> materials_;

@@ -1,0 +1,161 @@
+// compare: per-frame PSNR, SSIM and flicker of test sequences against a reference, as CSV, JSON, error-map EXRs
+// and VTK plots, with pass/fail thresholds for pipelines. The metrics live in libtemporal (temporal/comparison.h);
+// docs/compare.md defines them.
+#include "tool.h"
+
+#include "temporal/comparison.h"
+#include "temporal/plot.h"
+
+#include <cmath>
+#include <cstdio>
+#include <iostream>
+#include <optional>
+#include <sstream>
+#include <string>
+#include <vector>
+
+namespace {
+
+std::vector<std::string> split_names(const std::string& text) {
+  std::vector<std::string> names;
+  std::stringstream in(text);
+  std::string item;
+  while (std::getline(in, item, ',')) names.push_back(item);
+  return names;
+}
+
+std::string show(double v, const char* format) {
+  if (std::isnan(v)) return "-";
+  if (std::isinf(v)) return v > 0 ? "inf" : "-inf";
+  char text[64];
+  std::snprintf(text, sizeof text, format, v);
+  return text;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  using namespace temporal;
+  tool::Tool tool("compare",
+                  "Measures test sequences against a reference, frame by frame: PSNR (all compared channels and "
+                  "luminance), SSIM (Wang et al. 2004, on luminance) and temporal instability (flicker: RMS "
+                  "difference between the test's and the reference's frame-to-frame change, motion-compensated "
+                  "with --gbuffer). Writes a per-frame CSV, a JSON summary, error-map EXRs and PNG charts.\n"
+                  "Typical use: compare --reference REF.####.exr TEST.####.exr [TEST2.####.exr ...] [--names a,b] "
+                  "--csv F.csv --json F.json --plot F.png");
+  auto& app = tool.app();
+
+  ComparisonSetup setup;
+  std::string names, csv, json, plot, frames, peak = "1";
+  std::optional<double> fail_psnr, fail_ssim, fail_flicker;
+  std::string fail_on = "mean";
+  app.add_option("--reference", setup.reference, "Reference sequence, e.g. ref.####.exr")->required();
+  app.add_option("tests", setup.tests, "Test sequences (one or more), e.g. taa.####.exr phlm.####.exr")->required();
+  app.add_option("--names", names, "Comma-separated names of the test sequences (default: file names)");
+  app.add_option("--csv", csv, "Per-frame metrics CSV to write");
+  app.add_option("--json", json, "JSON summary to write (mean/min/max per sequence, thresholds)");
+  app.add_option("--plot", plot,
+                 "PNG charts: F.png (PSNR per frame), F-psnr-y.png, F-ssim.png, F-flicker.png, F-speed.png "
+                 "(PSNR against the compute time found in the test headers)");
+  app.add_option("--gbuffer", setup.gbuffer,
+                 "G-buffer sequence with `motion` (at the reference's size): motion-compensated flicker");
+  app.add_option("--mask", setup.mask,
+                 "Mask layer or channel (> 0.5 = inside) to report metrics inside and outside it; looked up in each "
+                 "test, then the G-buffer, then the reference");
+  app.add_option("--layer", setup.layer, "Layer compared: rgb (the bare R,G,B) or a layer name (NAME.*)");
+  app.add_option("--reference-layer", setup.reference_layer,
+                 "Layer of the reference to compare with (default: same as --layer), e.g. reference");
+  app.add_option("--error-maps", setup.error_maps,
+                 "Folder for error-map EXRs NAME.####.exr (error.R/G/B/Y, error.ssim, error.flicker, error.invalid)");
+  app.add_option("--frames", frames, "Frames A-B (default: every reference frame on disk)");
+  app.add_option("--peak", peak,
+                 "Peak value L for PSNR and SSIM, in pixel units; `max` = idiff's rule per frame (largest value, "
+                 "at least 1)");
+  app.add_option("--fail-psnr", fail_psnr, "Exit 3 when a sequence's PSNR (dB) is below this");
+  app.add_option("--fail-ssim", fail_ssim, "Exit 3 when a sequence's SSIM is below this");
+  app.add_option("--fail-flicker", fail_flicker, "Exit 3 when a sequence's flicker is above this");
+  app.add_option("--fail-on", fail_on, "What the thresholds judge: each sequence's mean over frames, or its worst frame")
+      ->check(CLI::IsMember({"mean", "worst"}));
+  app.footer(
+      "Exit codes: 0 success (thresholds passed), 1 usage error, 2 input error (missing, corrupt or mismatched "
+      "files, missing layers), 3 a threshold (--fail-psnr, --fail-ssim, --fail-flicker) failed, 4 output error (including plots that cannot be "
+      "drawn: CSV and JSON are still written), 5 internal error.\n"
+      "Without DISPLAY, compare starts its own Xvfb for the plots (--verbose says so). Definitions: "
+      "docs/compare.md; conventions: docs/conventions.md");
+
+  bool threshold_failed = false;
+  const int code = tool.run(argc, argv, [&]() -> Status {
+    if (!frames.empty()) {
+      auto range = FrameRange::parse(frames);
+      if (!range) return range.error();
+      setup.frames = *range;
+    }
+    if (peak == "max") {
+      setup.peak_from_data = true;
+    } else {
+      char* end = nullptr;
+      setup.peak = std::strtod(peak.c_str(), &end);
+      if (end == peak.c_str() || *end != '\0' || !(setup.peak > 0.0) || !std::isfinite(setup.peak))
+        return Error::usage("--peak '" + peak + "' is not a positive number or `max`");
+    }
+    if (!names.empty()) setup.names = split_names(names);
+    setup.tool = tool.signature();
+    setup.parameters = tool.command_line();
+
+    ComparisonHooks hooks;
+    std::optional<tool::Progress> progress;
+    hooks.frame_done = [&](int frame, int, int total) {
+      if (!progress) progress.emplace("compare", total);
+      progress->step(frame);
+    };
+    hooks.warning = [&](const std::string& file, const std::string& text) { tool.print_warning(file, text); };
+    hooks.log = [&](const std::string& text) { tool.log(text); };
+    auto report = compare_sequences(setup, hooks);
+    if (!report) return report.error();
+
+    Thresholds thresholds{fail_psnr, fail_ssim, fail_flicker, fail_on == "worst"};
+    const auto failures = check_thresholds(*report, thresholds);
+
+    std::optional<Error> output_error;
+    auto keep = [&](const Status& st) {
+      if (!st && !output_error) output_error = st.error();
+      if (!st) tool.print_error(st.error());
+    };
+    if (!csv.empty()) keep(write_comparison_csv(*report, csv));
+    if (!json.empty())
+      keep(write_comparison_json(*report, thresholds, failures, tool.signature(), tool.command_line(), json));
+
+    // Summary table on stdout.
+    std::printf("%-20s %7s %10s %10s %9s %11s %11s\n", "sequence", "frames", "psnr_rgb", "psnr_y", "ssim", "flicker",
+                "compute_ms");
+    for (const auto& s : report->sequences) {
+      const auto ms = mean_compute_ms(s);
+      std::printf("%-20s %7zu %10s %10s %9s %11s %11s\n", s.name.c_str(), s.frames.size(),
+                  show(summarize(s, Metric::PsnrRgb).mean, "%.3f").c_str(),
+                  show(summarize(s, Metric::PsnrY).mean, "%.3f").c_str(),
+                  show(summarize(s, Metric::Ssim).mean, "%.5f").c_str(),
+                  show(summarize(s, Metric::Flicker).mean, "%.5g").c_str(),
+                  ms ? show(*ms, "%.3f").c_str() : "-");
+    }
+    std::fflush(stdout);
+
+    if (!plot.empty()) {
+      auto display = VirtualDisplay::ensure();
+      if (!display) {
+        keep(Status(Error::output(plot, display.error().message)));
+      } else {
+        if (display->started()) tool.log("DISPLAY is not usable: started Xvfb on " + display->display() + " for the plots");
+        for (const auto& [path, chart] : comparison_charts(*report, plot)) {
+          keep(write_chart_png(chart, path));
+          tool.log("wrote " + path);
+        }
+      }
+    }
+    for (const auto& f : failures) std::cerr << "compare: threshold failed: " << f.message() << "\n";
+    threshold_failed = !failures.empty();
+    if (output_error) return Status(Error{output_error->kind, {}, "some outputs were not written (see above)"});
+    return Status::ok();
+  });
+  if (code == tool::kExitOk && threshold_failed) return tool::kExitThreshold;
+  return code;
+}

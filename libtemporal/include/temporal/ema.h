@@ -1,0 +1,46 @@
+// The plain exponential history buffer of seed 003 eq. 1, with reprojection and G-buffer rejection:
+//   h(t) = alpha h(t-1)(p + motion) + (1 - alpha) y(t)
+// alpha is the history weight. The history is fetched bilinearly at p + motion; it is rejected (h = y) when
+// that position is off-screen, when the material id at the nearest previous pixel differs from the current
+// one, or when the previous depth there differs from the current depth by more than `depth_tolerance`
+// (relative). Without G-buffer data only the off-screen test applies. NaN/Inf input never enters h: such a
+// pixel keeps (outputs) its reprojected history.
+#pragma once
+
+#include "temporal/error.h"
+#include "temporal/frame_filter.h"
+#include "temporal/image.h"
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace temporal {
+
+struct EmaParams {
+  float alpha = 0.9f;            // history weight of eq. 1
+  float depth_tolerance = 0.05f; // |d_prev - d| / d above this rejects the history
+};
+
+class EmaFilter {
+ public:
+  explicit EmaFilter(EmaParams params = {});
+
+  // Filters one frame; `debug.reject` (1 where the history was rejected) is added when in.debug.
+  Status process(const FilterInput& in, Image& output, FilterStats* stats = nullptr);
+
+  // History `history.<c>` plus the previous frame's `history.depth` and `history.id` (when given).
+  const Image& state() const { return history_; }
+  Status set_state(const Image& state, int channels);
+  static std::vector<std::string> state_channel_names(int channels);
+
+ private:
+  EmaParams params_;
+  Image history_;
+  Image next_;
+  int channels_ = 0;
+  bool have_state_ = false;
+  std::vector<std::uint8_t> valid_;  // 1 where the input pixel is finite
+};
+
+}  // namespace temporal

@@ -1,0 +1,49 @@
+// What the temporal filters of `filter-phlm` (PHLM, TAA, EMA, FXAA) receive for one frame, and what they
+// report back. Shared by temporal/phlm.h, taa.h, ema.h and fxaa.h.
+#pragma once
+
+#include "temporal/error.h"
+#include "temporal/image.h"
+
+#include <glm/vec2.hpp>
+
+#include <cstddef>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace temporal {
+
+// One input frame. Planes are width x height, row-major (the planes of an Image).
+struct FilterInput {
+  const Image* color = nullptr;       // the frame to filter (scene-linear values)
+  std::vector<std::string> channels;  // the channels of `color` to filter: 3 (R,G,B) or 1 (e.g. ssao.Y)
+  // Motion in pixels, p_prev = p + motion (docs/conventions.md). Null: static scene (motion 0), seed 003's
+  // "special case with static scenes".
+  const float* motion_x = nullptr;
+  const float* motion_y = nullptr;
+  // G-buffer data for the history rejection of `ema` (null: no rejection). Depth: linear view depth.
+  const float* depth = nullptr;
+  const std::uint32_t* id = nullptr;
+  // `temporal:jitter` of this frame, pixels in [-0.5, 0.5): the sample of pixel (x, y) was taken at
+  // (x + 0.5 + jx, y + 0.5 + jy). Used by `taa` to reconstruct pixel centres.
+  glm::vec2 jitter{0.0f, 0.0f};
+  // Discard every history at this frame (first frame, camera cut, --reset-frames).
+  bool reset = false;
+  // Write `debug.*` planes into the output image.
+  bool debug = false;
+};
+
+// Counts of one frame, for the tool's report.
+struct FilterStats {
+  std::size_t non_finite = 0;       // input pixels with a NaN or Inf value (never entered a history)
+  std::size_t history_resets = 0;   // histories / models reset (off-screen, first frame, cut, rejection)
+  std::size_t clamped = 0;          // histories clipped or models reset by the neighbourhood box test
+  double max_trace_p = 0.0;         // PHLM: largest trace(P) after the update
+};
+
+// Checks that `in` is usable: a colour image with the named float channels (1 or 3 of them). Input error
+// naming the missing channel otherwise.
+Status validate_filter_input(const FilterInput& in);
+
+}  // namespace temporal

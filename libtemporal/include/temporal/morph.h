@@ -1,0 +1,111 @@
+// Temporal upsampling of rendered frames for high-refresh-rate displays: seed 004 (Didyk et al. 2010,
+// "Perceptually-motivated real-time temporal upsampling of 3D content for high-refresh-rate displays") and
+// the baselines it is measured against.
+//
+// One rendered frame n (scene-linear colour R,G,B, assumed display-referred: 1.0 is the display's peak) and its
+// G-buffer (motion.X/Y, depth.Z) become `factor` displayed frames, slot k = 0 .. factor-1 at time
+// (n + k/factor) / fps. Slot 0 is the rendered frame itself (with `didyk`: high-frequency compensated),
+// slots k >= 1 are extrapolated from frame n and its motion, with no added latency (except `blend`).
+//
+// Methods (docs/morph-120hz.md has the details and every choice the paper leaves open):
+//  - Didyk:  snapped grid morph + depth test + selective blur + high-frequency compensation (sections 5-6).
+//  - Repeat: every slot shows frame n (a 40 Hz stream on a 120 Hz hold-type display).
+//  - Blend:  slot k = (1 - k/N) frame n + (k/N) frame n+1 in linear light; needs frame n+1, so it adds one
+//            rendered frame of latency (the last frame, without a successor, is repeated).
+//  - Warp:   per-pixel forward warp of frame n with a depth test, holes left black (no hole filling).
+#pragma once
+
+#include "temporal/error.h"
+#include "temporal/grid_warp.h"
+#include "temporal/image.h"
+#include "temporal/blur_pyramid.h"
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace temporal {
+
+enum class MorphMethod { Didyk, Repeat, Blend, Warp };
+Expected<MorphMethod> parse_morph_method(const std::string& name);
+const char* morph_method_name(MorphMethod method);
+
+struct MorphOptions {
+  MorphMethod method = MorphMethod::Didyk;
+  int factor = 3;             // displayed frames per rendered frame, >= 2 (40 Hz -> 120 Hz: 3)
+  float gamma = 2.2f;         // display gamma g: displayed light = value^g, value in [0, 1]
+  GridOptions grid;           // cell size, snapping, eye-tracking limit (pixels per degree, fps)
+  float blur_level = 2.0f;    // pyramid level read for the low-pass layer L (fractional allowed)
+  // Smooth-step from cell distortion to blur strength of the in-between frames: 0 below distortion_low,
+  // 1 above distortion_high (section 5.1, "Selective Blur").
+  float distortion_low = 0.05f;
+  float distortion_high = 0.5f;
+  float min_blur = 0.0f;      // blur strength floor in [0, 1] (1: blur every in-between frame fully, as [CKL*05])
+  bool compensate = true;     // high-frequency compensation of the rendered frame (section 5.1)
+  bool debug_layers = false;  // add debug.grid, debug.distortion, debug.blur, debug.H, debug.Hprime
+};
+
+// Milliseconds spent per stage for one rendered frame (all its in-between frames), seed 004 Table 1.
+struct MorphTimings {
+  double flow_ms = 0.0;   // flow gradient, max-pyramid, snapping, vertex motion and damping
+  double morph_ms = 0.0;  // vertex extrapolation, distortion, rasterisation of every in-between frame
+  double blur_ms = 0.0;   // blur pyramid, tri-cubic reconstruction, compensation, blur-strength map
+  double total_ms() const { return flow_ms + morph_ms + blur_ms; }
+};
+
+// Seed 004 section 5.1: the detail layer H' that makes the rendered frame plus N-1 frames showing only the
+// low-pass L emit, integrated over the N frames, the energy of N frames of H + L on a display of gamma g:
+//   N (H + L)^g = (L + H')^g + (N - 1) L^g  <=>  H' = (N (H + L)^g - (N - 1) L^g)^(1/g) - L.
+// `frames` is N (real-valued: selective blur uses 1 + the sum of the in-between blur strengths). No range
+// rules here; the result may need L + H' outside [0, 1].
+float compensated_high_frequency(float high, float low, float frames, float gamma);
+
+// One channel of a pixel after compensation with the dynamic-range rules of section 5.1. Values are
+// display-encoded ([0, 1], light = value^g). `top` goes to the rendered frame; `low` is the low-frequency
+// value the in-between frames show where they are blurred (strength b_k, blended in linear light).
+struct CompensatedValue {
+  float top = 0.0f;
+  float low = 0.0f;
+};
+// original = H + L, low = L; blurred = sum over the in-between frames of their blur strength (N - 1 when all
+// are fully blurred). Rules: an original darker than its low-pass is kept in every frame (top = low =
+// original: no negative light is needed); when L + H' exceeds 1, the rendered frame shows 1 and the excess
+// energy moves into the low-frequency layer of the in-between frames. Energy is conserved exactly:
+//   top^g + blurred * low^g = (1 + blurred) * original^g   (for original in [0, 1]).
+// Values outside [0, 1] are passed through (top = low = original).
+CompensatedValue compensate_value(float original, float low, float blurred, float gamma);
+
+// Pixels per degree of visual angle of a screen `screen_width_m` wide showing `pixels_x` pixels across, seen
+// from `distance_m` (at the screen centre).
+float pixels_per_degree(float screen_width_m, float distance_m, int pixels_x);
+
+// Upsamples rendered frames one at a time. Full-resolution scratch buffers are kept between calls (no
+// per-pixel allocation; only grid-sized vectors are rebuilt per frame).
+class Morpher {
+ public:
+  explicit Morpher(MorphOptions options);
+  const MorphOptions& options() const { return options_; }
+
+  // color: R,G,B (float, scene-linear) of rendered frame n; gbuffer: motion.X, motion.Y, depth.Z of frame n
+  // (Didyk and Warp; Repeat and Blend ignore it and accept nullptr); next: colour of frame n+1 (Blend only;
+  // nullptr repeats). Writes `factor` images (R,G,B and, with debug_layers, the debug layers) into `out`,
+  // slot k = out[k]. Metadata is left to the caller. Errors: missing channels, mismatched sizes, factor < 2.
+  Status process(const Image& color, const Image* gbuffer, const Image* next, std::vector<Image>& out,
+                 MorphTimings* timings = nullptr);
+
+ private:
+  Status check(const Image& color, const Image* gbuffer, const Image* next) const;
+  void run_didyk(const Image& color, const Image& gbuffer, std::vector<Image>& out, MorphTimings& t);
+  void run_warp(const Image& color, const Image& gbuffer, std::vector<Image>& out);
+
+  MorphOptions options_;
+  GridBuilder grid_builder_;
+  GridRasterizer rasterizer_;
+  BlurPyramid pyramid_;
+  SnappedGrid grid_;
+  std::vector<std::vector<float>> planes_;  // reusable full-resolution scratch planes
+  std::vector<std::uint64_t> warp_buffer_;
+};
+
+}  // namespace temporal

@@ -1,0 +1,145 @@
+// Deferred OSMesa renderer of animated scenes (render-gbuffer, issue 3; docs/render-gbuffer.md).
+//
+// One Renderer owns an OpenGL 4.5 core context on llvmpipe (OSMesa, every entry point loaded through
+// OSMesaGetProcAddress), the scene's geometry and textures, and per-frame render targets. render() takes
+// the scene state of this frame and of the previous frame (scene.h, FrameState, instances paired by index)
+// and returns the images asked for:
+//
+//   gbuffer    full resolution, no jitter: depth.Z (linear view depth, background = clipFar), N.X/Y/Z (world
+//              normal facing the camera), motion.X/Y (pixels, p_prev = p + motion, jitter removed, from the
+//              two frames' vertex positions), id (uint32, material + 1), albedo.R/G/B (linear base colour).
+//   shade      1/factor resolution per axis with this frame's shade jitter: the payload terms and their sum.
+//   reference  full resolution, the same payload averaged over reference_spp jittered samples.
+//   color      full resolution, one sample per pixel at the colour jitter: the payload sum (R,G,B), with
+//              textures (mipmapped unless disabled) and alpha-mask cut-outs, no antialiasing.
+//
+// Payload (each term can be switched off; docs/render-gbuffer.md gives the equations):
+//   direct.R/G/B  diffuse + Blinn-Phong specular radiance from every scene light, unshadowed
+//   shadow.Y      visibility of the key light (light 0): PCF of an N x N kernel against a shadow map
+//   ssao.Y        horizon-based ambient occlusion (Bavoil & Sainz 2008), D directions x S steps, pattern
+//                 re-randomised every frame
+//   gi.R/G/B      one-bounce indirect radiance from V virtual point lights drawn from a reflective shadow
+//                 map of the key light (Dachsbacher & Stamminger 2005), no visibility (instant GI)
+//   R,G,B         sum = direct * shadow + gi * ssao (a term that is off counts as 0 for direct/gi and 1
+//                 for shadow/ssao)
+// Background pixels: direct = gi = sum = 0, shadow = ssao = 1.
+//
+// Every image's metadata carries worldToCamera, worldToNDC (with that image's jitter), clipNear/Far,
+// frame, fps, time, jitter (+ jitterFactor/jitterIndex on shade), cameraCut, the pass timings and
+// compute_ms. Timings are wall-clock milliseconds of the GL work of each pass, glFinish included,
+// read-back excluded.
+#pragma once
+
+#include "temporal/error.h"
+#include "temporal/image.h"
+#include "temporal/render_jitter.h"
+#include "temporal/scene.h"
+
+#include <glm/vec3.hpp>
+
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace temporal {
+
+// Pass names used in timings (`temporal:ms:<name>`, timings.csv columns).
+inline constexpr const char* kPassGbuffer = "gbuffer";      // full-res G-buffer raster
+inline constexpr const char* kPassLightMaps = "lightMaps";  // shadow map + reflective shadow map + VPLs
+inline constexpr const char* kPassShadeLow = "shadeLow";    // low-res jittered G-buffer + payload shading
+inline constexpr const char* kPassShadeFull = "shadeFull";  // payload shading of one full-res G-buffer
+inline constexpr const char* kPassReference = "reference";  // all reference samples
+inline constexpr const char* kPassColor = "color";          // colour: jittered full-res G-buffer + shading
+
+struct PayloadOptions {
+  bool direct = true, shadow = true, ssao = true, gi = true;
+  int shadow_map_size = 2048;   // texels per side of the key light's shadow map
+  int pcf_kernel = 6;           // N: PCF over N x N shadow-map texels (seed 000's jeep: 6 x 6)
+  float shadow_bias = 1.5f;     // depth bias in shadow-map texels (slope-scaled by glPolygonOffset)
+  int ssao_directions = 8;      // HBAO directions (seed 000's horses: 8 x 8 horizon samples)
+  int ssao_steps = 8;           // HBAO steps per direction
+  float ssao_radius = 0.0f;     // world units; 0: 5% of the scene's bounding-box diagonal
+  int vpl_count = 2000;         // VPLs for gi (seed 000, Figure 1: 2000)
+  int rsm_size = 128;           // texels per side of the reflective shadow map the VPLs are drawn from
+  float vpl_clamp = 0.0f;       // minimum VPL distance (world units) against 1/d^2 spikes; 0: 2% of diagonal
+
+  // The channel names of the enabled terms plus R,G,B.
+  std::vector<std::string> channels() const;
+};
+
+// Sets the terms of `base` from "direct,shadow,ssao,gi" (any subset, any order, at least one).
+Expected<PayloadOptions> parse_payload_terms(const std::string& list, PayloadOptions base = {});
+
+struct RenderOutputs {
+  bool gbuffer = true, shade = true, reference = true, color = true;
+  // "gbuffer,shade,reference,color" (any subset, at least one).
+  static Expected<RenderOutputs> parse(const std::string& list);
+};
+
+struct RenderOptions {
+  int width = 1280, height = 1024;     // full resolution, pixels
+  int factor = 4;                      // shade is width/factor x height/factor (must divide both)
+  JitterMode shade_jitter = JitterMode::Regular;
+  JitterMode color_jitter = JitterMode::Random;
+  int reference_spp = 16;              // reference samples per pixel (Halton (2,3) sub-pixel positions)
+  bool mipmaps = true;                 // false: textures sampled without mipmaps (seed 003, section 7.2)
+  std::uint32_t seed = 0;              // decorrelates random jitter, SSAO patterns and VPL sets
+  PayloadOptions payload;
+  RenderOutputs outputs;
+};
+
+// Checks sizes, factor and payload settings without touching OpenGL (Usage errors naming the option).
+Status validate(const RenderOptions& options);
+
+// The static part of a scene: what Scene::load returns (tests build it by hand).
+struct SceneGeometry {
+  const std::vector<ScenePrimitive>* primitives = nullptr;
+  const std::vector<SceneMaterial>* materials = nullptr;
+  const std::vector<SceneTexture>* textures = nullptr;
+  glm::vec3 bounds_min{-1.0f}, bounds_max{1.0f};  // world-space bounds (SSAO radius, VPL clamp defaults)
+};
+
+struct FrameInput {
+  int frame = 0;
+  double fps = 40.0;
+  const FrameState* current = nullptr;
+  const FrameState* previous = nullptr;  // state at (frame - 1) / fps; nullptr: no motion (motion = 0)
+  bool camera_cut = false;               // first frame of a sequence
+};
+
+struct RenderedFrame {
+  std::optional<Image> gbuffer, shade, reference, color;
+  std::map<std::string, double> timings_ms;  // pass name -> ms (only the passes that ran)
+};
+
+class Renderer {
+ public:
+  // Creates the OSMesa context (LP_NUM_THREADS must already be set), compiles the shaders and uploads the
+  // scene's geometry and textures. Usage errors for bad sizes/factors; Internal when OpenGL fails.
+  static Expected<Renderer> create(const RenderOptions& options, const SceneGeometry& scene);
+
+  // Renders one frame. The FrameState's instances must refer to the SceneGeometry given to create().
+  Expected<RenderedFrame> render(const FrameInput& input);
+
+  const RenderOptions& options() const;
+  // OpenGL renderer and version strings, for --verbose.
+  std::string gl_description() const;
+
+  Renderer(Renderer&&) noexcept;
+  Renderer& operator=(Renderer&&) noexcept;
+  ~Renderer();
+
+ private:
+  Renderer();
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+// The projection of a camera for an image of width x height (no jitter): glm::perspective with the
+// camera's vertical field of view, the image's aspect and the camera's near/far planes.
+glm::mat4 camera_projection(const CameraState& camera, int width, int height);
+
+}  // namespace temporal

@@ -1,0 +1,135 @@
+// Exponential history buffer, seed 003 eq. 1, with reprojection and depth / id rejection.
+#include "temporal/ema.h"
+
+#include "filter_common.h"
+#include "temporal/parallel.h"
+#include "temporal/resample.h"
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+
+namespace temporal {
+namespace {
+const char* suffix(int channels, int c) {
+  static constexpr const char* kRgb[3] = {"R", "G", "B"};
+  return channels == 3 ? kRgb[c] : "Y";
+}
+}  // namespace
+
+EmaFilter::EmaFilter(EmaParams params) : params_(params) {}
+
+std::vector<std::string> EmaFilter::state_channel_names(int channels) {
+  std::vector<std::string> names;
+  for (int c = 0; c < channels; ++c) names.push_back("history." + std::string(suffix(channels, c)));
+  return names;
+}
+
+Status EmaFilter::process(const FilterInput& in, Image& output, FilterStats* stats) {
+  if (Status s = validate_filter_input(in); !s) return s;
+  const int channels = int(in.channels.size());
+  const int w = in.color->width(), h = in.color->height();
+  const bool same = have_state_ && channels == channels_ && history_.width() == w && history_.height() == h;
+  if (!same) {
+    channels_ = channels;
+    history_ = Image(w, h);
+    next_ = Image(w, h);
+    for (const auto& n : state_channel_names(channels)) {
+      history_.add_channel(n);
+      next_.add_channel(n);
+    }
+  }
+  // The previous G-buffer planes are part of the state (so --state-in resumes the rejection too).
+  if (in.depth) next_.add_channel("history.depth");
+  if (in.id) next_.add_uint_channel("history.id");
+  const std::size_t non_finite = detail::prepare_frame(in, false, nullptr, valid_);
+  float* out[3] = {};
+  detail::prepare_output(in, output, out);
+  float* dbg = in.debug ? output.add_channel("debug.reject") : nullptr;
+
+  const auto names = state_channel_names(channels);
+  const float* hist[3] = {};
+  float* next[3] = {};
+  const float* y[3] = {};
+  for (int c = 0; c < channels; ++c) {
+    hist[c] = history_.plane(names[std::size_t(c)]);
+    next[c] = next_.plane(names[std::size_t(c)]);
+    y[c] = in.color->plane(in.channels[std::size_t(c)]);
+  }
+  const float* prev_depth = history_.plane("history.depth");
+  const std::uint32_t* prev_id = history_.uint_plane("history.id");
+  float* next_depth = in.depth ? next_.plane("history.depth") : nullptr;
+  std::uint32_t* next_id = in.id ? next_.uint_plane("history.id") : nullptr;
+  const bool use_depth = in.depth && prev_depth && same;
+  const bool use_id = in.id && prev_id && same;
+  const float alpha = params_.alpha, tol = params_.depth_tolerance;
+  const std::uint8_t* valid = valid_.data();
+
+  std::atomic<std::size_t> rejects{0};
+  parallel_rows(h, [&](int y0, int y1) {
+    std::size_t local = 0;
+    for (int yy = y0; yy < y1; ++yy)
+      for (int xx = 0; xx < w; ++xx) {
+        const std::size_t i = std::size_t(yy) * std::size_t(w) + std::size_t(xx);
+        const float mvx = in.motion_x ? in.motion_x[i] : 0.0f;
+        const float mvy = in.motion_y ? in.motion_y[i] : 0.0f;
+        const float fx = float(xx) + mvx, fy = float(yy) + mvy;
+        bool reject = in.reset || !same || !resample::on_screen(fx, fy, w, h);
+        if (!reject && (use_depth || use_id)) {
+          const std::size_t q = resample::nearest(fx, fy, w, h);
+          if (use_id && prev_id[q] != in.id[i]) reject = true;
+          if (use_depth && std::fabs(prev_depth[q] - in.depth[i]) > tol * std::fabs(in.depth[i])) reject = true;
+        }
+        float hv[3] = {};
+        if (!reject) {
+          const resample::Bilinear b = resample::bilinear(fx, fy, w, h);
+          for (int c = 0; c < channels; ++c) hv[c] = b(hist[c]);
+        }
+        local += reject ? 1 : 0;
+        for (int c = 0; c < channels; ++c) {
+          float v;
+          if (valid[i])
+            v = reject ? y[c][i] : alpha * hv[c] + (1.0f - alpha) * y[c][i];  // eq. 1
+          else
+            v = reject ? 0.0f : hv[c];  // no valid sample: keep the history (0 when there is none)
+          out[c][i] = v;
+          next[c][i] = v;
+        }
+        if (next_depth) next_depth[i] = in.depth[i];
+        if (next_id) next_id[i] = in.id[i];
+        if (dbg) dbg[i] = reject ? 1.0f : 0.0f;
+      }
+    rejects += local;
+  });
+  std::swap(history_, next_);
+  have_state_ = true;
+  if (stats) {
+    *stats = {};
+    stats->non_finite = non_finite;
+    stats->history_resets = rejects.load();
+  }
+  return Status::ok();
+}
+
+Status EmaFilter::set_state(const Image& state, int channels) {
+  if (channels != 1 && channels != 3) return Error::usage("ema state: the layer must have 1 or 3 channels");
+  Image copy(state.width(), state.height()), next(state.width(), state.height());
+  for (const auto& n : state_channel_names(channels)) {
+    const float* src = state.plane(n);
+    if (!src) return Error::input({}, "state has no channel '" + n + "': write it with `filter-phlm --method ema --state-out`");
+    if (count_non_finite({src, state.pixel_count()}) != 0)
+      return Error::input({}, "state channel '" + n + "' holds NaN or Inf values");
+    std::copy(src, src + state.pixel_count(), copy.add_channel(n));
+    next.add_channel(n);
+  }
+  if (const float* d = state.plane("history.depth")) std::copy(d, d + state.pixel_count(), copy.add_channel("history.depth"));
+  if (const std::uint32_t* id = state.uint_plane("history.id"))
+    std::copy(id, id + state.pixel_count(), copy.add_uint_channel("history.id"));
+  history_ = std::move(copy);
+  next_ = std::move(next);
+  channels_ = channels;
+  have_state_ = true;
+  return Status::ok();
+}
+
+}  // namespace temporal

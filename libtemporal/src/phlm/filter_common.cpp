@@ -1,0 +1,60 @@
+#include "filter_common.h"
+
+#include "temporal/color.h"
+#include "temporal/parallel.h"
+
+#include <atomic>
+#include <cmath>
+
+namespace temporal {
+
+Status validate_filter_input(const FilterInput& in) {
+  if (!in.color || in.color->empty()) return Error::input({}, "empty input image");
+  if (in.channels.size() != 1 && in.channels.size() != 3)
+    return Error::usage("the filtered layer must have 1 or 3 channels (got " + std::to_string(in.channels.size()) +
+                        "); pick one with --layer");
+  for (const auto& c : in.channels)
+    if (!in.color->plane(c)) return Error::input({}, "input has no float channel '" + c + "'");
+  if ((in.motion_x == nullptr) != (in.motion_y == nullptr))
+    return Error::internal("motion needs both motion.X and motion.Y");
+  return Status::ok();
+}
+
+namespace detail {
+
+std::size_t prepare_frame(const FilterInput& in, bool want_ycgco, std::vector<float> ycgco[3],
+                          std::vector<std::uint8_t>& valid) {
+  const Image& img = *in.color;
+  const std::size_t n = img.pixel_count();
+  const int w = img.width();
+  const int channels = int(in.channels.size());
+  if (valid.size() != n) valid.assign(n, 0);
+  if (want_ycgco)
+    for (int c = 0; c < 3; ++c)
+      if (ycgco[c].size() != n) ycgco[c].assign(n, 0.0f);
+  const float* p[3] = {};
+  for (int c = 0; c < channels; ++c) p[c] = img.plane(in.channels[std::size_t(c)]);
+  std::atomic<std::size_t> bad{0};
+  parallel_rows(img.height(), [&](int y0, int y1) {
+    std::size_t local = 0;
+    for (std::size_t i = std::size_t(y0) * std::size_t(w); i < std::size_t(y1) * std::size_t(w); ++i) {
+      bool ok = true;
+      for (int c = 0; c < channels; ++c) ok = ok && std::isfinite(p[c][i]);
+      valid[i] = ok ? 1 : 0;
+      local += ok ? 0 : 1;
+      if (want_ycgco) rgb_to_ycgco(p[0][i], p[1][i], p[2][i], ycgco[0][i], ycgco[1][i], ycgco[2][i]);
+    }
+    bad += local;
+  });
+  return bad.load();
+}
+
+void prepare_output(const FilterInput& in, Image& output, float* out[3]) {
+  const Image& img = *in.color;
+  if (output.width() != img.width() || output.height() != img.height()) output = Image(img.width(), img.height());
+  for (std::size_t c = 0; c < in.channels.size(); ++c) out[c] = output.add_channel(in.channels[c]);
+  output.metadata() = img.metadata();
+}
+
+}  // namespace detail
+}  // namespace temporal

@@ -1,0 +1,20 @@
+// Helpers shared by the filters of src/phlm (not part of the public headers).
+#pragma once
+
+#include "temporal/frame_filter.h"
+
+#include <cstdint>
+#include <vector>
+
+namespace temporal::detail {
+
+// Marks the finite pixels of the input (valid = 1 when every filtered channel is finite) and, when
+// `want_ycgco`, converts the three channels to YCgCo planes (temporal/color.h). Buffers are resized only
+// when the frame size changes. Returns the number of non-finite pixels.
+std::size_t prepare_frame(const FilterInput& in, bool want_ycgco, std::vector<float> ycgco[3],
+                          std::vector<std::uint8_t>& valid);
+
+// Sizes `output` like the input (reusing its planes when it already matches), adds the filtered channels
+// with the input's names and returns their planes in `out`.
+void prepare_output(const FilterInput& in, Image& output, float* out[3]);
+}  // namespace temporal::detail

@@ -1,0 +1,500 @@
+// Pixel History Linear Models, seed 003 sections 4-6 and Algorithm 1. The terms the paper leaves loose and
+// how they are read here are listed in docs/filter-phlm.md ("Reading the paper").
+#include "temporal/phlm.h"
+
+#include "filter_common.h"
+#include "temporal/color.h"
+#include "temporal/parallel.h"
+#include "temporal/resample.h"
+#include "temporal/rls.h"
+
+#include <algorithm>
+#include <array>
+#include <atomic>
+#include <cmath>
+#include <cstring>
+#include <vector>
+
+namespace temporal {
+namespace {
+
+// Plain comparisons instead of std::fmin / std::fmax: those honour NaN operands and are not inlined by GCC
+// (a libm call per use, measured 11% of the PHLM frame); every operand here is finite.
+inline float min_(float a, float b) { return b < a ? b : a; }
+inline float max_(float a, float b) { return a < b ? b : a; }
+
+template <int C>
+constexpr int kN = C + 1;
+
+// Luminance used by the feature heuristic and the model scale: the Y of YCgCo (section 5.1: "we transform
+// RGB samples into luminance values, using the YCgCo colorspace"); a one-channel payload is its own luma.
+template <int C>
+inline float luma(const float* v) {
+  if constexpr (C == 3)
+    return 0.25f * v[0] + 0.5f * v[1] + 0.25f * v[2];
+  else
+    return v[0];
+}
+
+// The box test of Algorithm 1 runs in YCgCo for colour (section 5.2 names RGB or YCgCo; YCgCo gives a tighter
+// box around chroma, as in Karis 2014) and on the value itself for one channel.
+template <int C>
+inline void to_box_space(const float* v, float* b) {
+  if constexpr (C == 3)
+    rgb_to_ycgco(v[0], v[1], v[2], b[0], b[1], b[2]);
+  else
+    b[0] = v[0];
+}
+template <int C>
+inline void from_box_space(const float* b, float* v) {
+  if constexpr (C == 3)
+    ycgco_to_rgb(b[0], b[1], b[2], v[0], v[1], v[2]);
+  else
+    v[0] = b[0];
+}
+
+// Scale of a model reset to colour c: the regression runs on y / s and z / s so that the predictor
+// x = [1, z / s] stays of order one. s = 1 for values up to 1 (the paper's setting, unchanged); HDR values
+// (1e4) would otherwise make P ill-conditioned beyond float precision. See docs, "HDR scaling".
+template <int C>
+inline float model_scale(const float* c) {
+  return max_(1.0f, std::fabs(luma<C>(c)));
+}
+
+// One pixel's model record, interleaved: beta (C x N), D (N), U (N (N - 1) / 2), feature (C), scale (1), in the
+// order of PhlmFilter::state_channel_names. The models are fetched at p + motion, 2 x 2 records at a time:
+// interleaved records make that two short contiguous reads instead of one scattered read per plane (26 planes
+// x 2 rows of streams defeat the hardware prefetchers: one 1080p frame with fractional motion took 476 ms on one
+// core with planes, 143 ms with records; docs/filter-phlm.md, "Performance").
+template <int C>
+struct Layout {
+  static constexpr int N = kN<C>;
+  static constexpr int kOff = rls::kOffDiagonal<N>;
+  static constexpr int kBeta = 0;
+  static constexpr int kD = C * N;
+  static constexpr int kU = kD + N;
+  static constexpr int kFeature = kU + kOff;
+  static constexpr int kScale = kFeature + C;
+  static constexpr int kSize = kScale + 1;
+  static_assert(kSize == phlm_state_floats(C));
+};
+
+struct FrameScratch {
+  const float* y[3];       // input planes
+  const float* box[3];     // input in box space (YCgCo or the value)
+  const std::uint8_t* valid;
+};
+
+template <int C>
+void run_phlm(const FilterInput& in, const PhlmParams& params, bool have_prev, const float* prev, float* next,
+              const FrameScratch& fs, float* const out[C], float* const dbg[3 + C],
+              std::atomic<std::size_t>& resets, std::atomic<std::size_t>& clamps, float& max_trace) {
+  constexpr int N = kN<C>;
+  constexpr int kOff = rls::kOffDiagonal<N>;
+  const int w = in.color->width(), h = in.color->height();
+  const float p0 = params.p_init;
+  const float trace_max = params.trace_factor * float(N) * p0;
+  const float a = params.feature_a, b = params.feature_b, lambda = params.lambda;
+  std::atomic<std::uint32_t> max_trace_bits{0};  // positive floats order like their bit patterns
+
+  parallel_rows(h, [&](int y0, int y1) {
+    std::size_t local_resets = 0, local_clamps = 0;
+    float local_trace = 0.0f;
+    // Row buffers of the separable 3x3 neighbourhood (one allocation per band of rows, reused for its rows):
+    // vertical pass into columns padded by one on each side, then horizontal pass. Both are plain loops over x
+    // that the compiler vectorises; the per-pixel kernel then reads one value per quantity.
+    const std::size_t wp = std::size_t(w) + 2;
+    std::vector<float> buf(wp * (3 * C + 1) + std::size_t(w) * (3 * C + 1));
+    float* vmin[C];
+    float* vmax[C];
+    float* vlow[C];
+    float* hmin[C];
+    float* hmax[C];
+    float* hlow[C];
+    for (int c = 0; c < C; ++c) {
+      vmin[c] = buf.data() + wp * std::size_t(c);
+      vmax[c] = buf.data() + wp * std::size_t(C + c);
+      vlow[c] = buf.data() + wp * std::size_t(2 * C + c);
+    }
+    float* vw = buf.data() + wp * std::size_t(3 * C);
+    float* hbase = buf.data() + wp * std::size_t(3 * C + 1);
+    for (int c = 0; c < C; ++c) {
+      hmin[c] = hbase + std::size_t(w) * std::size_t(c);
+      hmax[c] = hbase + std::size_t(w) * std::size_t(C + c);
+      hlow[c] = hbase + std::size_t(w) * std::size_t(2 * C + c);
+    }
+    float* hw = hbase + std::size_t(w) * std::size_t(3 * C);
+
+    for (int yy = y0; yy < y1; ++yy) {
+      // 3x3 neighbourhood: colour box (Algorithm 1 line 13, axis-aligned box of section 5.2), its luma range
+      // Delta(Y) (section 5.1), and the low-frequency colour (a [1 2 1]^2 / 16 binomial filter) that the
+      // feature accumulates. Non-finite samples are left out (weight 0, +-inf for the box); edges repeat.
+      {
+        const std::size_t r0 = std::size_t(std::max(yy - 1, 0)) * std::size_t(w);
+        const std::size_t r1 = std::size_t(yy) * std::size_t(w);
+        const std::size_t r2 = std::size_t(std::min(yy + 1, h - 1)) * std::size_t(w);
+        const std::uint8_t* v0 = fs.valid + r0;
+        const std::uint8_t* v1 = fs.valid + r1;
+        const std::uint8_t* v2 = fs.valid + r2;
+        for (int xx = 0; xx < w; ++xx) {
+          const bool va = v0[xx] != 0, vb = v1[xx] != 0, vc = v2[xx] != 0;
+          vw[xx + 1] = (va ? 1.0f : 0.0f) + (vb ? 2.0f : 0.0f) + (vc ? 1.0f : 0.0f);
+        }
+        for (int c = 0; c < C; ++c) {
+          const float* b0 = fs.box[c] + r0;
+          const float* b1 = fs.box[c] + r1;
+          const float* b2 = fs.box[c] + r2;
+          const float* y0p = fs.y[c] + r0;
+          const float* y1p = fs.y[c] + r1;
+          const float* y2p = fs.y[c] + r2;
+          float* mn = vmin[c] + 1;
+          float* mx = vmax[c] + 1;
+          float* lo = vlow[c] + 1;
+          for (int xx = 0; xx < w; ++xx) {
+            const bool va = v0[xx] != 0, vb = v1[xx] != 0, vc = v2[xx] != 0;
+            mn[xx] = min_(min_(va ? b0[xx] : INFINITY, vb ? b1[xx] : INFINITY), vc ? b2[xx] : INFINITY);
+            mx[xx] = max_(max_(va ? b0[xx] : -INFINITY, vb ? b1[xx] : -INFINITY), vc ? b2[xx] : -INFINITY);
+            lo[xx] = (va ? y0p[xx] : 0.0f) + 2.0f * (vb ? y1p[xx] : 0.0f) + (vc ? y2p[xx] : 0.0f);
+          }
+        }
+        // Replicate the edge columns into the padding.
+        auto pad = [&](float* row) {
+          row[0] = row[1];
+          row[w + 1] = row[w];
+        };
+        pad(vw);
+        for (int c = 0; c < C; ++c) {
+          pad(vmin[c]);
+          pad(vmax[c]);
+          pad(vlow[c]);
+        }
+        for (int xx = 0; xx < w; ++xx) hw[xx] = vw[xx] + 2.0f * vw[xx + 1] + vw[xx + 2];
+        for (int c = 0; c < C; ++c) {
+          const float* mn = vmin[c];
+          const float* mx = vmax[c];
+          const float* lo = vlow[c];
+          float* omn = hmin[c];
+          float* omx = hmax[c];
+          float* olo = hlow[c];
+          for (int xx = 0; xx < w; ++xx) {
+            omn[xx] = min_(min_(mn[xx], mn[xx + 1]), mn[xx + 2]);
+            omx[xx] = max_(max_(mx[xx], mx[xx + 1]), mx[xx + 2]);
+            olo[xx] = hw[xx] > 0.0f ? (lo[xx] + 2.0f * lo[xx + 1] + lo[xx + 2]) / hw[xx] : 0.0f;
+          }
+        }
+      }
+
+      for (int xx = 0; xx < w; ++xx) {
+        const std::size_t i = std::size_t(yy) * std::size_t(w) + std::size_t(xx);
+        float bmin[C], bmax[C], low[C], yc[C];
+        for (int c = 0; c < C; ++c) {
+          bmin[c] = hmin[c][xx];
+          bmax[c] = hmax[c][xx];
+          low[c] = hlow[c][xx];
+          yc[c] = fs.y[c][i];
+        }
+        const bool any_valid = hw[xx] > 0.0f;
+        const bool centre_valid = fs.valid[i] != 0;
+
+        // Reprojection q = pi(v) = p + motion (Algorithm 1 line 6).
+        const float mvx = in.motion_x ? in.motion_x[i] : 0.0f;
+        const float mvy = in.motion_y ? in.motion_y[i] : 0.0f;
+        const float fx = float(xx) + mvx, fy = float(yy) + mvy;
+        const bool reset = in.reset || !have_prev || !resample::on_screen(fx, fy, w, h);  // lines 7-9
+        resample::Bilinear bl{};
+        if (!reset) bl = resample::bilinear(fx, fy, w, h);
+        // The previous model record at q, bilinearly (line 11). Integer motion (a static scene, a static
+        // camera's still objects) reads the one record directly instead of four with weights (1, 0, 0, 0).
+        using L = Layout<C>;
+        float rec[L::kSize];
+        if (!reset) {
+          const float* q00 = prev + bl.i00 * L::kSize;
+          if (bl.w00 == 1.0f) {
+            for (int k = 0; k < L::kSize; ++k) rec[k] = q00[k];
+          } else {
+            const float* q10 = prev + bl.i10 * L::kSize;
+            const float* q01 = prev + bl.i01 * L::kSize;
+            const float* q11 = prev + bl.i11 * L::kSize;
+            for (int k = 0; k < L::kSize; ++k)
+              rec[k] = bl.w00 * q00[k] + bl.w10 * q10[k] + bl.w01 * q01[k] + bl.w11 * q11[k];
+          }
+        }
+
+        // Temporal feature z (section 5.1): exponential accumulation of the low-frequency colour with the
+        // per-pixel weight alpha = phi(v, l) / (l + Delta(Y)), phi = a l^2 + b v l^3.
+        float z[C];
+        float alpha = 1.0f;
+        if (reset) {
+          // Section 6: "Our temporal feature z is initialized with the input image, z(0) = y(0)".
+          for (int c = 0; c < C; ++c) z[c] = centre_valid ? yc[c] : low[c];
+        } else {
+          float zh[C];
+          for (int c = 0; c < C; ++c) zh[c] = rec[L::kFeature + c];
+          if (!any_valid) {
+            for (int c = 0; c < C; ++c) z[c] = zh[c];
+            alpha = 0.0f;
+          } else {
+            // Luminances enter the heuristic relative to k = max(1, Y(low)): values up to 1 (the display-
+            // referred range the constants a, b were tuned for) are used as they are, HDR values by their
+            // Weber contrast, so that alpha does not saturate to 1 on highlights (docs, "HDR scaling").
+            const float k = 1.0f / max_(1.0f, std::fabs(luma<C>(low)));
+            const float lh = luma<C>(zh);
+            const float delta = (bmax[0] - bmin[0]) * k;  // box[0] is the luma (YCgCo Y)
+            const float l = min_(std::fabs(lh - bmin[0]), std::fabs(lh - bmax[0])) * k;
+            const float v = std::sqrt(mvx * mvx + mvy * mvy);
+            const float phi = a * l * l + b * v * l * l * l;
+            const float den = l + delta;
+            alpha = den > 0.0f ? min_(phi / den, 1.0f) : 0.0f;
+            // The accumulated feature is kept inside the current neighbourhood box (as Karis' history), so a
+            // disoccluded region cannot keep a stale feature.
+            float zb[C];
+            to_box_space<C>(zh, zb);
+            for (int c = 0; c < C; ++c) zb[c] = std::clamp(zb[c], bmin[c], bmax[c]);
+            from_box_space<C>(zb, zh);
+            // alpha weighs the new low-frequency sample (the reading of Karis / UE4, whose code the constants
+            // a, b come from; see docs): z = (1 - alpha) z_prev + alpha low.
+            for (int c = 0; c < C; ++c) z[c] = zh[c] + alpha * (low[c] - zh[c]);
+          }
+        }
+
+        // Model fetch (line 11) or reset (line 9, section 6 "Initialization").
+        rls::Model<N, C> m;
+        float s;
+        float flag = 0.0f;
+        if (reset) {
+          const float* c0 = centre_valid ? yc : z;
+          s = model_scale<C>(c0);
+          float v0[C];
+          for (int c = 0; c < C; ++c) v0[c] = c0[c] / s;
+          rls::reset(m, v0, p0);
+          flag = 1.0f;
+          ++local_resets;
+        } else {
+          for (int c = 0; c < C; ++c)
+            for (int k = 0; k < N; ++k) m.beta[c][k] = rec[L::kBeta + c * N + k];
+          for (int k = 0; k < kOff; ++k) m.u[k] = rec[L::kU + k];
+          for (int k = 0; k < N; ++k) m.d[k] = rec[L::kD + k];
+          s = rec[L::kScale];
+        }
+        float x[N];
+        x[0] = 1.0f;
+        for (int c = 0; c < C; ++c) x[c + 1] = z[c] / s;  // eq. 3, x = [1, z]
+
+        float trace_p = 0.0f;
+        if (centre_valid) {
+          // Lines 12-19: initial prediction, box test, ray-box clip towards the input and model reset.
+          float f[C], fb[C], yb[C];
+          for (int c = 0; c < C; ++c) f[c] = s * rls::predict(m, c, x);
+          to_box_space<C>(f, fb);
+          to_box_space<C>(yc, yb);
+          bool inside = true;
+          for (int c = 0; c < C; ++c) inside = inside && fb[c] >= bmin[c] && fb[c] <= bmax[c];
+          if (!inside) {
+            bool finite = true;
+            for (int c = 0; c < C; ++c) finite = finite && std::isfinite(fb[c]);
+            float t_hit = 1.0f;  // a non-finite prediction is replaced by the input itself
+            if (finite) {
+              // Slab intersection of the ray f + t (y - f) with the box; y is inside the box (it is one of
+              // its samples), so the entry point is at t in [0, 1].
+              float t_near = 0.0f;
+              for (int c = 0; c < C; ++c) {
+                const float dir = yb[c] - fb[c];
+                if (dir == 0.0f) continue;
+                const float t0 = (bmin[c] - fb[c]) / dir, t1 = (bmax[c] - fb[c]) / dir;
+                t_near = max_(t_near, min_(t0, t1));
+              }
+              t_hit = min_(t_near, 1.0f);
+            }
+            for (int c = 0; c < C; ++c) fb[c] = finite ? fb[c] + t_hit * (yb[c] - fb[c]) : yb[c];
+            from_box_space<C>(fb, f);
+            s = model_scale<C>(f);  // line 18: Reset(beta, P) <- f
+            float v0[C];
+            for (int c = 0; c < C; ++c) v0[c] = f[c] / s;
+            rls::reset(m, v0, p0);
+            for (int c = 0; c < C; ++c) x[c + 1] = z[c] / s;
+            flag = 2.0f;
+            ++local_clamps;
+          }
+          // Lines 20-21: a-priori error and RLS update (eq. 5-7).
+          float yn[C];
+          for (int c = 0; c < C; ++c) yn[c] = yc[c] / s;
+          trace_p = rls::update(m, x, yn, lambda, p0, trace_max);
+        } else {
+          // No valid sample at this pixel this frame: the model is carried over unchanged (conventions:
+          // non-finite input never enters a history).
+          trace_p = rls::trace<N>(m.u, m.d);
+        }
+        local_trace = max_(local_trace, trace_p);
+
+        // Line 22 / eq. 8: the output is the updated model's prediction.
+        for (int c = 0; c < C; ++c) out[c][i] = s * rls::predict(m, c, x);
+
+        for (int c = 0; c < C; ++c)
+          for (int k = 0; k < N; ++k) next[i * L::kSize + L::kBeta + std::size_t(c * N + k)] = m.beta[c][k];
+        for (int k = 0; k < kOff; ++k) next[i * L::kSize + L::kU + std::size_t(k)] = m.u[k];
+        for (int k = 0; k < N; ++k) next[i * L::kSize + L::kD + std::size_t(k)] = m.d[k];
+        for (int c = 0; c < C; ++c) next[i * L::kSize + L::kFeature + std::size_t(c)] = z[c];
+        next[i * L::kSize + L::kScale] = s;
+        if (dbg[0]) {
+          for (int c = 0; c < C; ++c) dbg[3 + c][i] = z[c];
+          dbg[0][i] = alpha;
+          dbg[1][i] = flag;
+          dbg[2][i] = trace_p;
+        }
+      }
+    }
+    resets += local_resets;
+    clamps += local_clamps;
+    std::uint32_t bits;
+    std::memcpy(&bits, &local_trace, sizeof bits);
+    std::uint32_t cur = max_trace_bits.load();
+    while (bits > cur && !max_trace_bits.compare_exchange_weak(cur, bits)) {
+    }
+  });
+  const std::uint32_t bits = max_trace_bits.load();
+  std::memcpy(&max_trace, &bits, sizeof max_trace);
+}
+
+const char* channel_suffix(int channels, int c) {
+  static constexpr const char* kRgb[3] = {"R", "G", "B"};
+  return channels == 3 ? kRgb[c] : "Y";
+}
+
+}  // namespace
+
+PhlmFilter::PhlmFilter(PhlmParams params) : params_(params) {}
+
+std::vector<std::string> PhlmFilter::state_channel_names(int channels) {
+  const int n = channels + 1;
+  std::vector<std::string> names;
+  for (int c = 0; c < channels; ++c)
+    for (int k = 0; k < n; ++k) names.push_back("beta." + std::string(channel_suffix(channels, c)) + std::to_string(k));
+  for (int k = 0; k < n; ++k) names.push_back("P.D" + std::to_string(k));
+  for (int i = 0; i < n; ++i)
+    for (int j = i + 1; j < n; ++j) names.push_back("P.U" + std::to_string(i) + std::to_string(j));
+  for (int c = 0; c < channels; ++c) names.push_back("feature." + std::string(channel_suffix(channels, c)));
+  names.push_back("scale.s");
+  return names;
+}
+
+Status PhlmFilter::process(const FilterInput& in, Image& output, FilterStats* stats) {
+  if (Status s = validate_filter_input(in); !s) return s;
+  const int channels = int(in.channels.size());
+  const int w = in.color->width(), h = in.color->height();
+  const bool same_shape = have_state_ && channels == channels_ && width_ == w && height_ == h;
+  if (!same_shape) {
+    channels_ = channels;
+    width_ = w;
+    height_ = h;
+    const std::size_t n = std::size_t(w) * std::size_t(h) * std::size_t(phlm_state_floats(channels));
+    state_.assign(n, 0.0f);
+    next_.assign(n, 0.0f);
+  }
+  const bool have_prev = same_shape;
+
+  FrameScratch fs{};
+  const std::size_t non_finite = detail::prepare_frame(in, channels == 3, ycgco_, valid_);
+  for (int c = 0; c < channels; ++c) {
+    fs.y[c] = in.color->plane(in.channels[std::size_t(c)]);
+    fs.box[c] = channels == 3 ? ycgco_[std::size_t(c)].data() : fs.y[c];
+  }
+  fs.valid = valid_.data();
+
+  float* out[3] = {};
+  detail::prepare_output(in, output, out);
+  float* dbg[6] = {};
+  if (in.debug) {
+    dbg[0] = output.add_channel("debug.alpha");
+    dbg[1] = output.add_channel("debug.reset");
+    dbg[2] = output.add_channel("debug.traceP");
+    for (int c = 0; c < channels; ++c)
+      dbg[3 + c] = output.add_channel(channels == 3 ? "debug.feature" + std::string(channel_suffix(3, c))
+                                                    : std::string("debug.feature"));
+  }
+
+  std::atomic<std::size_t> resets{0}, clamps{0};
+  float max_trace = 0.0f;
+  if (channels == 3) {
+    run_phlm<3>(in, params_, have_prev, state_.data(), next_.data(), fs, out, dbg, resets, clamps, max_trace);
+  } else {
+    run_phlm<1>(in, params_, have_prev, state_.data(), next_.data(), fs, out, dbg, resets, clamps, max_trace);
+  }
+  std::swap(state_, next_);
+  have_state_ = true;
+  if (stats) {
+    stats->non_finite = non_finite;
+    stats->history_resets = resets.load();
+    stats->clamped = clamps.load();
+    stats->max_trace_p = max_trace;
+  }
+  return Status::ok();
+}
+
+Image PhlmFilter::state() const {
+  if (!have_state_) return Image();
+  Image img(width_, height_);
+  const auto names = state_channel_names(channels_);
+  std::vector<float*> planes;
+  for (const auto& n : names) planes.push_back(img.add_channel(n));
+  const std::size_t size = names.size();
+  parallel_chunks(img.pixel_count(), [&](std::size_t b0, std::size_t b1) {
+    for (std::size_t i = b0; i < b1; ++i)
+      for (std::size_t k = 0; k < size; ++k) planes[k][i] = state_[i * size + k];
+  });
+  return img;
+}
+
+Image PhlmFilter::state_with_covariance() const {
+  Image out = state();
+  if (!have_state_) return out;
+  const int n = channels_ + 1;
+  const auto names = state_channel_names(channels_);
+  const int off = n * (n - 1) / 2;
+  const std::size_t d_first = std::size_t(channels_ * n);
+  std::vector<const float*> d(static_cast<std::size_t>(n));
+  std::vector<const float*> u(static_cast<std::size_t>(std::max(off, 1)));
+  for (int k = 0; k < n; ++k) d[std::size_t(k)] = out.plane(names[d_first + std::size_t(k)]);
+  for (int k = 0; k < off; ++k) u[std::size_t(k)] = out.plane(names[d_first + std::size_t(n + k)]);
+  std::vector<float*> p;
+  for (int i = 0; i < n; ++i)
+    for (int j = i; j < n; ++j) p.push_back(out.add_channel("Pmat.P" + std::to_string(i) + std::to_string(j)));
+  for (std::size_t i = 0; i < out.pixel_count(); ++i) {
+    float uu[6] = {}, dd[4] = {}, pp[10] = {};
+    for (int k = 0; k < n; ++k) dd[k] = d[std::size_t(k)][i];
+    for (int k = 0; k < off; ++k) uu[k] = u[std::size_t(k)][i];
+    if (n == 4)
+      rls::covariance<4>(uu, dd, pp);
+    else
+      rls::covariance<2>(uu, dd, pp);
+    for (std::size_t k = 0; k < p.size(); ++k) p[k][i] = pp[k];
+  }
+  return out;
+}
+
+Status PhlmFilter::set_state(const Image& state, int channels) {
+  if (channels != 1 && channels != 3)
+    return Error::usage("phlm state: the filtered layer must have 1 or 3 channels, not " + std::to_string(channels));
+  const auto names = state_channel_names(channels);
+  std::vector<const float*> planes;
+  for (const auto& name : names) {
+    const float* src = state.plane(name);
+    if (!src)
+      return Error::input({}, "state has no channel '" + name + "': write it with `filter-phlm --method phlm " +
+                                  "--state-out` on the same --layer");
+    if (count_non_finite({src, state.pixel_count()}) != 0)
+      return Error::input({}, "state channel '" + name + "' holds NaN or Inf values; it cannot be resumed");
+    planes.push_back(src);
+  }
+  channels_ = channels;
+  width_ = state.width();
+  height_ = state.height();
+  const std::size_t size = names.size();
+  state_.assign(state.pixel_count() * size, 0.0f);
+  next_.assign(state.pixel_count() * size, 0.0f);
+  for (std::size_t i = 0; i < state.pixel_count(); ++i)
+    for (std::size_t k = 0; k < size; ++k) state_[i * size + k] = planes[k][i];
+  have_state_ = true;
+  return Status::ok();
+}
+
+}  // namespace temporal

@@ -1,0 +1,399 @@
+// `drobot`: the spatiotemporal framework of seed 002 (Drobot 2011), in the order of its "Spatiotemporal
+// Coherency" list:
+//   1-2. caching at the low (shading) resolution with a history buffer HB and a current buffer CB;
+//   3.   CB = this frame's samples;
+//   4.   HB accumulated into CB by reprojection caching (Listing 7.2: bilinear depth, cache miss when the
+//        depth differs; exponential history h(t) = h(t-1) w + r (1 - w) with a running convergence);
+//   5.   the per-pixel convergence factor is kept;
+//   6.   CB bilaterally filtered (Listing 7.3, separable), more strongly where convergence is low;
+//   7.   CB bilaterally upsampled to full resolution (Listing 7.1, precomputed bilinear weight table);
+//   8.   CB becomes HB (the filtered buffer is the history: "we were switching history buffers after
+//        bilateral filtering").
+// `DrobotMode::Refresh` is the refresh-buffer reconstruction of Figure 7.12: a full-resolution history,
+// the 1/n refresh buffer written at its pixels, and Listing 7.1 upsampling where neither has the pixel.
+//
+// The low-resolution samples of successive frames sit at different sub-pixel positions (the regular
+// pattern). The cache stores one value per k x k block (its centre), so that, as in Figure 7.6, each frame
+// adds one subset of the block's samples and a static cache is never resampled; repeated resampling of a
+// jittered grid blurs it (measured: 7 px of blur at k = 4, docs/upsample-st.md).
+#include "upsample_internal.h"
+
+#include "temporal/drobot.h"
+#include "temporal/parallel.h"
+
+#include <atomic>
+
+namespace temporal::upsample {
+namespace {
+
+// Listing 7.1 for full-resolution row Y from low-resolution planes src[c] with availability `avail` (0/1),
+// into out[c] (row pointers); `wsum` receives the sum of weights.
+// Where the coarse samples are: tap tables, their geometry and the bilinear table.
+struct CoarseGrid {
+  const TapTable& cols;
+  const TapTable& rows;
+  const float *lz, *lnx, *lny, *lnz;
+  const float* table;
+};
+
+void drobot_upsample_row(const CoarseGrid& gr, const FrameContext& f, const Options& o, int Y,
+                         const std::vector<const float*>& src, const float* avail_, float* const* out, float* wsum) {
+  thread_local std::vector<float> w4;
+  w4.resize(std::size_t(f.W) * 4);
+  float* __restrict w00 = w4.data();
+  float* __restrict w01 = w00 + f.W;
+  float* __restrict w10 = w01 + f.W;
+  float* __restrict w11 = w10 + f.W;
+  const int W = f.W, k = f.grid.k;
+  const int r0 = gr.rows.i0[Y] * f.lw, r1 = gr.rows.i1[Y] * f.lw;
+  const float vy0 = gr.rows.v0[Y], vy1 = gr.rows.v1[Y];
+  const float* __restrict table = gr.table + std::size_t(gr.rows.d[Y]) * k * 4;
+  const std::size_t row = std::size_t(Y) * W;
+  const float inv_range = 1.0f / f.depth_range;
+  const bool normals = o.drobot_normals;
+  const float power = o.normal_power;
+  const float* __restrict lz = gr.lz;
+  const float* __restrict lnx = gr.lnx;
+  const float* __restrict lny = gr.lny;
+  const float* __restrict lnz = gr.lnz;
+  const float* __restrict avail = avail_;
+  const int* __restrict ci0 = gr.cols.i0.data();
+  const int* __restrict ci1 = gr.cols.i1.data();
+  const int* __restrict cd = gr.cols.d.data();
+  const float* __restrict cv0 = gr.cols.v0.data();
+  const float* __restrict cv1 = gr.cols.v1.data();
+  const float* __restrict z = f.z + row;
+  const float* __restrict nx = f.nx + row;
+  const float* __restrict ny = f.ny + row;
+  const float* __restrict nz = f.nz + row;
+  const bool pow32 = power == 32.0f;  // the default contrast: five squarings instead of exp2(32 log2(dot))
+  auto geo = [=](int j, float zi, float ax, float ay, float az) {
+    // pow(dot, contrastCoef) (Listing 7.1), or 1 for the depth-only variant.
+    const float dot = std::max(1e-8f, ax * lnx[j] + ay * lny[j] + az * lnz[j]);
+    float d2 = dot * dot;
+    d2 *= d2;
+    d2 *= d2;
+    d2 *= d2;
+    d2 *= d2;
+    const float nw = normals ? (pow32 ? d2 : fast_exp2(power * fast_log2(dot))) : 1.0f;
+    const float w = nw / (kDrobotDepthBias + std::abs(zi - lz[j]) * inv_range) * avail[j];
+    return w >= 0.0f ? w : 0.0f;
+  };
+#pragma GCC ivdep
+  for (int X = 0; X < W; ++X) {
+    const float* t = table + std::size_t(cd[X]) * 4;
+    const int i0 = ci0[X], i1 = ci1[X];
+    const float zi = z[X], ax = nx[X], ay = ny[X], az = nz[X];
+    w00[X] = geo(r0 + i0, zi, ax, ay, az) * t[0] * cv0[X] * vy0;
+    w01[X] = geo(r0 + i1, zi, ax, ay, az) * t[1] * cv1[X] * vy0;
+    w10[X] = geo(r1 + i0, zi, ax, ay, az) * t[2] * cv0[X] * vy1;
+    w11[X] = geo(r1 + i1, zi, ax, ay, az) * t[3] * cv1[X] * vy1;
+  }
+  for (int c = 0; c < f.C; ++c) {
+    const float* __restrict l0 = src[c] + r0;
+    const float* __restrict l1 = src[c] + r1;
+    float* __restrict o_ = out[c];
+#pragma GCC ivdep
+    for (int X = 0; X < W; ++X) {
+      const int i0 = ci0[X], i1 = ci1[X];
+      const float ws = w00[X] + w01[X] + w10[X] + w11[X];
+      const float a = w00[X] > 0 ? l0[i0] : 0.0f, b = w01[X] > 0 ? l0[i1] : 0.0f;
+      const float cc = w10[X] > 0 ? l1[i0] : 0.0f, d = w11[X] > 0 ? l1[i1] : 0.0f;
+      // No usable coarse sample at all: the plain bilinear value (from whatever the buffer holds).
+      const float* t = table + std::size_t(cd[X]) * 4;
+      const float t0 = t[0] * cv0[X] * vy0, t1 = t[1] * cv1[X] * vy0, t2 = t[2] * cv0[X] * vy1, t3 = t[3] * cv1[X] * vy1;
+      const float ts = t0 + t1 + t2 + t3;
+      const float fallback = ts > 0 ? (t0 * l0[i0] + t1 * l0[i1] + t2 * l1[i0] + t3 * l1[i1]) / ts : 0.0f;
+      const float fb = std::abs(fallback) <= 3.0e38f ? fallback : 0.0f;
+      o_[X] = ws > 0 ? (w00[X] * a + w01[X] * b + w10[X] * cc + w11[X] * d) / ws : fb;
+    }
+  }
+  if (wsum)
+    for (int X = 0; X < W; ++X) wsum[X] = w00[X] + w01[X] + w10[X] + w11[X];
+}
+
+// Bilinear clamp-to-edge sample; texel centres at integer coordinates.
+inline float bilerp(const float* p, int w, int h, float u, float v) {
+  u = std::clamp(u, 0.0f, float(w - 1));
+  v = std::clamp(v, 0.0f, float(h - 1));
+  const int x0 = std::min(int(u), w - 1), y0 = std::min(int(v), h - 1);
+  const int x1 = std::min(x0 + 1, w - 1), y1 = std::min(y0 + 1, h - 1);
+  const float ax = u - float(x0), ay = v - float(y0);
+  return (1 - ay) * ((1 - ax) * p[std::size_t(y0) * w + x0] + ax * p[std::size_t(y0) * w + x1]) +
+         ay * ((1 - ax) * p[std::size_t(y1) * w + x0] + ax * p[std::size_t(y1) * w + x1]);
+}
+
+// One direction of Listing 7.3 over a w x h low-resolution plane. Taps at +-1.5 and +-3.5 texels read
+// the mean of two texels, as the hardware linear filter does; depth is filtered the same way.
+// `strength` in [0, 1] scales the four side taps (0 leaves the pixel unchanged). Texels are counted by
+// their availability `avail` (0 for a block without any sample of its own surface yet), so such a block
+// is reconstructed from its neighbours ("when a pixel lacks samples ... it is reconstructed from spatial
+// coherency data"); `avail_out` says whether anything reached the texel.
+void bilateral_pass(const float* src, const float* z, const float* strength, const float* avail, int w, int h,
+                    bool horizontal, float amp, float* dst, float* avail_out) {
+  parallel_rows(h, [&](int y0, int y1) {
+    for (int y = y0; y < y1; ++y)
+      for (int x = 0; x < w; ++x) {
+        const std::size_t i = std::size_t(y) * w + x;
+        auto at = [&](const float* p, int o) {
+          const int xx = horizontal ? std::clamp(x + o, 0, w - 1) : x;
+          const int yy = horizontal ? y : std::clamp(y + o, 0, h - 1);
+          return p[std::size_t(yy) * w + xx];
+        };
+        const float zc = z[i];
+        const float inv_z = zc > 0 ? 1.0f / zc : 0.0f;
+        const float s_i = avail[i] > 0 ? strength[i] : 1.0f;
+        float sum = kDrobotCenterWeight * avail[i] * src[i], wsum = kDrobotCenterWeight * avail[i];
+        static constexpr int kPair[4][2] = {{-3, -4}, {-1, -2}, {1, 2}, {3, 4}};
+        for (int t = 0; t < 4; ++t) {
+          const float a0 = at(avail, kPair[t][0]), a1 = at(avail, kPair[t][1]);
+          if (a0 + a1 <= 0.0f) continue;
+          const float v = (a0 * at(src, kPair[t][0]) + a1 * at(src, kPair[t][1])) / (a0 + a1);
+          const float zt = (a0 * at(z, kPair[t][0]) + a1 * at(z, kPair[t][1])) / (a0 + a1);
+          const float wt = 0.5f * (a0 + a1) * s_i *
+                           drobot_filter_tap_weight(zc * inv_z, zt * inv_z, amp, kDrobotTapWeights[t]);
+          sum += wt * v;
+          wsum += wt;
+        }
+        dst[i] = wsum > 0 ? sum / wsum : src[i];
+        avail_out[i] = wsum > 0 ? 1.0f : 0.0f;
+      }
+  });
+}
+
+// The cache grid: low-resolution pixel x stands for its k x k block, at the block's centre
+// (k x + k/2 in full-resolution coordinates, a pixel corner for even k). Its geometry is the G-buffer at
+// pixel (k x + k/2, k y + k/2). Accumulating the jittered samples of k*k frames there is the sample-set
+// amortisation of Figure 7.6; the cache is never resampled in a static scene.
+void build_cache_grid(Upsampler::State& s, const FrameContext& f) {
+  const int k = f.grid.k, lw = f.lw, lh = f.lh;
+  s.cache_cols.build(f.W, lw, k, k / 2);
+  s.cache_rows.build(f.H, lh, k, k / 2);
+  if (s.cache_table.size() != std::size_t(k) * k * 4) {
+    // Listing 7.1's table for the block centres: offset d of pixel X from the sample pixel k x + k/2 is
+    // a distance of d + 0.5 pixels from the block centre for even k.
+    const float off = (k % 2 == 0) ? 0.5f : 0.0f;
+    s.cache_table.resize(std::size_t(k) * k * 4);
+    for (int dy = 0; dy < k; ++dy)
+      for (int dx = 0; dx < k; ++dx) {
+        const float fx = (float(dx) + off) / float(k), fy = (float(dy) + off) / float(k);
+        float* e = &s.cache_table[std::size_t(dy * k + dx) * 4];
+        e[0] = (1 - fx) * (1 - fy);
+        e[1] = fx * (1 - fy);
+        e[2] = (1 - fx) * fy;
+        e[3] = fx * fy;
+      }
+  }
+  const std::size_t LN = std::size_t(lw) * lh;
+  s.cz.resize(LN);
+  s.cnx.resize(LN);
+  s.cny.resize(LN);
+  s.cnz.resize(LN);
+  for (int y = 0; y < lh; ++y)
+    for (int x = 0; x < lw; ++x) {
+      const std::size_t j = std::size_t(y) * lw + x;
+      const std::size_t i = std::size_t(std::min(f.H - 1, k * y + k / 2)) * f.W + std::min(f.W - 1, k * x + k / 2);
+      s.cz[j] = f.z[i];
+      s.cnx[j] = f.nx[i];
+      s.cny[j] = f.ny[i];
+      s.cnz[j] = f.nz[i];
+    }
+}
+
+void run_cache(Upsampler::State& s, const FrameContext& f, const Options& o, FrameStats& stats) {
+  const int C = f.C, k = f.grid.k, lw = f.lw, lh = f.lh;
+  const std::size_t LN = std::size_t(lw) * lh;
+  const int cur = s.cur, prv = 1 - s.cur;
+  const float nmax = o.max_frames > 0 ? o.max_frames : float(k * k);
+  for (auto& hv : s.hb_val) {
+    hv.resize(C);
+    for (auto& v : hv) v.resize(LN, 0.0f);
+  }
+  for (auto& v : s.hb_z) v.resize(LN, 0.0f);
+  for (auto& v : s.hb_n) v.resize(LN, 0.0f);
+  s.cb_val.resize(C);
+  s.cb_tmp.resize(C);
+  for (auto& v : s.cb_val) v.resize(LN);
+  for (auto& v : s.cb_tmp) v.resize(LN);
+  s.cb_conf.resize(LN);
+  s.cb_hit.resize(LN);
+  s.cb_w.resize(LN);
+  s.cb_strength.resize(LN);
+  s.cb_avail.resize(LN);
+  s.cb_avail_h.resize(LN);
+  build_cache_grid(s, f);
+  const bool history = s.have_history && s.hb_z[prv].size() == LN;
+  std::atomic<std::size_t> hits{0};
+
+  // Steps 3-5: CB from this frame's samples and the reprojected HB (Listing 7.2).
+  parallel_rows(lh, [&](int y0, int y1) {
+    std::size_t band_hits = 0;
+    for (int y = y0; y < y1; ++y)
+      for (int x = 0; x < lw; ++x) {
+        const std::size_t j = std::size_t(y) * lw + x;
+        const int PX = std::min(f.W - 1, k * x + k / 2), PY = std::min(f.H - 1, k * y + k / 2);
+        const std::size_t i = std::size_t(PY) * f.W + PX;
+        const float z = s.cz[j];
+        float conf = 0.0f, n_prev = 0.0f;
+        float u = 0, v = 0;
+        if (history && std::abs(f.mx[i]) < 1e6f && std::abs(f.my[i]) < 1e6f) {
+          // Block centre moved by the motion at its representative pixel, in the previous cache grid.
+          const float cx = float(k * x) + 0.5f * float(k), cy = float(k * y) + 0.5f * float(k);
+          const float px = cx + f.mx[i], py = cy + f.my[i];
+          const bool inside = px >= 0 && py >= 0 && px < float(f.W) && py < float(f.H);
+          u = (px - 0.5f * float(k)) / float(k);
+          v = (py - 0.5f * float(k)) / float(k);
+          const float zc = bilerp(s.hb_z[prv].data(), lw, lh, u, v);  // bilinear depth at discontinuities
+          conf = drobot_cache_confidence(z > 0 ? (z - zc) / z : 1.0f, o.miss_threshold, o.convergence_time, inside);
+          if (!o.cache_bilinear) {  // point sampling of the cache: the nearest previous texel
+            u = std::round(u);
+            v = std::round(v);
+          }
+          if (conf > 0) n_prev = bilerp(s.hb_n[prv].data(), lw, lh, u, v);
+        }
+        if (conf > 0) ++band_hits;
+        float n_new = 0.0f;
+        const float w = drobot_convergence_weight(n_prev, conf, nmax, &n_new);
+        // This frame's sample lies at sub-pixel (sx, sy) of the block: it is accumulated only when it shows
+        // the block's surface (same relative-depth test as the cache), so a block straddling a silhouette
+        // does not mix the two surfaces. A non-finite sample never enters the history.
+        const float zs = f.z[std::size_t(k * y + f.grid.sy) * f.W + (k * x + f.grid.sx)];
+        const bool finite = s.lvalid[j] > 0;
+        const bool valid = finite && z > 0 && std::abs(zs - z) <= o.miss_threshold * z;
+        const float n = valid ? n_new : n_prev * conf;
+        for (int c = 0; c < C; ++c) {
+          const float hist = conf > 0 ? bilerp(s.hb_val[prv][c].data(), lw, lh, u, v) : 0.0f;
+          float value = valid ? exponential_history(hist, f.low[c][j], w) : hist;
+          if (n <= 0.0f) value = finite ? f.low[c][j] : 0.0f;  // nothing of this surface yet (filter fills it)
+          s.cb_val[c][j] = value;
+        }
+        s.hb_n[cur][j] = n;
+        s.hb_z[cur][j] = z;
+        s.cb_hit[j] = conf;
+        s.cb_w[j] = n > 0 ? 1.0f : 0.0f;
+        s.cb_conf[j] = std::min(1.0f, n / nmax);  // convergence factor (step 5)
+        s.cb_strength[j] = 1.0f - s.cb_conf[j];
+      }
+    hits += band_hits;
+  });
+
+  // Step 6: Listing 7.3, horizontal then vertical, strength 1 - convergence; result is the new HB (step 8).
+  for (int c = 0; c < C; ++c) {
+    bilateral_pass(s.cb_val[c].data(), s.hb_z[cur].data(), s.cb_strength.data(), s.cb_w.data(), lw, lh, true,
+                   o.filter_amp, s.cb_tmp[c].data(), s.cb_avail_h.data());
+    bilateral_pass(s.cb_tmp[c].data(), s.hb_z[cur].data(), s.cb_strength.data(), s.cb_avail_h.data(), lw, lh, false,
+                   o.filter_amp, s.hb_val[cur][c].data(), s.cb_avail.data());
+  }
+
+  // Step 7: Listing 7.1 upsampling of the filtered CB.
+  Image& out = s.result[cur];
+  std::vector<float*> planes;
+  for (const auto& c : s.channels) planes.push_back(out.plane(c));
+  std::vector<const float*> src;
+  for (int c = 0; c < C; ++c) src.push_back(s.hb_val[cur][c].data());
+  float* dbg_conf = o.debug_layers ? out.add_channel("debug.confidence") : nullptr;
+  float* dbg_disocc = o.debug_layers ? out.add_channel("debug.disocclusion") : nullptr;
+  float* dbg_conv = o.debug_layers ? out.add_channel("debug.convergence") : nullptr;
+  float* dbg_hw = o.debug_layers ? out.add_channel("debug.historyWeight") : nullptr;
+  const CoarseGrid grid{s.cache_cols, s.cache_rows, s.cz.data(), s.cnx.data(), s.cny.data(), s.cnz.data(),
+                        s.cache_table.data()};
+  parallel_rows(f.H, [&](int y0, int y1) {
+    std::vector<float*> rows(C);
+    for (int Y = y0; Y < y1; ++Y) {
+      const std::size_t row = std::size_t(Y) * f.W;
+      for (int c = 0; c < C; ++c) rows[c] = planes[c] + row;
+      drobot_upsample_row(grid, f, o, Y, src, s.cb_avail.data(), rows.data(), dbg_conf ? dbg_conf + row : nullptr);
+      if (dbg_disocc) {
+        const int ly = std::clamp(Y / k, 0, lh - 1);  // the block the pixel lies in
+        for (int X = 0; X < f.W; ++X) {
+          const std::size_t j = std::size_t(ly) * lw + std::clamp(X / k, 0, lw - 1);
+          dbg_disocc[row + X] = s.cb_hit[j] > 0 ? 0.0f : 1.0f;
+          dbg_conv[row + X] = s.cb_conf[j];
+          dbg_hw[row + X] = s.hb_n[cur][j];
+        }
+      }
+    }
+  });
+  stats.history_pixels = hits * std::size_t(k) * k;
+  stats.hole_pixels = (LN - hits) * std::size_t(k) * k;
+}
+
+void run_refresh(Upsampler::State& s, const FrameContext& f, const Options& o, FrameStats& stats) {
+  const int C = f.C;
+  Image& out = s.result[s.cur];
+  const Image& prev = s.result[1 - s.cur];
+  std::vector<float*> planes;
+  std::vector<const float*> prev_planes;
+  for (const auto& c : s.channels) {
+    planes.push_back(out.plane(c));
+    prev_planes.push_back(prev.plane(c));
+  }
+  const bool history = s.have_history && s.prev_z.size() == std::size_t(f.W) * f.H;
+  float* dbg_conf = o.debug_layers ? out.add_channel("debug.confidence") : nullptr;
+  float* dbg_disocc = o.debug_layers ? out.add_channel("debug.disocclusion") : nullptr;
+  float* dbg_conv = o.debug_layers ? out.add_channel("debug.convergence") : nullptr;
+  std::atomic<std::size_t> holes{0}, hits{0};
+  // The refresh buffer's samples sit at this frame's jittered positions.
+  const CoarseGrid grid{s.cols, s.rows, s.lz.data(), s.lnx.data(), s.lny.data(), s.lnz.data(),
+                        s.bilinear_table.data()};
+  parallel_rows(f.H, [&](int y0, int y1) {
+    std::vector<float*> rows(C);
+    std::size_t band_holes = 0, band_hits = 0;
+    for (int Y = y0; Y < y1; ++Y) {
+      const std::size_t row = std::size_t(Y) * f.W;
+      for (int c = 0; c < C; ++c) rows[c] = planes[c] + row;
+      // Bilateral upsampling of the refresh buffer everywhere first (Listing 7.1) ...
+      drobot_upsample_row(grid, f, o, Y, f.low, s.lvalid.data(), rows.data(), dbg_conf ? dbg_conf + row : nullptr);
+      const bool row_computed = s.rows.d[Y] == 0;
+      const std::size_t lrow = std::size_t(s.rows.i0[Y]) * f.lw;
+      for (int X = 0; X < f.W; ++X) {
+        const std::size_t i = row + X;
+        float conf = 0.0f;
+        if (row_computed && s.cols.d[X] == 0 && s.lvalid[lrow + s.cols.i0[X]] > 0) {
+          // ... the refresh buffer where it has the pixel ...
+          for (int c = 0; c < C; ++c) planes[c][i] = f.low[c][lrow + s.cols.i0[X]];
+          conf = 1.0f;
+        } else if (history && std::abs(f.mx[i]) < 1e6f && std::abs(f.my[i]) < 1e6f) {
+          // ... and the history where the reprojection cache hits (Listing 7.2 test, bilinear depth).
+          const float px = float(X) + 0.5f + f.mx[i], py = float(Y) + 0.5f + f.my[i];
+          const bool inside = px >= 0 && py >= 0 && px < float(f.W) && py < float(f.H);
+          const float u = px - 0.5f, v = py - 0.5f;
+          const float zc = bilerp(s.prev_z.data(), f.W, f.H, u, v);
+          const float z = f.z[i];
+          conf = drobot_cache_confidence(z > 0 ? (z - zc) / z : 1.0f, o.miss_threshold, o.convergence_time, inside);
+          if (conf > 0) {
+            ++band_hits;
+            for (int c = 0; c < C; ++c) {
+              const float hist = bilerp(prev_planes[c], f.W, f.H, u, v);
+              planes[c][i] += (hist - planes[c][i]) * conf;
+            }
+          } else {
+            ++band_holes;
+          }
+        } else {
+          ++band_holes;
+        }
+        if (dbg_disocc) {
+          dbg_disocc[i] = conf > 0 ? 0.0f : 1.0f;
+          dbg_conv[i] = conf;
+        }
+      }
+    }
+    holes += band_holes;
+    hits += band_hits;
+  });
+  stats.hole_pixels = holes;
+  stats.history_pixels = hits;
+}
+
+}  // namespace
+
+void run_drobot(Upsampler::State& s, const FrameContext& f, const Options& o, FrameStats& stats) {
+  if (s.bilinear_table.size() != std::size_t(f.grid.k) * f.grid.k * 4) s.bilinear_table = drobot_bilinear_table(f.grid.k);
+  if (o.drobot_mode == DrobotMode::Refresh)
+    run_refresh(s, f, o, stats);
+  else
+    run_cache(s, f, o, stats);
+}
+
+}  // namespace temporal::upsample

@@ -1,0 +1,95 @@
+// `temporal`: temporally-amortised upsampling, seed 000 section 3.2, eq. 4 with the binary weight w_t:
+// a pixel shaded this frame (w_t = 1) takes the new sample, every other pixel takes the previous output at
+// its motion-compensated position. Disocclusions (warped depth + material id, Figure 3) and pixels that
+// leave the screen have no history: the paper re-renders them in a second pass; we count them
+// (FrameStats::hole_pixels, `temporal:holePixels`) and fill them with the joint-bilateral result (eq. 1-3).
+#include "upsample_internal.h"
+
+#include "temporal/parallel.h"
+
+#include <atomic>
+
+namespace temporal::upsample {
+
+void run_temporal(Upsampler::State& s, const FrameContext& f, const Options& o, FrameStats& stats) {
+  Image& out = s.result[s.cur];
+  const Image& prev = s.result[1 - s.cur];
+  const int C = f.C;
+  std::vector<float*> planes;
+  std::vector<const float*> prev_planes;
+  for (const auto& c : s.channels) {
+    planes.push_back(out.plane(c));
+    prev_planes.push_back(prev.plane(c));
+  }
+  float* dbg_disocc = o.debug_layers ? out.add_channel("debug.disocclusion") : nullptr;
+  float* dbg_conf = o.debug_layers ? out.add_channel("debug.confidence") : nullptr;
+  const bool history = s.have_history;
+  std::atomic<std::size_t> holes{0}, hits{0};
+  parallel_rows(f.H, [&](int y0, int y1) {
+    thread_local std::vector<float> fill, computed, hole;
+    thread_local HistoryRow hist;
+    fill.resize(std::size_t(C) * f.W);
+    computed.resize(f.W);
+    hole.resize(f.W);
+    std::vector<float*> fill_rows(C);
+    for (int c = 0; c < C; ++c) fill_rows[c] = fill.data() + std::size_t(c) * f.W;
+    std::size_t band_holes = 0, band_hits = 0;
+    for (int Y = y0; Y < y1; ++Y) {
+      const std::size_t row = std::size_t(Y) * f.W;
+      const bool row_computed = s.rows.d[Y] == 0;
+      const std::size_t lrow = std::size_t(s.rows.i0[Y]) * f.lw;
+      // w_t of eq. 4: 1 where this frame shaded the pixel (and the sample is finite).
+      for (int X = 0; X < f.W; ++X)
+        computed[X] = (row_computed && s.cols.d[X] == 0 && s.lvalid[lrow + s.cols.i0[X]] > 0) ? 1.0f : 0.0f;
+      if (history) {
+        history_row(s, f, o, Y, hist);
+      } else {
+        hist.resize(f.W);
+        std::fill(hist.hit.begin(), hist.hit.end(), 0.0f);
+      }
+      std::size_t row_holes = 0, row_hits = 0;
+      for (int X = 0; X < f.W; ++X) {
+        hole[X] = (computed[X] == 0.0f && hist.hit[X] == 0.0f) ? 1.0f : 0.0f;
+        row_holes += hole[X] > 0 ? 1 : 0;
+        row_hits += (computed[X] == 0.0f && hist.hit[X] > 0.0f) ? 1 : 0;
+      }
+      if (history) {  // eq. 4, w_t = 0: the previous output at p + motion
+        for (int c0 = 0; c0 < C; c0 += 4) {
+          const float* src[4];
+          float* dst[4];
+          const int n = std::min(4, C - c0);
+          for (int i = 0; i < n; ++i) {
+            src[i] = prev_planes[c0 + i];
+            dst[i] = planes[c0 + i] + row;
+          }
+          gather_history_planes(hist, src, dst, n, f.W);
+        }
+      }
+      for (int c = 0; c < C; ++c) {
+        float* out_row = planes[c] + row;
+        const float* l = f.low[c] + lrow;
+        const int* ci0 = s.cols.i0.data();
+        for (int X = 0; X < f.W; ++X) {
+          const float h = history && hist.hit[X] > 0 ? out_row[X] : 0.0f;
+          out_row[X] = computed[X] > 0 ? l[ci0[X]] : h;  // eq. 4, w_t = 1
+        }
+      }
+      if (row_holes > 0 || dbg_conf) {
+        spatial_row(s, f, o, Y, fill_rows.data(), dbg_conf ? dbg_conf + row : nullptr);
+        for (int c = 0; c < C; ++c)
+          for (int X = 0; X < f.W; ++X)
+            if (hole[X] > 0) planes[c][row + X] = fill_rows[c][X];
+      }
+      if (dbg_disocc)
+        for (int X = 0; X < f.W; ++X) dbg_disocc[row + X] = hole[X];
+      band_holes += row_holes;
+      band_hits += row_hits;
+    }
+    holes += band_holes;
+    hits += band_hits;
+  });
+  stats.hole_pixels = holes;
+  stats.history_pixels = hits;
+}
+
+}  // namespace temporal::upsample

@@ -1,0 +1,271 @@
+// Internal state and per-frame context shared by the upsampling methods (not installed).
+#pragma once
+
+#include "temporal/image.h"
+#include "temporal/joint_bilateral.h"
+#include "temporal/reprojection.h"
+#include "temporal/upsample.h"
+
+#include <bit>
+#include <cmath>
+#include <cstdint>
+#include <vector>
+
+namespace temporal::upsample {
+
+// Vectorisable exp2 / log2 for the per-tap kernel powers (std::pow does not vectorise without
+// -ffast-math). log2: relative error < 1e-6 on normal positive floats; exp2: relative error < 2e-6 for
+// x in [-126, 0], clamped below.
+inline float fast_log2(float x) {
+  const std::uint32_t bits = std::bit_cast<std::uint32_t>(x);
+  const float e = float(int((bits >> 23) & 255u) - 127);
+  const float m = std::bit_cast<float>((bits & 0x7fffffu) | 0x3f800000u);  // [1, 2)
+  const float t = (m - 1.0f) / (m + 1.0f);                                 // [0, 1/3)
+  const float t2 = t * t;
+  const float s = t * (1.0f + t2 * (1.0f / 3 + t2 * (1.0f / 5 + t2 * (1.0f / 7 + t2 * (1.0f / 9)))));
+  return e + s * 2.8853900817779268f;  // 2 / ln 2
+}
+inline float fast_exp2(float x) {
+  x = x < -126.0f ? -126.0f : (x > 0.0f ? 0.0f : x);
+  const float xi = std::floor(x);
+  const float f = (x - xi) * 0.69314718056f;  // 2^f = e^(f ln 2)
+  const float p =
+      1.0f + f * (1.0f + f * (0.5f + f * (1.0f / 6 + f * (1.0f / 24 + f * (1.0f / 120 + f * (1.0f / 720 + f * (1.0f / 5040)))))));
+  const float scale = std::bit_cast<float>(std::uint32_t(int(xi) + 127) << 23);
+  return p * scale;
+}
+
+// Everything one frame needs, resolved and validated by Upsampler::process().
+struct FrameContext {
+  int W = 0, H = 0;      // full (G-buffer) resolution
+  int lw = 0, lh = 0;    // low resolution
+  JitterGrid grid;       // k, sx, sy
+  int C = 0;             // payload channels
+  std::vector<const float*> low;  // C low-resolution planes
+  const float *z = nullptr, *nx = nullptr, *ny = nullptr, *nz = nullptr, *mx = nullptr, *my = nullptr;
+  const std::uint32_t* id = nullptr;
+  float sigma_d = 1.0f;      // world units
+  float depth_range = 1.0f;  // far - near (world units), for the Listing 7.1 depth weight
+  std::vector<float> luma;   // C weights of the gradient's scalar "norm" (Rec.709 luminance for R,G,B)
+};
+
+// Per-column and per-row tap tables of the jittered low-resolution grid: taps x0 = floor((X - sx) / k) and
+// x0 + 1, clamped read indices, 0/1 validity (a tap outside the low image does not exist), offset X - (k x0 + sx).
+struct TapTable {
+  std::vector<int> i0, i1, d;
+  std::vector<float> v0, v1;
+  void build(int full, int low, int k, int s);
+};
+
+struct Upsampler::State {
+  int W = 0, H = 0, k = 0, C = 0, lw = 0, lh = 0;
+  bool have_history = false;
+  int prev_sx = 0, prev_sy = 0;
+  std::vector<std::string> channels;
+  TapTable cols, rows;
+  // Geometry of this frame's low-resolution samples, gathered from the G-buffer, and payload validity.
+  std::vector<float> lz, lnx, lny, lnz, lvalid;
+  // Full-resolution results, ping-pong: result[cur] is this frame's, result[1 - cur] the previous one
+  // (the history of `temporal`, `herzog` and drobot `refresh`).
+  Image result[2];
+  int cur = 0;
+  Image aa;  // antialiasing variant: downsampled output
+  // Previous G-buffer depth and id (for the disocclusion tests).
+  std::vector<float> prev_z;
+  std::vector<std::uint32_t> prev_id;
+  // herzog: history weights (ping-pong), scratch of pass A, gradient state at the intermediate resolution.
+  std::vector<float> hw[2];
+  std::vector<float> w_tilde, w_conf, hw_fetch;
+  std::vector<std::vector<float>> hr_fetch;
+  int GW = 0, GH = 0;
+  std::vector<float> dcur, dcount;
+  std::vector<float> dhist[2][3];  // relative gradients of t-1, t-2, t-3 (ping-pong)
+  std::vector<float> gfilt, wf[2], grad_smooth;
+  std::vector<std::vector<float>> pyramid;
+  std::vector<int> pyr_w, pyr_h;
+  // drobot cache mode: low-resolution history (value, depth, frame count), ping-pong, and filter scratch.
+  std::vector<std::vector<float>> hb_val[2];
+  std::vector<float> hb_z[2], hb_n[2];
+  std::vector<std::vector<float>> cb_val, cb_tmp;
+  std::vector<float> cb_conf, cb_hit, cb_w, cb_strength, cb_avail, cb_avail_h;
+  std::vector<float> bilinear_table;
+  // drobot cache grid: one sample per k x k block at its centre.
+  TapTable cache_cols, cache_rows;
+  std::vector<float> cz, cnx, cny, cnz, cache_table;
+};
+
+// Motion-compensated history taps of one full-resolution row (reprojection.h), written branch-free so the
+// loop vectorises (gathers of the previous depth and id): for pixel X, indices q[j][X] into the previous
+// frame's full-resolution buffers and bilinear weights w[j][X] of the four taps, renormalised over the taps
+// that pass the disocclusion test; all weights 0 (and hit[X] = 0) on a miss.
+struct HistoryRow {
+  std::vector<int> q[4];
+  std::vector<float> w[4];
+  std::vector<float> hit;
+  void resize(int W) {
+    for (auto& v : q) v.resize(W);
+    for (auto& v : w) v.resize(W);
+    hit.resize(W);
+  }
+};
+
+template <bool kIds>
+inline void history_row_impl(const Upsampler::State& s, const FrameContext& f, const Options& o, int Y,
+                             HistoryRow& h) {
+  const int W = f.W, H = f.H;
+  const std::size_t row = std::size_t(Y) * W;
+  const float* __restrict mxr = f.mx + row;
+  const float* __restrict myr = f.my + row;
+  const float* __restrict zr = f.z + row;
+  const float* __restrict pz = s.prev_z.data();
+  const std::uint32_t* __restrict idr = kIds ? f.id + row : nullptr;
+  const std::uint32_t* __restrict pid = kIds ? s.prev_id.data() : nullptr;
+  const float tol = o.depth_tolerance;
+  int* __restrict q0 = h.q[0].data();
+  int* __restrict q1 = h.q[1].data();
+  int* __restrict q2 = h.q[2].data();
+  int* __restrict q3 = h.q[3].data();
+  float* __restrict w0 = h.w[0].data();
+  float* __restrict w1 = h.w[1].data();
+  float* __restrict w2 = h.w[2].data();
+  float* __restrict w3 = h.w[3].data();
+  float* __restrict hit = h.hit.data();
+  const float fY = float(Y);
+  // Bitwise & instead of && keeps the loop free of branches (it vectorises, with gathers).
+  auto same = [=](float z, float zp) { return std::abs(z - zp) <= tol * (z > zp ? z : zp); };
+#pragma GCC ivdep
+  for (int X = 0; X < W; ++X) {
+    float mx = mxr[X], my = myr[X];
+    const bool finite = (std::abs(mx) < 1e6f) & (std::abs(my) < 1e6f);  // NaN/Inf/absurd motion: no history
+    mx = finite ? mx : 0.0f;
+    my = finite ? my : 0.0f;
+    const float u = float(X) + mx, v = fY + my;
+    const float fu = std::floor(u), fv = std::floor(v);
+    const float ax = u - fu, ay = v - fv;
+    const int x0 = int(fu), y0 = int(fv);
+    const bool ix0 = (x0 >= 0) & (x0 < W), ix1 = (x0 + 1 >= 0) & (x0 + 1 < W);
+    const bool iy0 = (y0 >= 0) & (y0 < H), iy1 = (y0 + 1 >= 0) & (y0 + 1 < H);
+    const int cx0 = std::clamp(x0, 0, W - 1), cx1 = std::clamp(x0 + 1, 0, W - 1);
+    const int cy0 = std::clamp(y0, 0, H - 1), cy1 = std::clamp(y0 + 1, 0, H - 1);
+    const int a = cy0 * W + cx0, b = cy0 * W + cx1, c = cy1 * W + cx0, d = cy1 * W + cx1;
+    const float z = zr[X];
+    bool ok0 = finite & ix0 & iy0 & same(z, pz[a]);
+    bool ok1 = finite & ix1 & iy0 & same(z, pz[b]);
+    bool ok2 = finite & ix0 & iy1 & same(z, pz[c]);
+    bool ok3 = finite & ix1 & iy1 & same(z, pz[d]);
+    if constexpr (kIds) {
+      const std::uint32_t id = idr[X];
+      ok0 = ok0 & (pid[a] == id);
+      ok1 = ok1 & (pid[b] == id);
+      ok2 = ok2 & (pid[c] == id);
+      ok3 = ok3 & (pid[d] == id);
+    }
+    const float e0 = ok0 ? (1 - ax) * (1 - ay) : 0.0f, e1 = ok1 ? ax * (1 - ay) : 0.0f;
+    const float e2 = ok2 ? (1 - ax) * ay : 0.0f, e3 = ok3 ? ax * ay : 0.0f;
+    const float sum = e0 + e1 + e2 + e3;
+    const float inv = sum >= 1e-3f ? 1.0f / sum : 0.0f;
+    q0[X] = a;
+    q1[X] = b;
+    q2[X] = c;
+    q3[X] = d;
+    w0[X] = e0 * inv;
+    w1[X] = e1 * inv;
+    w2[X] = e2 * inv;
+    w3[X] = e3 * inv;
+    hit[X] = inv > 0.0f ? 1.0f : 0.0f;
+  }
+}
+
+inline void history_row(const Upsampler::State& s, const FrameContext& f, const Options& o, int Y, HistoryRow& h) {
+  h.resize(f.W);
+  if (o.use_ids && f.id && !s.prev_id.empty())
+    history_row_impl<true>(s, f, o, Y, h);
+  else
+    history_row_impl<false>(s, f, o, Y, h);
+}
+
+// Segments [X0, X1) of a HistoryRow whose taps are the image-aligned 2x2 block at a constant offset from
+// X (q0 = base + X, q1 = q0 + 1, q2 = q0 + W, q3 = q2 + 1): where the motion is locally constant (camera pans,
+// static regions) the taps can be read with contiguous vector loads instead of gathers.
+template <typename F>
+inline void for_each_segment(const HistoryRow& h, int W, F&& f) {
+  const int* q0 = h.q[0].data();
+  const int* q1 = h.q[1].data();
+  const int* q2 = h.q[2].data();
+  const int* q3 = h.q[3].data();
+  int X = 0;
+  while (X < W) {
+    const int base = q0[X] - X;
+    int E = X;
+    while (E < W && q0[E] - E == base && q1[E] == q0[E] + 1 && q2[E] == q0[E] + W && q3[E] == q2[E] + 1) ++E;
+    if (E - X >= 16) {
+      f(X, E, true, base);
+      X = E;
+    } else {
+      // A short run (or a pixel whose taps are clamped at the border): gather until the next long run.
+      int G = std::max(E, X + 1);
+      f(X, G, false, 0);
+      X = G;
+    }
+  }
+}
+
+// The four-tap gather of up to 4 previous-frame planes with the weights of a HistoryRow, in one pass (the
+// indices and weights are loaded once for all planes).
+inline void gather_history_planes(const HistoryRow& h, const float* const* prev, float* const* out, int n, int W) {
+  const int* __restrict q0 = h.q[0].data();
+  const int* __restrict q1 = h.q[1].data();
+  const int* __restrict q2 = h.q[2].data();
+  const int* __restrict q3 = h.q[3].data();
+  const float* __restrict w0 = h.w[0].data();
+  const float* __restrict w1 = h.w[1].data();
+  const float* __restrict w2 = h.w[2].data();
+  const float* __restrict w3 = h.w[3].data();
+  for_each_segment(h, W, [&](int X0, int X1, bool contiguous, int base) {
+    for (int i = 0; i < n; ++i) {
+      const float* __restrict p = prev[i];
+      float* __restrict o = out[i];
+      if (contiguous) {
+        // Taps 0/1 are p[base + X], p[base + X + 1]; taps 2/3 the same one row below.
+#pragma GCC ivdep
+        for (int X = X0; X < X1; ++X) {
+          const int a = base + X;
+          o[X] = w0[X] * p[a] + w1[X] * p[a + 1] + w2[X] * p[a + W] + w3[X] * p[a + W + 1];
+        }
+      } else {
+#pragma GCC ivdep
+        for (int X = X0; X < X1; ++X)
+          o[X] = w0[X] * p[q0[X]] + w1[X] * p[q1[X]] + w2[X] * p[q2[X]] + w3[X] * p[q3[X]];
+      }
+    }
+  });
+}
+
+// The four-tap gather of a previous-frame plane with the weights of a HistoryRow.
+inline void gather_history(const HistoryRow& h, const float* prev, float* out, int W) {
+  const int* __restrict q0 = h.q[0].data();
+  const int* __restrict q1 = h.q[1].data();
+  const int* __restrict q2 = h.q[2].data();
+  const int* __restrict q3 = h.q[3].data();
+  const float* __restrict w0 = h.w[0].data();
+  const float* __restrict w1 = h.w[1].data();
+  const float* __restrict w2 = h.w[2].data();
+  const float* __restrict w3 = h.w[3].data();
+#pragma GCC ivdep
+  for (int X = 0; X < W; ++X) out[X] = w0[X] * prev[q0[X]] + w1[X] * prev[q1[X]] + w2[X] * prev[q2[X]] + w3[X] * prev[q3[X]];
+}
+
+// Per-method implementations (one .cpp each). Each fills s.result[s.cur] and stats.
+void gather_low_geometry(Upsampler::State& s, const FrameContext& f);
+void run_spatial(Upsampler::State& s, const FrameContext& f, const Options& o, FrameStats& stats);
+void run_temporal(Upsampler::State& s, const FrameContext& f, const Options& o, FrameStats& stats);
+void run_herzog(Upsampler::State& s, const FrameContext& f, const Options& o, FrameStats& stats);
+void run_drobot(Upsampler::State& s, const FrameContext& f, const Options& o, FrameStats& stats);
+
+// Joint-bilateral upsampling (eq. 1-3, hat kernel) of full-resolution row Y into out[c][0 .. W); `wsum`
+// (row of W values) receives the sum of weights when not null. Shared by `spatial` and the hole filling of
+// `temporal`.
+void spatial_row(const Upsampler::State& s, const FrameContext& f, const Options& o, int Y, float* const* out,
+                 float* wsum);
+
+}  // namespace temporal::upsample

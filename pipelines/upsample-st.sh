@@ -1,0 +1,129 @@
+#!/usr/bin/env bash
+# Reproduces seed 000's Table 1 and Figure 8 (Herzog et al. 2010, "Spatio-Temporal Upsampling on the GPU") on the
+# built-in scenes: each scene is rendered by render-gbuffer (full-resolution G-buffer, the payload at 1/4 x 1/4
+# under the regular 4x4 jitter pattern, the full-resolution payload's cost, and a supersampled reference), every
+# upsample-st method rebuilds the full-resolution payload, and compare reports PSNR per frame (Figure 8's PSNR, as
+# PNG charts) and the table of Table 1: per method, low-resolution shading ms + upsampling ms next to the
+# full-resolution shading ms, and mean PSNR against the reference.
+#
+# Usage: pipelines/upsample-st.sh [BUILD_DIR] [OUT_DIR] [SCENE.glb ...]
+#   BUILD_DIR  where the tools were built (default build/release)
+#   OUT_DIR    report folder (default report/upsample-st)
+#   SCENE      scenes to run (default: the built-in walkers (the horses scene), tower and fan of assets/scenes)
+# Environment: SIZE (default 640x512; the paper used 1280x1024), FRAMES (default 0-63), FPS (default 30),
+#   FACTOR (default 4), METHODS (default "spatial temporal herzog drobot"; also "herzog-lagged" = herzog
+#   --lagged-wf and "drobot-refresh" = drobot --mode refresh), REFERENCE_SPP (default 16),
+#   RENDER_ARGS (extra render-gbuffer options; default "--payload direct,shadow,ssao"), UPSAMPLE_ARGS (extra
+#   upsample-st options for every method).
+#
+# Costs: shading ms are render-gbuffer's `shadeLow` (payload at 1/FACTOR resolution) and `shadeFull` (the same
+# payload at full resolution) from timings.csv, upsampling ms are upsample-st's `temporal:computeMs` (mean
+# over frames, as printed by compare). Both are measured on this machine (llvmpipe for the shading).
+set -euo pipefail
+
+here="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+BUILD="${1:-build/release}"
+OUT="${2:-report/upsample-st}"
+shift $(( $# > 2 ? 2 : $# ))
+SIZE="${SIZE:-640x512}"
+FRAMES="${FRAMES:-0-63}"
+FPS="${FPS:-30}"
+FACTOR="${FACTOR:-4}"
+METHODS="${METHODS:-spatial temporal herzog drobot}"
+REFERENCE_SPP="${REFERENCE_SPP:-16}"
+RENDER_ARGS="${RENDER_ARGS:---payload direct,shadow,ssao}"
+UPSAMPLE_ARGS="${UPSAMPLE_ARGS:-}"
+
+case "$BUILD" in /*) ;; *) BUILD="$PWD/$BUILD" ;; esac
+render="$BUILD/apps/render-gbuffer/render-gbuffer"
+upsample="$BUILD/apps/upsample-st/upsample-st"
+compare="$BUILD/apps/compare/compare"
+for t in "$render" "$upsample" "$compare"; do
+  if [[ ! -x "$t" ]]; then
+    echo "upsample-st.sh: $t is missing: build the project first (cmake --preset release && cmake --build --preset release)" >&2
+    exit 2
+  fi
+done
+
+scenes=("$@")
+if [[ ${#scenes[@]} -eq 0 ]]; then
+  for s in walkers tower fan; do
+    [[ -f "$here/assets/scenes/$s.glb" ]] && scenes+=("$here/assets/scenes/$s.glb")
+  done
+fi
+if [[ ${#scenes[@]} -eq 0 ]]; then
+  echo "upsample-st.sh: no scenes given and none in $here/assets/scenes" >&2
+  exit 2
+fi
+
+# Mean of a named column of a CSV file (empty cells skipped).
+csv_mean() {
+  awk -F, -v col="$2" '
+    NR == 1 { for (i = 1; i <= NF; i++) if ($i == col) c = i; next }
+    c && $c != "" { s += $c; n++ }
+    END { if (n) printf "%.3f", s / n; else printf "-" }' "$1"
+}
+
+mkdir -p "$OUT"
+summary="$OUT/summary.md"
+{
+  echo "# upsample-st: seed 000 Table 1 / Figure 8 on the built-in scenes"
+  echo
+  echo "Size $SIZE, factor $FACTOR, frames $FRAMES at $FPS fps; reference: $REFERENCE_SPP spp; render options: $RENDER_ARGS."
+  echo "shade = render-gbuffer shadeLow (1/$FACTOR payload), up = upsample-st compute ms, full = shadeFull"
+  echo "(payload at full resolution); PSNR (RGB, dB) against the reference, mean over frames."
+  echo
+} > "$summary"
+
+for scene in "${scenes[@]}"; do
+  name="$(basename "${scene%.*}")"
+  dir="$OUT/$name"
+  mkdir -p "$dir"
+  echo "== $name: rendering ($SIZE, factor $FACTOR, frames $FRAMES)" >&2
+  # shellcheck disable=SC2086
+  "$render" "$scene" --out "$dir/render" --size "$SIZE" --fps "$FPS" --frames "$FRAMES" --factor "$FACTOR" \
+    --outputs gbuffer,shade,reference,color --reference-spp "$REFERENCE_SPP" $RENDER_ARGS
+
+  tests=()
+  names=""
+  for m in $METHODS; do
+    case "$m" in
+      herzog-lagged) args="--method herzog --lagged-wf" ;;
+      drobot-refresh) args="--method drobot --mode refresh" ;;
+      *) args="--method $m" ;;
+    esac
+    echo "== $name: upsample-st $args" >&2
+    # shellcheck disable=SC2086
+    "$upsample" --gbuffer "$dir/render/gbuffer.####.exr" --input "$dir/render/shade.####.exr" \
+      --out "$dir/$m/up-$m.####.exr" $args $UPSAMPLE_ARGS
+    tests+=("$dir/$m/up-$m.####.exr")
+    names+="${names:+,}$m"
+  done
+
+  echo "== $name: compare" >&2
+  "$compare" --reference "$dir/render/reference.####.exr" "${tests[@]}" --names "$names" \
+    --gbuffer "$dir/render/gbuffer.####.exr" --csv "$dir/metrics.csv" --json "$dir/metrics.json" \
+    --plot "$dir/psnr.png" | tee "$dir/compare.txt"
+
+  shade_low="$(csv_mean "$dir/render/timings.csv" shadeLow)"
+  shade_full="$(csv_mean "$dir/render/timings.csv" shadeFull)"
+  {
+    echo "## $name"
+    echo
+    echo "| method | shade ms | up ms | total ms | full-res shade ms | speed-up | PSNR dB |"
+    echo "|---|---|---|---|---|---|---|"
+    # compare's table: sequence frames psnr_rgb psnr_y ssim flicker compute_ms
+    awk -v low="$shade_low" -v full="$shade_full" '
+      NR > 1 && NF >= 7 {
+        up = ($7 == "-") ? 0 : $7; total = low + up
+        printf "| %s | %s | %s | %.3f | %s | %.1fx | %s |\n", $1, low, $7, total, full, (total > 0 ? full / total : 0), $3
+      }' "$dir/compare.txt"
+    echo
+    echo "Per-frame PSNR: $name/psnr.png; metrics: $name/metrics.csv, $name/metrics.json."
+    echo
+  } >> "$summary"
+done
+
+echo
+cat "$summary"
+echo "upsample-st.sh: report in $OUT (summary.md, per scene: metrics.csv, metrics.json, psnr*.png)" >&2

@@ -1,0 +1,112 @@
+// filter-phlm's methods at 1920x1080 (RGB, 1 spp noise, fractional motion so that the history fetches
+// interpolate), next to the streaming bound of PHLM's state traffic: a memcpy of the bytes the filter must
+// read and write per frame (26 floats of models read at p + motion and 26 written, per pixel).
+// Run: build/<dir>/tests/benchmarks/phlm/phlm_bench [--benchmark_filter=...]
+#include "temporal/ema.h"
+#include "temporal/fxaa.h"
+#include "temporal/parallel.h"
+#include "temporal/phlm.h"
+#include "temporal/taa.h"
+
+#include <benchmark/benchmark.h>
+
+#include <cstring>
+#include <random>
+#include <vector>
+
+namespace {
+
+using namespace temporal;
+constexpr int kW = 1920, kH = 1080;
+
+struct Scene {
+  Image color{kW, kH}, gbuffer{kW, kH};
+  Scene() {
+    std::mt19937 rng(1);
+    std::uniform_real_distribution<float> u(0.0f, 1.0f);
+    for (const char* c : {"R", "G", "B"}) {
+      float* p = color.add_channel(c);
+      for (std::size_t i = 0; i < color.pixel_count(); ++i) p[i] = 0.5f * float((i / 7 + i / kW / 5) % 2) + 0.3f * u(rng);
+    }
+    gbuffer.add_channel("motion.X", 0.37f);
+    gbuffer.add_channel("motion.Y", -0.21f);
+    gbuffer.add_channel("depth.Z", 4.0f);
+    gbuffer.add_uint_channel("id", 1);
+  }
+  FilterInput input(bool with_motion) const {
+    FilterInput in;
+    in.color = &color;
+    in.channels = {"R", "G", "B"};
+    if (with_motion) {
+      in.motion_x = gbuffer.plane("motion.X");
+      in.motion_y = gbuffer.plane("motion.Y");
+      in.depth = gbuffer.plane("depth.Z");
+      in.id = gbuffer.uint_plane("id");
+    }
+    in.jitter = {0.25f, -0.125f};
+    return in;
+  }
+};
+
+const Scene& scene() {
+  static const Scene s;
+  return s;
+}
+
+template <typename Filter>
+void run_filter(benchmark::State& state) {
+  ThreadLimit limit(int(state.range(1)));
+  Filter filter;
+  Image out;
+  const FilterInput in = scene().input(state.range(0) != 0);
+  (void)filter.process(in, out);  // first frame: allocations and resets
+  for (auto _ : state) {
+    (void)filter.process(in, out);
+    benchmark::DoNotOptimize(out.plane("R"));
+  }
+  state.SetItemsProcessed(state.iterations() * int64_t(kW) * kH);
+}
+
+void BM_Phlm(benchmark::State& s) { run_filter<PhlmFilter>(s); }
+void BM_Taa(benchmark::State& s) { run_filter<TaaFilter>(s); }
+void BM_Ema(benchmark::State& s) { run_filter<EmaFilter>(s); }
+
+void BM_Fxaa(benchmark::State& state) {
+  ThreadLimit limit(int(state.range(0)));
+  Image out;
+  const FilterInput in = scene().input(false);
+  for (auto _ : state) {
+    (void)fxaa(in, out);
+    benchmark::DoNotOptimize(out.plane("R"));
+  }
+}
+
+// The streaming bound: copy the bytes of one frame's PHLM state (read + write), in parallel bands like the
+// filter. Nothing the filter does per frame can take less than this on the same memory system.
+void BM_PhlmStateStreamBound(benchmark::State& state) {
+  ThreadLimit limit(int(state.range(0)));
+  const std::size_t bytes = std::size_t(kW) * kH * std::size_t(phlm_state_floats(3)) * sizeof(float);
+  std::vector<char> src(bytes, 1), dst(bytes, 0);
+  for (auto _ : state) {
+    parallel_rows(kH, [&](int y0, int y1) {
+      const std::size_t row = bytes / kH;
+      std::memcpy(dst.data() + std::size_t(y0) * row, src.data() + std::size_t(y0) * row, std::size_t(y1 - y0) * row);
+    });
+    benchmark::DoNotOptimize(dst.data());
+    benchmark::ClobberMemory();
+  }
+  state.SetBytesProcessed(state.iterations() * int64_t(bytes) * 2);
+}
+
+}  // namespace
+
+// Args: motion (1: a G-buffer with fractional motion, bilinear / Catmull-Rom history fetches; 0: static
+// scene), threads (0: every core; 1: one thread, whose time is meaningful on a loaded machine).
+BENCHMARK(BM_Phlm)->ArgNames({"motion", "threads"})->Args({1, 0})->Args({0, 0})->Args({1, 1})
+    ->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_Taa)->ArgNames({"motion", "threads"})->Args({1, 0})->Args({0, 0})->Args({1, 1})
+    ->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_Ema)->ArgNames({"motion", "threads"})->Args({1, 0})->Args({1, 1})->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_Fxaa)->ArgNames({"threads"})->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_PhlmStateStreamBound)->ArgNames({"threads"})->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_MAIN();

@@ -1,0 +1,135 @@
+// Milliseconds of each render-gbuffer pass on llvmpipe, per built-in scene (assets/scenes), at 1280x1024
+// by default (the resolution of seed 000's Table 1):
+//   Gbuffer/<scene>    full-resolution G-buffer raster (glFinish included, read-back excluded)
+//   ShadeLow/<scene>   low-res (1/4 x 1/4) jittered G-buffer + full payload shading
+//   ShadeFull/<scene>  full payload shading of one full-resolution G-buffer
+//   Reference/<scene>  reference_spp full-resolution samples (G-buffer + payload each)
+// The time of each iteration is the pass's own timing from the renderer (manual time). Environment:
+//   TEMPORAL_BENCH_SIZE=WxH (default 1280x1024), TEMPORAL_BENCH_SPP (reference samples, default 16),
+//   TEMPORAL_BENCH_SCENES=walkers,tower (default: every built-in scene).
+#include "temporal/render.h"
+#include "temporal/scene.h"
+
+#include <benchmark/benchmark.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <memory>
+#include <sstream>
+#include <string>
+#include <vector>
+
+namespace {
+
+using namespace temporal;
+
+int env_int(const char* name, int fallback) {
+  const char* v = std::getenv(name);
+  return v ? std::atoi(v) : fallback;
+}
+
+struct Size {
+  int w = 1280, h = 1024;
+};
+
+Size bench_size() {
+  Size s;
+  if (const char* v = std::getenv("TEMPORAL_BENCH_SIZE")) std::sscanf(v, "%dx%d", &s.w, &s.h);
+  return s;
+}
+
+struct Loaded {
+  Scene scene;
+  SceneGeometry geometry;
+};
+
+// Scenes are loaded once and kept (a Scene is not copyable).
+Loaded* load(const std::string& name) {
+  static std::vector<std::pair<std::string, std::unique_ptr<Loaded>>> cache;
+  for (auto& [n, l] : cache)
+    if (n == name) return l.get();
+  auto scene = Scene::load(std::string(TEMPORAL_SOURCE_DIR) + "/assets/scenes/" + name + ".glb");
+  if (!scene) return nullptr;
+  auto l = std::make_unique<Loaded>();
+  l->scene = std::move(*scene);
+  l->geometry = {&l->scene.primitives(), &l->scene.materials(), &l->scene.textures(), l->scene.bounds_min(),
+                 l->scene.bounds_max()};
+  cache.emplace_back(name, std::move(l));
+  return cache.back().second.get();
+}
+
+void run_pass(benchmark::State& state, const std::string& scene_name, RenderOutputs outputs, const char* pass,
+              bool warm_up) {
+  Loaded* l = load(scene_name);
+  if (!l) {
+    state.SkipWithError(("cannot load assets/scenes/" + scene_name + ".glb").c_str());
+    return;
+  }
+  RenderOptions o;
+  const Size s = bench_size();
+  o.width = s.w;
+  o.height = s.h;
+  o.reference_spp = env_int("TEMPORAL_BENCH_SPP", 16);
+  o.outputs = outputs;
+  auto r = Renderer::create(o, l->geometry);
+  if (!r) {
+    state.SkipWithError(r.error().message.c_str());
+    return;
+  }
+  const double fps = 40.0;
+  int frame = 10;
+  auto render = [&](int n) {
+    const FrameState cur = l->scene.evaluate(n / fps), prev = l->scene.evaluate((n - 1) / fps);
+    FrameInput in;
+    in.frame = n;
+    in.fps = fps;
+    in.current = &cur;
+    in.previous = &prev;
+    return r->render(in);
+  };
+  if (warm_up) render(frame++);  // llvmpipe compiles shader variants at their first draw
+  double light_maps = 0.0;
+  for (auto _ : state) {
+    auto out = render(frame++);
+    if (!out) {
+      state.SkipWithError(out.error().message.c_str());
+      return;
+    }
+    state.SetIterationTime(out->timings_ms.at(pass) / 1000.0);
+    if (auto it = out->timings_ms.find(kPassLightMaps); it != out->timings_ms.end()) light_maps += it->second;
+  }
+  state.counters["lightMaps_ms"] = benchmark::Counter(light_maps, benchmark::Counter::kAvgIterations);
+  state.counters["pixels"] = double(s.w) * s.h;
+}
+
+std::vector<std::string> scene_names() {
+  std::string list = "walkers,tower,fan,fence";
+  if (const char* v = std::getenv("TEMPORAL_BENCH_SCENES")) list = v;
+  std::vector<std::string> out;
+  std::stringstream ss(list);
+  for (std::string item; std::getline(ss, item, ',');)
+    if (!item.empty()) out.push_back(item);
+  return out;
+}
+
+const int registered = [] {
+  for (const std::string& name : scene_names()) {
+    benchmark::RegisterBenchmark(("Gbuffer/" + name).c_str(), [name](benchmark::State& st) {
+      run_pass(st, name, RenderOutputs{true, false, false, false}, kPassGbuffer, true);
+    })->UseManualTime()->Unit(benchmark::kMillisecond)->Iterations(5);
+    benchmark::RegisterBenchmark(("ShadeLow/" + name).c_str(), [name](benchmark::State& st) {
+      run_pass(st, name, RenderOutputs{false, true, false, false}, kPassShadeLow, true);
+    })->UseManualTime()->Unit(benchmark::kMillisecond)->Iterations(3);
+    benchmark::RegisterBenchmark(("ShadeFull/" + name).c_str(), [name](benchmark::State& st) {
+      run_pass(st, name, RenderOutputs{false, false, false, true}, kPassShadeFull, false);
+    })->UseManualTime()->Unit(benchmark::kMillisecond)->Iterations(1);
+    benchmark::RegisterBenchmark(("Reference/" + name).c_str(), [name](benchmark::State& st) {
+      run_pass(st, name, RenderOutputs{false, false, true, false}, kPassReference, false);
+    })->UseManualTime()->Unit(benchmark::kMillisecond)->Iterations(1);
+  }
+  return 0;
+}();
+
+}  // namespace
+
+BENCHMARK_MAIN();

@@ -1,0 +1,104 @@
+// ms per frame of each upsampling method at 1280x1024 (factor 4, R,G,B payload) and, in the same run, the
+// time to stream the bytes the method must read and write (Upsampler::streamed_bytes: G-buffer planes,
+// payload in and out, full-resolution histories read and written once), measured as a parallel memcpy
+// moving that many bytes (half read, half written). Targets (issue 4): herzog <= 1.5x spatial, and within
+// 2.5x of its streaming bound.
+#include "synthetic.h"
+
+#include "temporal/parallel.h"
+#include "temporal/upsample.h"
+
+#include <benchmark/benchmark.h>
+
+#include <cstring>
+#include <memory>
+#include <vector>
+
+namespace up = temporal::upsample;
+using temporal::Image;
+
+namespace {
+
+constexpr int kW = 1280, kH = 1024, kK = 4;
+const std::vector<std::string> kRGB = {"R", "G", "B"};
+
+// A camera pan over a textured plane with a square standing still on screen: one G-buffer serves every
+// frame, the payload changes with the pan and the jitter. 16 frames, cycled.
+struct Inputs {
+  Image gbuffer;
+  std::vector<Image> low;
+  Inputs() {
+    temporal::test::SyntheticScene scene;
+    scene.width = kW;
+    scene.height = kH;
+    scene.k = kK;
+    scene.period = 37.0f;
+    scene.camera_velocity = {1.25f, 0.5f};
+    scene.object = true;
+    scene.object_start = {400.0f, 300.0f};
+    scene.object_size = 300;
+    for (int t = 1; t <= kK * kK; ++t) {
+      auto f = temporal::test::make_frame(scene, t);
+      if (t == 1) gbuffer = std::move(f.gbuffer);
+      low.push_back(std::move(f.low));
+    }
+  }
+};
+
+const Inputs& inputs() {
+  static const Inputs in;
+  return in;
+}
+
+up::Options options(int method) {
+  up::Options o;
+  switch (method) {
+    case 0: o.method = up::Method::Spatial; break;
+    case 1: o.method = up::Method::Temporal; break;
+    case 2: o.method = up::Method::Herzog; break;
+    case 3: o.method = up::Method::Drobot; break;
+    case 4: o.method = up::Method::Drobot; o.drobot_mode = up::DrobotMode::Refresh; break;
+    default: o.method = up::Method::Herzog; o.lagged_wf = true; break;
+  }
+  return o;
+}
+
+const char* kNames[] = {"spatial", "temporal", "herzog", "drobot", "drobot-refresh", "herzog-lagged-wf"};
+
+void BM_Upsample(benchmark::State& state) {
+  const int m = int(state.range(0));
+  const Inputs& in = inputs();
+  up::Upsampler u(options(m));
+  std::size_t t = 0;
+  for (int i = 0; i < 2 * kK * kK; ++i)  // warm the histories and buffers
+    (void)u.process(in.gbuffer, in.low[t++ % in.low.size()], kRGB, false);
+  for (auto _ : state) {
+    auto r = u.process(in.gbuffer, in.low[t++ % in.low.size()], kRGB, false);
+    benchmark::DoNotOptimize(r);
+  }
+  state.SetLabel(kNames[m]);
+  const std::size_t bytes = up::Upsampler::streamed_bytes(options(m), kW, kH, kK, 3);
+  state.counters["MB"] = double(bytes) / 1e6;
+}
+
+void BM_Stream(benchmark::State& state) {
+  const int m = int(state.range(0));
+  const std::size_t bytes = up::Upsampler::streamed_bytes(options(m), kW, kH, kK, 3);
+  const std::size_t n = bytes / 2;  // memcpy reads n bytes and writes n bytes
+  std::unique_ptr<char[]> src(new char[n]), dst(new char[n]);
+  std::memset(src.get(), 1, n);
+  std::memset(dst.get(), 2, n);
+  for (auto _ : state) {
+    temporal::parallel_chunks(n, [&](std::size_t b, std::size_t e) { std::memcpy(dst.get() + b, src.get() + b, e - b); },
+                              1 << 16);
+    benchmark::ClobberMemory();
+  }
+  state.SetLabel(std::string("stream bound of ") + kNames[m]);
+  state.counters["MB"] = double(bytes) / 1e6;
+}
+
+}  // namespace
+
+BENCHMARK(BM_Upsample)->DenseRange(0, 5)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_Stream)->DenseRange(0, 5)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_MAIN();

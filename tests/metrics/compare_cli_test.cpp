@@ -1,0 +1,211 @@
+// The built `compare` tool, run as a pipeline would: DISPLAY unset (compare must provide its own Xvfb), CSV
+// rows, JSON keys, PNG files, exit codes for thresholds and bad input, and every option of --help accepted.
+#include "temporal/exr.h"
+#include "temporal/image.h"
+
+#include "test_support.h"
+
+#include <nlohmann/json.hpp>
+
+#include <gtest/gtest.h>
+
+#include <array>
+#include <filesystem>
+#include <fstream>
+#include <random>
+#include <sstream>
+
+namespace temporal {
+namespace {
+
+namespace fs = std::filesystem;
+
+Image noisy(int w, int h, unsigned seed, float amount, const Image* base) {
+  Image img(w, h);
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<float> u(-amount, amount);
+  for (const char* c : {"R", "G", "B"}) {
+    float* p = img.add_channel(c);
+    for (std::size_t i = 0; i < img.pixel_count(); ++i) {
+      const float x = float(i % std::size_t(w)) / float(w), y = float(i / std::size_t(w)) / float(h);
+      p[i] = (base ? base->plane(c)[i] : 0.5f + 0.4f * std::sin(6.0f * x + 3.0f * y)) + u(rng);
+    }
+  }
+  return img;
+}
+
+std::string read_text(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+// True for a PNG file with a valid signature and an IHDR of the expected size.
+::testing::AssertionResult is_png(const fs::path& path, int width, int height) {
+  if (!fs::exists(path)) return ::testing::AssertionFailure() << path << " does not exist";
+  const auto bytes = read_text(path);
+  static const std::string sig("\x89PNG\r\n\x1a\n", 8);
+  if (bytes.size() < 33 || bytes.compare(0, 8, sig) != 0 || bytes.compare(12, 4, "IHDR") != 0)
+    return ::testing::AssertionFailure() << path << " is not a PNG (" << bytes.size() << " bytes)";
+  auto be32 = [&](std::size_t at) {
+    return (std::uint32_t(std::uint8_t(bytes[at])) << 24) | (std::uint32_t(std::uint8_t(bytes[at + 1])) << 16) |
+           (std::uint32_t(std::uint8_t(bytes[at + 2])) << 8) | std::uint32_t(std::uint8_t(bytes[at + 3]));
+  };
+  if (int(be32(16)) != width || int(be32(20)) != height)
+    return ::testing::AssertionFailure() << path << " is " << be32(16) << "x" << be32(20);
+  return ::testing::AssertionSuccess();
+}
+
+class CompareCli : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    tool_ = test::tool_path("compare").string();
+    if (!fs::exists(tool_)) GTEST_FAIL() << "compare is not built at " << tool_;
+    dir_ = test::scratch_dir(std::string("compare-cli-") +
+                             ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    for (int f = 1; f <= 3; ++f) {
+      char digits[8];
+      std::snprintf(digits, sizeof digits, "%04d", f);
+      Image ref = noisy(64, 40, 1, 0.0f, nullptr);
+      Image a = noisy(64, 40, unsigned(10 + f), 0.02f, &ref);
+      Image b = noisy(64, 40, unsigned(20 + f), 0.1f, &ref);
+      a.metadata().compute_ms = 1.5;
+      b.metadata().compute_ms = 0.5;
+      b.metadata().timings_ms["filter"] = 0.4;
+      ASSERT_TRUE(write_exr((dir_ / (std::string("ref.") + digits + ".exr")).string(), ref));
+      ASSERT_TRUE(write_exr((dir_ / (std::string("a.") + digits + ".exr")).string(), a));
+      ASSERT_TRUE(write_exr((dir_ / (std::string("b.") + digits + ".exr")).string(), b));
+      Image g(64, 40);
+      g.add_channel("motion.X", 0.0f);
+      g.add_channel("motion.Y", 0.0f);
+      ASSERT_TRUE(write_exr((dir_ / (std::string("g.") + digits + ".exr")).string(), g));
+    }
+  }
+  int run(const std::string& args, std::string* out = nullptr) {
+    return test::run_command("cd " + dir_.string() + " && env -u DISPLAY " + tool_ + " " + args, out);
+  }
+  std::string tool_;
+  fs::path dir_;
+};
+
+TEST_F(CompareCli, WritesCsvJsonAndPngWithoutDisplay) {
+  const bool have_xvfb = test::run_command("command -v Xvfb >/dev/null") == 0;
+  std::string out;
+  const int code = run("--reference ref.####.exr a.####.exr b.####.exr --names good,noisy --csv m.csv --json m.json "
+                       "--plot plots/p.png --verbose", &out);
+  if (have_xvfb) {
+    EXPECT_EQ(code, 0) << out;
+    EXPECT_NE(out.find("started Xvfb"), std::string::npos) << out;  // said only with --verbose
+    for (const char* name : {"p.png", "p-psnr-y.png", "p-ssim.png", "p-flicker.png", "p-speed.png"})
+      EXPECT_TRUE(is_png(dir_ / "plots" / name, 1280, 720)) << out;
+  } else {
+    // No Xvfb: a clear error and exit 4, but CSV and JSON are written.
+    EXPECT_EQ(code, 4) << out;
+    EXPECT_NE(out.find("Xvfb"), std::string::npos) << out;
+  }
+  // CSV: header + 3 frames x 2 sequences.
+  const auto csv = read_text(dir_ / "m.csv");
+  std::istringstream lines(csv);
+  std::string line;
+  std::vector<std::string> rows;
+  while (std::getline(lines, line)) rows.push_back(line);
+  ASSERT_EQ(rows.size(), 7u) << csv;
+  EXPECT_EQ(rows[0].rfind("frame,sequence,psnr_rgb_db,psnr_y_db,ssim,flicker,", 0), 0u) << rows[0];
+  EXPECT_EQ(rows[1].rfind("1,good,", 0), 0u);
+  EXPECT_EQ(rows[6].rfind("3,noisy,", 0), 0u);
+  // JSON summary.
+  const auto j = nlohmann::json::parse(read_text(dir_ / "m.json"));
+  for (const char* key : {"tool", "reference", "frames", "peak", "thresholds", "passed", "sequences"})
+    EXPECT_TRUE(j.contains(key)) << key;
+  ASSERT_EQ(j["sequences"].size(), 2u);
+  EXPECT_EQ(j["sequences"][0]["name"], "good");
+  for (const char* key : {"psnr_rgb", "psnr_y", "ssim", "flicker"}) {
+    EXPECT_TRUE(j["sequences"][1][key].contains("mean")) << key;
+    EXPECT_TRUE(j["sequences"][1][key].contains("min")) << key;
+  }
+  EXPECT_GT(j["sequences"][0]["psnr_rgb"]["mean"].get<double>(), j["sequences"][1]["psnr_rgb"]["mean"].get<double>());
+  EXPECT_EQ(j["sequences"][1]["compute_ms"], 0.5);
+  EXPECT_EQ(j["frames"]["count"], 3);
+  EXPECT_EQ(j["passed"], true);
+}
+
+TEST_F(CompareCli, WithoutXvfbPlotsFailWithExitFourButCsvAndJsonAreWritten) {
+  std::string out;
+  // An empty PATH hides Xvfb (compare itself is run by its full path).
+  const int code = test::run_command("cd " + dir_.string() + " && env -u DISPLAY PATH=/nonexistent " + tool_ +
+                                         " --reference ref.####.exr a.####.exr --csv m.csv --json m.json --plot p.png",
+                                     &out);
+  EXPECT_EQ(code, 4) << out;
+  EXPECT_NE(out.find("compare: p.png: cannot draw the plots: DISPLAY is unset and Xvfb is not installed"),
+            std::string::npos) << out;
+  EXPECT_TRUE(fs::exists(dir_ / "m.csv"));
+  EXPECT_TRUE(fs::exists(dir_ / "m.json"));
+  EXPECT_FALSE(fs::exists(dir_ / "p.png"));
+}
+
+TEST_F(CompareCli, ThresholdsGiveExitThree) {
+  std::string out;
+  // good: uniform noise 0.02 -> PSNR ~39.5 dB; noisy: 0.1 -> ~25.5 dB.
+  EXPECT_EQ(run("--reference ref.####.exr a.####.exr --fail-psnr 30", &out), 0) << out;
+  EXPECT_EQ(run("--reference ref.####.exr a.####.exr b.####.exr --fail-psnr 30 --json t.json", &out), 3) << out;
+  EXPECT_NE(out.find("b: psnr_rgb"), std::string::npos) << out;
+  const auto j = nlohmann::json::parse(read_text(dir_ / "t.json"));
+  EXPECT_EQ(j["passed"], false);
+  EXPECT_EQ(j["failures"][0]["sequence"], "b");
+  EXPECT_EQ(run("--reference ref.####.exr a.####.exr --fail-ssim 0.9999", &out), 3) << out;
+  EXPECT_EQ(run("--reference ref.####.exr b.####.exr --fail-flicker 0.001 --fail-on worst", &out), 3) << out;
+}
+
+TEST_F(CompareCli, ExitCodesForUsageErrors) {
+  std::string out;
+  EXPECT_EQ(run("--reference ref.####.exr", &out), 1) << out;                                // no test
+  EXPECT_EQ(run("--reference ref.####.exr a.####.exr --bogus", &out), 1) << out;            // unknown option
+  EXPECT_EQ(run("--reference ref.####.exr a.####.exr --peak -2", &out), 1) << out;          // bad value
+  EXPECT_EQ(run("--reference ref.####.exr a.####.exr --frames 3-1", &out), 1) << out;
+  EXPECT_EQ(run("--reference ref.####.exr a.####.exr --names x,y", &out), 1) << out;
+}
+
+TEST_F(CompareCli, ExitCodesForInputErrors) {
+  std::string out;
+  EXPECT_EQ(run("--reference ref.####.exr missing.####.exr", &out), 2) << out;              // missing files
+  EXPECT_NE(out.find("compare: "), std::string::npos);
+  EXPECT_EQ(run("--reference ref.####.exr a.####.exr --layer albedo", &out), 2) << out;     // missing layer
+  EXPECT_NE(out.find("albedo"), std::string::npos) << out;
+  EXPECT_EQ(run("--reference nothing.####.exr a.####.exr", &out), 2) << out;                // empty sequence
+  fs::resize_file(dir_ / "a.0002.exr", 100);
+  EXPECT_EQ(run("--reference ref.####.exr a.####.exr", &out), 2) << out;                    // truncated
+  EXPECT_NE(out.find("a.0002.exr"), std::string::npos) << out;
+}
+
+TEST_F(CompareCli, HelpListsEveryOptionAndEachIsAccepted) {
+  std::string help;
+  ASSERT_EQ(run("--help", &help), 0);
+  std::string version;
+  ASSERT_EQ(run("--version", &version), 0);
+  EXPECT_NE(version.find("compare "), std::string::npos);
+  // Every option documented in --help, fed to the parser in one run (without --plot to stay fast).
+  const std::array<std::pair<const char*, const char*>, 19> options = {{
+      {"--reference", "ref.####.exr"}, {"--names", "one"}, {"--csv", "all.csv"}, {"--json", "all.json"},
+      {"--gbuffer", "g.####.exr"}, {"--mask", "R"}, {"--layer", "rgb"}, {"--reference-layer", "rgb"},
+      {"--error-maps", "maps"}, {"--frames", "1-2"}, {"--peak", "max"}, {"--fail-psnr", "1"},
+      {"--fail-ssim", "0"}, {"--fail-flicker", "100"}, {"--fail-on", "worst"}, {"--threads", "1"},
+      {"--verbose", ""}, {"--plot", ""}, {"--help", ""}}};
+  std::string args;
+  for (const auto& [name, value] : options) {
+    EXPECT_NE(help.find(name), std::string::npos) << name << " is not in --help";
+    if (std::string(name) == "--plot" || std::string(name) == "--help") continue;
+    args += std::string(" ") + name + (*value ? std::string(" ") + value : std::string());
+  }
+  EXPECT_NE(help.find("Exit codes"), std::string::npos);
+  EXPECT_NE(help.find("--peak TEXT=1"), std::string::npos) << "--peak default not shown";
+  std::string out;
+  EXPECT_EQ(run(args + " a.####.exr", &out), 0) << args << "\n" << out;
+  EXPECT_TRUE(fs::exists(dir_ / "maps" / "one.0002.exr"));
+  EXPECT_FALSE(fs::exists(dir_ / "maps" / "one.0003.exr"));  // --frames 1-2
+  const auto csv = read_text(dir_ / "all.csv");
+  EXPECT_NE(csv.find("psnr_rgb_in_db"), std::string::npos);  // --mask columns
+}
+
+}  // namespace
+}  // namespace temporal

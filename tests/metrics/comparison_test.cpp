@@ -1,0 +1,461 @@
+// The comparison engine on EXR sequences: values against idiff and hand computations, identical sequences,
+// masks, error maps, outputs without NaN, and every kind of bad input.
+#include "temporal/comparison.h"
+#include "temporal/exr.h"
+#include "temporal/image.h"
+
+#include "test_support.h"
+
+#include <nlohmann/json.hpp>
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <random>
+#include <sstream>
+
+namespace temporal {
+namespace {
+
+namespace fs = std::filesystem;
+
+// A 3-channel image with uniform random values in [lo, hi).
+Image noise_image(int w, int h, unsigned seed, float lo = 0.0f, float hi = 1.0f) {
+  Image img(w, h);
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<float> u(lo, hi);
+  for (const char* c : {"R", "G", "B"}) {
+    float* p = img.add_channel(c);
+    for (std::size_t i = 0; i < img.pixel_count(); ++i) p[i] = u(rng);
+  }
+  return img;
+}
+
+std::string write_frame(const fs::path& dir, const std::string& name, int frame, const Image& img) {
+  char digits[16];
+  std::snprintf(digits, sizeof digits, "%04d", frame);
+  const auto path = (dir / (name + "." + digits + ".exr")).string();
+  EXPECT_TRUE(write_exr(path, img));
+  return path;
+}
+
+std::string pattern(const fs::path& dir, const std::string& name) { return (dir / (name + ".####.exr")).string(); }
+
+std::string read_text(const std::string& path) {
+  std::ifstream in(path);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+// "Peak SNR = 24.7712" from idiff's output; NaN when absent.
+double idiff_psnr(const std::string& a, const std::string& b) {
+  std::string out;
+  test::run_command("idiff " + a + " " + b, &out);
+  const auto at = out.find("Peak SNR = ");
+  if (at == std::string::npos) return NAN;
+  return std::atof(out.c_str() + at + 11);
+}
+
+bool have_idiff() { return test::run_command("command -v idiff >/dev/null") == 0; }
+
+TEST(Comparison, PsnrMatchesIdiffWithinUnitRange) {
+  if (!have_idiff()) GTEST_SKIP() << "idiff (openimageio-tools) is not in PATH";
+  const auto dir = test::scratch_dir("comparison-idiff");
+  const Image ref = noise_image(48, 32, 1);
+  Image test = ref;
+  std::mt19937 rng(2);
+  std::normal_distribution<float> noise(0.0f, 0.05f);
+  for (const char* c : {"R", "G", "B"}) {
+    float* p = test.plane(c);
+    for (std::size_t i = 0; i < test.pixel_count(); ++i) p[i] = std::clamp(p[i] + noise(rng), 0.0f, 1.0f);
+  }
+  const auto rp = write_frame(dir, "ref", 0, ref);
+  const auto tp = write_frame(dir, "test", 0, test);
+  ComparisonSetup setup;
+  setup.reference = pattern(dir, "ref");
+  setup.tests = {pattern(dir, "test")};
+  auto report = compare_sequences(setup);
+  ASSERT_TRUE(report) << report.error().message;
+  const double ours = report->sequences[0].frames[0].psnr_rgb;
+  const double theirs = idiff_psnr(rp, tp);
+  ASSERT_FALSE(std::isnan(theirs));
+  EXPECT_GT(ours, 20.0);
+  EXPECT_NEAR(ours, theirs, 1e-3);  // idiff prints 6 significant digits
+}
+
+TEST(Comparison, PeakMaxMatchesIdiffOnHdrData) {
+  if (!have_idiff()) GTEST_SKIP() << "idiff (openimageio-tools) is not in PATH";
+  const auto dir = test::scratch_dir("comparison-idiff-hdr");
+  const Image ref = noise_image(32, 32, 3, 0.0f, 4.0f);
+  const Image test = noise_image(32, 32, 4, 0.0f, 4.0f);
+  const auto rp = write_frame(dir, "ref", 0, ref);
+  const auto tp = write_frame(dir, "test", 0, test);
+  ComparisonSetup setup;
+  setup.reference = pattern(dir, "ref");
+  setup.tests = {pattern(dir, "test")};
+  setup.peak_from_data = true;
+  auto report = compare_sequences(setup);
+  ASSERT_TRUE(report);
+  const auto& f = report->sequences[0].frames[0];
+  EXPECT_GT(f.peak, 3.9);
+  EXPECT_NEAR(f.psnr_rgb, idiff_psnr(rp, tp), 1e-3);
+  // The default fixed peak of 1 gives 20 log10(peak) dB less.
+  setup.peak_from_data = false;
+  auto fixed = compare_sequences(setup);
+  ASSERT_TRUE(fixed);
+  EXPECT_NEAR(f.psnr_rgb - fixed->sequences[0].frames[0].psnr_rgb, 20.0 * std::log10(f.peak), 1e-6);
+}
+
+TEST(Comparison, HandComputedPsnrAndFlicker) {
+  // Reference constant 0.5; test = 0.5 + 0.1 on R only at even frames and 0.5 - 0.1 at odd frames.
+  // PSNR(RGB): MSE = 0.01 / 3 -> 10 log10(300) = 24.7712 dB. Luminance error 0.02126: PSNR_Y = -20 log10(0.02126).
+  // Flicker: d = -0.2 * 0.2126 (then +) at every pixel -> RMS 0.04252.
+  const auto dir = test::scratch_dir("comparison-hand");
+  for (int f = 0; f < 3; ++f) {
+    Image ref = test::make_image(16, 12, {"R", "G", "B"}, 0.5f);
+    Image t = ref;
+    std::fill(t.plane("R"), t.plane("R") + t.pixel_count(), f % 2 == 0 ? 0.6f : 0.4f);
+    write_frame(dir, "ref", f, ref);
+    write_frame(dir, "t", f, t);
+  }
+  ComparisonSetup setup;
+  setup.reference = pattern(dir, "ref");
+  setup.tests = {pattern(dir, "t")};
+  auto report = compare_sequences(setup);
+  ASSERT_TRUE(report) << report.error().message;
+  const auto& frames = report->sequences[0].frames;
+  ASSERT_EQ(frames.size(), 3u);
+  EXPECT_NEAR(frames[0].psnr_rgb, 10.0 * std::log10(300.0), 1e-4);
+  EXPECT_NEAR(frames[0].psnr_y, -20.0 * std::log10(0.1 * 0.2126), 1e-4);
+  EXPECT_FALSE(frames[0].flicker.has_value());  // no previous frame
+  ASSERT_TRUE(frames[1].flicker.has_value());
+  EXPECT_NEAR(*frames[1].flicker, 0.2 * 0.2126, 1e-6);
+  EXPECT_NEAR(*frames[2].flicker, 0.2 * 0.2126, 1e-6);
+  // Constant images: SSIM is the luminance term of Wang et al. eq. 13 for Y_test vs Y_ref = 0.5.
+  const double yt = 0.5 + 0.1 * 0.2126, yr = 0.5, c1 = 1e-4;
+  EXPECT_NEAR(frames[0].ssim, (2 * yt * yr + c1) / (yt * yt + yr * yr + c1), 1e-6);
+}
+
+TEST(Comparison, IdenticalSequencesGiveInfinitePsnrZeroFlickerAndNoNan) {
+  const auto dir = test::scratch_dir("comparison-identical");
+  for (int f = 0; f < 3; ++f) {
+    const Image img = noise_image(20, 16, unsigned(10 + f));
+    write_frame(dir, "ref", f, img);
+    write_frame(dir, "same", f, img);
+  }
+  ComparisonSetup setup;
+  setup.reference = pattern(dir, "ref");
+  setup.tests = {pattern(dir, "same")};
+  auto report = compare_sequences(setup);
+  ASSERT_TRUE(report);
+  for (const auto& f : report->sequences[0].frames) {
+    EXPECT_TRUE(std::isinf(f.psnr_rgb) && f.psnr_rgb > 0);
+    EXPECT_TRUE(std::isinf(f.psnr_y) && f.psnr_y > 0);
+    EXPECT_NEAR(f.ssim, 1.0, 1e-9);
+    if (f.frame > 0) {
+      ASSERT_TRUE(f.flicker.has_value());
+      EXPECT_EQ(*f.flicker, 0.0);
+    }
+  }
+  const auto csv = (dir / "m.csv").string(), json = (dir / "m.json").string();
+  ASSERT_TRUE(write_comparison_csv(*report, csv));
+  ASSERT_TRUE(write_comparison_json(*report, {}, {}, "compare test", "", json));
+  const auto csv_text = read_text(csv);
+  EXPECT_EQ(csv_text.find("nan"), std::string::npos);
+  EXPECT_NE(csv_text.find("1,same,inf,inf,1,0,"), std::string::npos) << csv_text;
+  const auto j = nlohmann::json::parse(read_text(json));  // throws (fails the test) if invalid
+  const auto& s = j["sequences"][0];
+  EXPECT_EQ(s["psnr_rgb"]["mean"], "inf");
+  EXPECT_EQ(s["flicker"]["mean"], 0.0);
+  EXPECT_EQ(s["flicker"]["frames"], 2);
+  EXPECT_EQ(read_text(json).find("NaN"), std::string::npos);
+}
+
+TEST(Comparison, MaskSplitsInsideAndOutside) {
+  const auto dir = test::scratch_dir("comparison-mask");
+  for (int f = 0; f < 2; ++f) {
+    Image ref = noise_image(24, 16, unsigned(f + 1));
+    Image t = ref;
+    float* mask = t.add_channel("debug.disocclusion");
+    float* r = t.plane("R");
+    for (int y = 0; y < 16; ++y)
+      for (int x = 12; x < 24; ++x) {  // right half: inside the mask, where the only error is
+        mask[y * 24 + x] = 1.0f;
+        r[y * 24 + x] += 0.1f;
+      }
+    write_frame(dir, "ref", f, ref);
+    write_frame(dir, "t", f, t);
+  }
+  ComparisonSetup setup;
+  setup.reference = pattern(dir, "ref");
+  setup.tests = {pattern(dir, "t")};
+  setup.mask = "debug.disocclusion";
+  auto report = compare_sequences(setup);
+  ASSERT_TRUE(report) << report.error().message;
+  EXPECT_EQ(report->sequences[0].mask_source, "test");
+  const auto& f = report->sequences[0].frames[1];
+  EXPECT_TRUE(f.has_mask);
+  EXPECT_NEAR(f.mask_fraction, 0.5, 1e-12);
+  EXPECT_TRUE(std::isinf(f.psnr_rgb_outside));
+  EXPECT_NEAR(f.psnr_rgb_inside, 10.0 * std::log10(300.0), 1e-3);  // MSE 0.01 / 3 inside
+  EXPECT_NEAR(f.psnr_rgb, 10.0 * std::log10(600.0), 1e-3);         // half the pixels: MSE halves
+  // Windows centred outside but reaching into the mask see some error; those inside all do.
+  EXPECT_GT(f.ssim_outside, 0.999);
+  EXPECT_LT(f.ssim_outside, 1.0);
+  EXPECT_LT(f.ssim_inside, 1.0 - 1e-4);
+  ASSERT_TRUE(f.flicker_inside && f.flicker_outside);
+  EXPECT_NEAR(*f.flicker_inside, 0.0, 1e-6);  // a stable error does not flicker
+}
+
+TEST(Comparison, MotionCompensatedFlickerWithGbuffer) {
+  // A pattern scrolling right 2 px per frame with a stable error on the surface: zero flicker when the G-buffer's
+  // motion (-2, 0) is used, clearly non-zero without it.
+  const auto dir = test::scratch_dir("comparison-motion");
+  const int w = 40, h = 12;
+  std::mt19937 rng(4);
+  std::uniform_real_distribution<float> u(0.0f, 1.0f);
+  std::vector<float> tex(80), err(80);
+  for (auto& v : tex) v = u(rng);
+  for (auto& v : err) v = 0.2f * u(rng) - 0.1f;
+  for (int f = 0; f < 3; ++f) {
+    Image ref(w, h), t(w, h), g(w, h);
+    for (const char* c : {"R", "G", "B"}) {
+      float* rp = ref.add_channel(c);
+      float* tp = t.add_channel(c);
+      for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x) {
+          const int s = x - 2 * f + 10;
+          rp[y * w + x] = tex[std::size_t(s)];
+          tp[y * w + x] = tex[std::size_t(s)] + err[std::size_t(s)];
+        }
+    }
+    g.add_channel("motion.X", f == 0 ? 0.0f : -2.0f);
+    g.add_channel("motion.Y", 0.0f);
+    write_frame(dir, "ref", f, ref);
+    write_frame(dir, "t", f, t);
+    write_frame(dir, "g", f, g);
+  }
+  ComparisonSetup setup;
+  setup.reference = pattern(dir, "ref");
+  setup.tests = {pattern(dir, "t")};
+  setup.gbuffer = pattern(dir, "g");
+  auto comp = compare_sequences(setup);
+  ASSERT_TRUE(comp) << comp.error().message;
+  EXPECT_TRUE(comp->motion_compensated);
+  ASSERT_TRUE(comp->sequences[0].frames[2].flicker);
+  EXPECT_NEAR(*comp->sequences[0].frames[2].flicker, 0.0, 1e-6);
+  EXPECT_EQ(comp->sequences[0].frames[2].flicker_pixels, std::size_t((w - 2) * h));
+  setup.gbuffer.clear();
+  auto plain = compare_sequences(setup);
+  ASSERT_TRUE(plain);
+  EXPECT_GT(*plain->sequences[0].frames[2].flicker, 0.02);
+}
+
+TEST(Comparison, ReferenceLayerAndCameraCut) {
+  // The reference keeps its colour in `reference.R,G,B` (render-gbuffer's payload layer); the test is bare RGB.
+  // Frame 1 of the reference is a camera cut: no flicker value there, one again at frame 2.
+  const auto dir = test::scratch_dir("comparison-reflayer");
+  for (int f = 0; f < 3; ++f) {
+    Image ref(16, 16), t = test::make_image(16, 16, {"R", "G", "B"}, 0.5f);
+    for (const char* c : {"reference.B", "reference.G", "reference.R"}) ref.add_channel(c, 0.5f);
+    std::fill(ref.plane("reference.R"), ref.plane("reference.R") + ref.pixel_count(), 0.4f);
+    if (f == 1) ref.metadata().camera_cut = true;
+    write_frame(dir, "ref", f, ref);
+    write_frame(dir, "t", f, t);
+  }
+  ComparisonSetup setup;
+  setup.reference = pattern(dir, "ref");
+  setup.reference_layer = "reference";
+  setup.tests = {pattern(dir, "t")};
+  auto report = compare_sequences(setup);
+  ASSERT_TRUE(report) << report.error().message;
+  EXPECT_EQ(report->reference_channels, (std::vector<std::string>{"reference.R", "reference.G", "reference.B"}));
+  const auto& frames = report->sequences[0].frames;
+  EXPECT_NEAR(frames[0].psnr_rgb, 10.0 * std::log10(300.0), 1e-4);  // R differs by 0.1, G and B agree
+  EXPECT_FALSE(frames[1].flicker.has_value());
+  ASSERT_TRUE(frames[2].flicker.has_value());
+  EXPECT_EQ(*frames[2].flicker, 0.0);
+  // A layer with another channel count is an input error naming both layers.
+  setup.reference_layer.clear();
+  setup.layer = "rgb";
+  setup.reference_layer = "motion";
+  for (int f = 0; f < 3; ++f) {
+    Image ref(16, 16);
+    ref.add_channel("motion.X");
+    ref.add_channel("motion.Y");
+    write_frame(dir, "ref", f, ref);
+  }
+  auto bad = compare_sequences(setup);
+  ASSERT_FALSE(bad);
+  EXPECT_EQ(bad.error().kind, ErrorKind::Input);
+  EXPECT_NE(bad.error().message.find("channels"), std::string::npos) << bad.error().message;
+}
+
+TEST(Comparison, NonFinitePixelsAreCountedAndExcluded) {
+  const auto dir = test::scratch_dir("comparison-nan");
+  for (int f = 0; f < 2; ++f) {
+    Image ref = test::make_image(16, 16, {"R", "G", "B"}, 0.5f);
+    Image t = ref;
+    std::fill(t.plane("G"), t.plane("G") + t.pixel_count(), 0.6f);
+    t.plane("R")[3] = NAN;
+    t.plane("B")[40] = INFINITY;
+    write_frame(dir, "ref", f, ref);
+    write_frame(dir, "t", f, t);
+  }
+  ComparisonSetup setup;
+  setup.reference = pattern(dir, "ref");
+  setup.tests = {pattern(dir, "t")};
+  setup.error_maps = (dir / "maps").string();
+  int warnings = 0;
+  ComparisonHooks hooks;
+  hooks.warning = [&](const std::string& file, const std::string& text) {
+    ++warnings;
+    EXPECT_NE(file.find("t.000"), std::string::npos);
+    EXPECT_NE(text.find("2 pixels"), std::string::npos) << text;
+  };
+  auto report = compare_sequences(setup, hooks);
+  ASSERT_TRUE(report);
+  EXPECT_EQ(warnings, 2);
+  const auto& f = report->sequences[0].frames[1];
+  EXPECT_EQ(f.nonfinite_test, 2u);
+  EXPECT_EQ(f.valid_pixels, 254u);
+  EXPECT_NEAR(f.psnr_rgb, 10.0 * std::log10(300.0), 1e-4);  // the remaining pixels: error 0.1 on G
+  EXPECT_TRUE(std::isfinite(f.ssim));
+  ASSERT_TRUE(f.flicker);
+  EXPECT_NEAR(*f.flicker, 0.0, 1e-7);
+  // The error map marks the excluded pixels and holds no NaN.
+  auto map = read_exr((dir / "maps" / "t.0001.exr").string());
+  ASSERT_TRUE(map) << map.error().message;
+  EXPECT_EQ(map->plane("error.invalid")[3], 1.0f);
+  EXPECT_EQ(map->plane("error.R")[3], 0.0f);
+  EXPECT_NEAR(map->plane("error.G")[0], 0.1f, 1e-6);
+  EXPECT_EQ(count_non_finite({map->plane("error.ssim"), map->pixel_count()}), 0u);
+  EXPECT_EQ(map->metadata().frame.value_or(-1), 1);
+}
+
+TEST(Comparison, ThresholdsJudgeMeanOrWorstFrame) {
+  ComparisonReport report;
+  SequenceReport s;
+  s.name = "taa";
+  for (int f = 0; f < 3; ++f) {
+    FrameMetrics m;
+    m.frame = f;
+    m.psnr_rgb = f == 1 ? 25.0 : 35.0;  // mean 31.67, worst 25
+    m.ssim = 0.9;
+    if (f > 0) m.flicker = 0.01 * f;  // mean 0.015, worst 0.02
+    s.frames.push_back(m);
+  }
+  report.sequences.push_back(s);
+  Thresholds th;
+  th.psnr = 30.0;
+  EXPECT_TRUE(check_thresholds(report, th).empty());
+  th.worst_frame = true;
+  auto fails = check_thresholds(report, th);
+  ASSERT_EQ(fails.size(), 1u);
+  EXPECT_EQ(fails[0].metric, Metric::PsnrRgb);
+  EXPECT_EQ(fails[0].value, 25.0);
+  th = {};
+  th.flicker = 0.012;
+  th.ssim = 0.95;
+  fails = check_thresholds(report, th);
+  ASSERT_EQ(fails.size(), 2u);
+  EXPECT_NEAR(fails[1].value, 0.015, 1e-12);
+}
+
+TEST(Comparison, SequenceNames) {
+  EXPECT_EQ(sequence_name("out/taa.####.exr"), "taa");
+  EXPECT_EQ(sequence_name("phlm_%04d.exr"), "phlm");
+  EXPECT_EQ(sequence_name("single.exr"), "single");
+}
+
+// --- Bad input: a clear error of the right kind, never a crash -------------------------------------------
+
+class BadInput : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = test::scratch_dir(std::string("comparison-bad-") + ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    for (int f = 0; f < 2; ++f) {
+      write_frame(dir_, "ref", f, noise_image(16, 16, unsigned(f)));
+      write_frame(dir_, "t", f, noise_image(16, 16, unsigned(f + 5)));
+    }
+    setup_.reference = pattern(dir_, "ref");
+    setup_.tests = {pattern(dir_, "t")};
+  }
+  Error run_expecting_error() {
+    auto r = compare_sequences(setup_);
+    EXPECT_FALSE(r) << "expected an error";
+    return r ? Error{} : r.error();
+  }
+  fs::path dir_;
+  ComparisonSetup setup_;
+};
+
+TEST_F(BadInput, TruncatedExr) {
+  const auto path = dir_ / "t.0001.exr";
+  const auto size = fs::file_size(path);
+  fs::resize_file(path, size / 2);
+  const auto e = run_expecting_error();
+  EXPECT_EQ(e.kind, ErrorKind::Input);
+  EXPECT_NE(e.file.find("t.0001.exr"), std::string::npos);
+}
+
+TEST_F(BadInput, CorruptExr) {
+  std::ofstream((dir_ / "ref.0000.exr").string(), std::ios::binary | std::ios::trunc) << "not an EXR at all";
+  const auto e = run_expecting_error();
+  EXPECT_EQ(e.kind, ErrorKind::Input);
+  EXPECT_NE(e.file.find("ref.0000.exr"), std::string::npos);
+}
+
+TEST_F(BadInput, MissingLayer) {
+  setup_.layer = "albedo";
+  const auto e = run_expecting_error();
+  EXPECT_EQ(e.kind, ErrorKind::Input);
+  EXPECT_NE(e.message.find("albedo"), std::string::npos) << e.message;
+}
+
+TEST_F(BadInput, MissingMaskLayer) {
+  setup_.mask = "debug.disocclusion";
+  const auto e = run_expecting_error();
+  EXPECT_EQ(e.kind, ErrorKind::Input);
+  EXPECT_NE(e.message.find("mask"), std::string::npos) << e.message;
+}
+
+TEST_F(BadInput, MismatchedSizes) {
+  write_frame(dir_, "t", 1, noise_image(20, 16, 9));
+  const auto e = run_expecting_error();
+  EXPECT_EQ(e.kind, ErrorKind::Input);
+  EXPECT_NE(e.message.find("20x16"), std::string::npos) << e.message;
+}
+
+TEST_F(BadInput, MissingTestFrame) {
+  fs::remove(dir_ / "t.0001.exr");
+  const auto e = run_expecting_error();
+  EXPECT_EQ(e.kind, ErrorKind::Input);
+  EXPECT_NE(e.file.find("t.0001.exr"), std::string::npos) << e.file << ": " << e.message;
+}
+
+TEST_F(BadInput, EmptySequence) {
+  setup_.reference = pattern(dir_, "nothing");
+  const auto e = run_expecting_error();
+  EXPECT_EQ(e.kind, ErrorKind::Input);
+}
+
+TEST_F(BadInput, TooSmallForSsim) {
+  write_frame(dir_, "tiny", 0, noise_image(8, 8, 1));
+  setup_.reference = pattern(dir_, "tiny");
+  setup_.tests = {pattern(dir_, "tiny")};
+  const auto e = run_expecting_error();
+  EXPECT_EQ(e.kind, ErrorKind::Input);
+}
+
+TEST_F(BadInput, NamesCountMismatchIsUsage) {
+  setup_.names = {"a", "b"};
+  EXPECT_EQ(run_expecting_error().kind, ErrorKind::Usage);
+}
+
+}  // namespace
+}  // namespace temporal

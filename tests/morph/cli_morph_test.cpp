@@ -1,0 +1,82 @@
+// The morph-120hz command line: frame numbering and timing of the output, metadata, bad input exit codes.
+#include "temporal/exr.h"
+
+#include "synthetic.h"
+#include "test_support.h"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+
+namespace temporal {
+namespace {
+
+class MorphCli : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = test::scratch_dir("morph_cli");
+    for (int n = 0; n < 2; ++n) {
+      Image c = test::make_color(32, 24, [n](float x, float y, int ch) { return test::texture(x - 3.0f * n, y, ch); });
+      c.metadata().fps = 40.0;
+      c.metadata().frame = n;
+      ASSERT_TRUE(write_exr((dir_ / ("color." + std::to_string(1000 + n).substr(1) + ".exr")).string(), c));
+      Image g = test::make_gbuffer(32, 24, [](int, int, float& mx, float& my, float& d) { mx = -3.0f; my = 0.0f; d = 2.0f; });
+      ASSERT_TRUE(write_exr((dir_ / ("gbuffer." + std::to_string(1000 + n).substr(1) + ".exr")).string(), g));
+      Image nm(32, 24);
+      nm.add_channel("depth.Z", 1.0f);
+      ASSERT_TRUE(write_exr((dir_ / ("nomotion." + std::to_string(1000 + n).substr(1) + ".exr")).string(), nm));
+    }
+  }
+  std::string tool() const { return test::tool_path("morph-120hz").string(); }
+  std::string in(const std::string& name) const { return (dir_ / (name + ".###.exr")).string(); }
+  std::filesystem::path dir_;
+};
+
+TEST_F(MorphCli, WritesFactorFramesPerInputWithDisplayRateTiming) {
+  std::string out;
+  const std::string cmd = tool() + " --input " + in("color") + " --gbuffer " + in("gbuffer") + " --out " +
+                          (dir_ / "didyk" / "o.####.exr").string() + " --method didyk --debug-layers";
+  ASSERT_EQ(test::run_command(cmd, &out), 0) << out;
+  for (int f = 0; f < 6; ++f) ASSERT_TRUE(std::filesystem::exists(dir_ / "didyk" / ("o.000" + std::to_string(f) + ".exr")));
+  auto info = read_exr_info((dir_ / "didyk" / "o.0004.exr").string());
+  ASSERT_TRUE(info);
+  ASSERT_TRUE(info->metadata.fps);
+  EXPECT_DOUBLE_EQ(*info->metadata.fps, 120.0);
+  EXPECT_EQ(*info->metadata.frame, 4);
+  EXPECT_NEAR(*info->metadata.time, 4.0 / 120.0, 1e-6);  // stored as float
+  EXPECT_TRUE(info->metadata.compute_ms.has_value());
+  EXPECT_EQ(info->metadata.extra.at("latencyFrames"), "0");
+  auto img = read_exr((dir_ / "didyk" / "o.0004.exr").string());
+  ASSERT_TRUE(img);
+  EXPECT_TRUE(img->has_channel("debug.blur"));
+  EXPECT_TRUE(img->has_channel("debug.Hprime"));
+
+  ASSERT_EQ(test::run_command(tool() + " --input " + in("color") + " --out " + (dir_ / "blend" / "o.####.exr").string() +
+                                  " --method blend", &out), 0) << out;
+  info = read_exr_info((dir_ / "blend" / "o.0002.exr").string());
+  ASSERT_TRUE(info);
+  EXPECT_EQ(info->metadata.extra.at("latencyFrames"), "1");
+
+  // The perceived-blur mode runs on the upsampled sequence (display rate) with a display-rate motion.
+  ASSERT_EQ(test::run_command(tool() + " --perceive --input " + (dir_ / "blend" / "o.####.exr").string() +
+                                  " --gbuffer " + in("gbuffer") + " --frames 0-1 --out " +
+                                  (dir_ / "perceived" / "p.####.exr").string(), &out), 0) << out;
+  EXPECT_TRUE(std::filesystem::exists(dir_ / "perceived" / "p.0001.exr"));
+}
+
+TEST_F(MorphCli, BadInputExitCodes) {
+  std::string out;
+  EXPECT_EQ(test::run_command(tool() + " --input " + in("color") + " --gbuffer " + in("nomotion") + " --out " +
+                                  (dir_ / "x" / "o.####.exr").string(), &out), 2) << out;
+  EXPECT_NE(out.find("motion"), std::string::npos) << out;
+  EXPECT_NE(out.find("nomotion.000.exr"), std::string::npos) << out;
+  EXPECT_EQ(test::run_command(tool() + " --input " + in("color") + " --gbuffer " + in("gbuffer") + " --factor 1 --out " +
+                                  (dir_ / "x" / "o.####.exr").string(), &out), 1) << out;
+  EXPECT_NE(out.find("factor"), std::string::npos) << out;
+  EXPECT_EQ(test::run_command(tool() + " --input " + in("color") + " --out " + (dir_ / "x" / "o.####.exr").string() +
+                                  " --method didyk", &out), 1) << out;
+  EXPECT_NE(out.find("--gbuffer"), std::string::npos) << out;
+}
+
+}  // namespace
+}  // namespace temporal

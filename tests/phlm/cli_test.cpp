@@ -1,0 +1,156 @@
+// filter-phlm's command line: every method on a tiny synthetic sequence, --state-out / --state-in resume,
+// errors and exit codes.
+#include "temporal/exr.h"
+
+#include "test_support.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+#include <random>
+
+namespace {
+
+using namespace temporal;
+namespace fs = std::filesystem;
+
+// Writes frames 0..n-1 of a noisy 12x10 colour sequence with a G-buffer (motion 0.5 px right).
+void write_sequence(const fs::path& dir, int n) {
+  std::mt19937 rng(42);
+  std::normal_distribution<float> noise(0.0f, 0.1f);
+  for (int t = 0; t < n; ++t) {
+    Image color(12, 10), g(12, 10);
+    for (const char* c : {"R", "G", "B"}) {
+      float* p = color.add_channel(c);
+      for (std::size_t i = 0; i < color.pixel_count(); ++i) p[i] = 0.4f + 0.02f * float(i % 12) + noise(rng);
+    }
+    g.add_channel("motion.X", -0.5f);
+    g.add_channel("motion.Y", 0.0f);
+    g.add_channel("depth.Z", 3.0f);
+    g.add_uint_channel("id", 1);
+    color.metadata().frame = t;
+    color.metadata().jitter = glm::vec2(0.25f, -0.25f);
+    if (t == 0) color.metadata().camera_cut = true;
+    char name[64];
+    std::snprintf(name, sizeof name, "color.%04d.exr", t);
+    ASSERT_TRUE(write_exr((dir / name).string(), color));
+    std::snprintf(name, sizeof name, "gbuffer.%04d.exr", t);
+    ASSERT_TRUE(write_exr((dir / name).string(), g));
+  }
+}
+
+std::string tool() { return test::tool_path("filter-phlm").string(); }
+
+TEST(FilterPhlmCli, HelpReportsStateBytesAndDefaults) {
+  std::string out;
+  ASSERT_EQ(test::run_command(tool() + " --help", &out), 0);
+  EXPECT_NE(out.find("104 bytes"), std::string::npos) << out;
+  EXPECT_NE(out.find("28 bytes"), std::string::npos);
+  EXPECT_NE(out.find("0.998"), std::string::npos);
+  EXPECT_NE(out.find("--state-out"), std::string::npos);
+}
+
+TEST(FilterPhlmCli, EveryMethodWritesTheSequence) {
+  const auto dir = test::scratch_dir("filter-phlm-cli-methods");
+  write_sequence(dir, 4);
+  for (const std::string m : {"phlm", "taa", "ema", "fxaa"}) {
+    std::string out;
+    const std::string cmd = tool() + " --input " + (dir / "color.####.exr").string() + " --gbuffer " +
+                            (dir / "gbuffer.####.exr").string() + " --out " + (dir / (m + ".####.exr")).string() +
+                            " --method " + m + " --debug-layers";
+    ASSERT_EQ(test::run_command(cmd, &out), 0) << cmd << "\n" << out;
+    auto img = read_exr((dir / (m + ".0003.exr")).string());
+    ASSERT_TRUE(img) << img.error().message;
+    EXPECT_TRUE(img->plane("R"));
+    EXPECT_EQ(img->metadata().frame.value_or(-1), 3);
+    EXPECT_TRUE(img->metadata().compute_ms.has_value());
+    EXPECT_NE(img->metadata().tool.find("filter-phlm"), std::string::npos);
+  }
+  auto dbg = read_exr((dir / "phlm.0002.exr").string());
+  ASSERT_TRUE(dbg);
+  EXPECT_TRUE(dbg->plane("debug.traceP"));
+  EXPECT_TRUE(dbg->plane("debug.alpha"));
+  EXPECT_TRUE(dbg->plane("debug.reset"));
+}
+
+TEST(FilterPhlmCli, ResumeFromStateIsBitExact) {
+  const auto dir = test::scratch_dir("filter-phlm-cli-resume");
+  write_sequence(dir, 6);
+  const std::string common = tool() + " --input " + (dir / "color.####.exr").string() + " --gbuffer " +
+                             (dir / "gbuffer.####.exr").string() + " --method phlm";
+  std::string out;
+  ASSERT_EQ(test::run_command(common + " --out " + (dir / "whole.####.exr").string(), &out), 0) << out;
+  ASSERT_EQ(test::run_command(common + " --frames 0-2 --out " + (dir / "part.####.exr").string() +
+                                  " --state-out " + (dir / "state.####.exr").string(), &out), 0) << out;
+  ASSERT_TRUE(fs::exists(dir / "state.0000.exr"));
+  ASSERT_EQ(test::run_command(common + " --frames 3-5 --out " + (dir / "part.####.exr").string() +
+                                  " --state-in " + (dir / "state.0002.exr").string(), &out), 0) << out;
+  for (const char* f : {"0003", "0005"}) {
+    auto a = read_exr((dir / (std::string("whole.") + f + ".exr")).string());
+    auto b = read_exr((dir / (std::string("part.") + f + ".exr")).string());
+    ASSERT_TRUE(a && b);
+    for (const char* c : {"R", "G", "B"})
+      EXPECT_EQ(std::memcmp(a->plane(c), b->plane(c), a->pixel_count() * sizeof(float)), 0) << f << " " << c;
+  }
+  auto state = read_exr((dir / "state.0002.exr").string());
+  ASSERT_TRUE(state);
+  EXPECT_TRUE(state->plane("beta.R3"));
+  EXPECT_TRUE(state->plane("P.D3"));
+  EXPECT_TRUE(state->plane("Pmat.P33"));
+}
+
+TEST(FilterPhlmCli, ResetFramesAndNonFiniteInput) {
+  const auto dir = test::scratch_dir("filter-phlm-cli-reset");
+  write_sequence(dir, 4);
+  // A NaN and an Inf in frame 1: counted and reported, never in the output or the state.
+  auto f1 = read_exr((dir / "color.0001.exr").string());
+  ASSERT_TRUE(f1);
+  f1->plane("R")[5] = NAN;
+  f1->plane("B")[17] = INFINITY;
+  ASSERT_TRUE(write_exr((dir / "color.0001.exr").string(), *f1));
+  std::string out;
+  const std::string cmd = tool() + " --input " + (dir / "color.####.exr").string() + " --gbuffer " +
+                          (dir / "gbuffer.####.exr").string() + " --out " + (dir / "p.####.exr").string() +
+                          " --reset-frames 3 --state-out " + (dir / "s.exr").string();
+  ASSERT_EQ(test::run_command(cmd, &out), 0) << out;
+  EXPECT_NE(out.find("color.0001.exr: warning: 2 pixels hold NaN or Inf"), std::string::npos) << out;
+  auto p1 = read_exr((dir / "p.0001.exr").string());
+  ASSERT_TRUE(p1);
+  for (const char* c : {"R", "G", "B"})
+    for (std::size_t i = 0; i < p1->pixel_count(); ++i) ASSERT_TRUE(std::isfinite(p1->plane(c)[i]));
+  // Frame 3 is a listed reset: every model restarts from the input, so the output is the input.
+  auto in3 = read_exr((dir / "color.0003.exr").string());
+  auto p3 = read_exr((dir / "p.0003.exr").string());
+  ASSERT_TRUE(in3 && p3);
+  for (const char* c : {"R", "G", "B"})
+    for (std::size_t i = 0; i < p3->pixel_count(); ++i) EXPECT_NEAR(p3->plane(c)[i], in3->plane(c)[i], 1e-5f);
+  // --state-out without a placeholder: the last frame's state only.
+  auto state = read_exr((dir / "s.exr").string());
+  ASSERT_TRUE(state);
+  EXPECT_EQ(state->metadata().frame.value_or(-1), 3);
+}
+
+TEST(FilterPhlmCli, ErrorsAndExitCodes) {
+  const auto dir = test::scratch_dir("filter-phlm-cli-errors");
+  write_sequence(dir, 2);
+  const std::string in = " --input " + (dir / "color.####.exr").string();
+  std::string out;
+  EXPECT_EQ(test::run_command(tool() + in + " --out " + (dir / "o.####.exr").string() + " --layer ssao", &out), 2);
+  EXPECT_NE(out.find("filter-phlm: "), std::string::npos) << out;
+  EXPECT_EQ(test::run_command(tool() + " --input " + (dir / "missing.####.exr").string() + " --out " +
+                                  (dir / "o.####.exr").string(), &out), 2) << out;
+  EXPECT_EQ(test::run_command(tool() + in + " --out " + (dir / "o.####.exr").string() + " --method fxaa --state-out " +
+                                  (dir / "s.exr").string(), &out), 1) << out;
+  EXPECT_EQ(test::run_command(tool() + in + " --out " + (dir / "o.####.exr").string() + " --method nope", &out), 1);
+  // A G-buffer without motion.
+  Image g(12, 10);
+  g.add_channel("depth.Z", 1.0f);
+  ASSERT_TRUE(write_exr((dir / "bad.0000.exr").string(), g));
+  ASSERT_TRUE(write_exr((dir / "bad.0001.exr").string(), g));
+  EXPECT_EQ(test::run_command(tool() + in + " --gbuffer " + (dir / "bad.####.exr").string() + " --out " +
+                                  (dir / "o.####.exr").string(), &out), 2);
+  EXPECT_NE(out.find("motion"), std::string::npos) << out;
+}
+
+}  // namespace

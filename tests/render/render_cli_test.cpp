@@ -1,0 +1,224 @@
+// render-gbuffer's command line: bad input, the layers of each --outputs choice, headers, determinism.
+#include "test_support.h"
+
+#include "temporal/exr.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cstring>
+#include <fstream>
+#include <iterator>
+#include <vector>
+
+namespace temporal {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::string base64(const std::vector<unsigned char>& data) {
+  static const char* t = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+  std::string out;
+  for (std::size_t i = 0; i < data.size(); i += 3) {
+    unsigned v = unsigned(data[i]) << 16;
+    if (i + 1 < data.size()) v |= unsigned(data[i + 1]) << 8;
+    if (i + 2 < data.size()) v |= data[i + 2];
+    out += t[(v >> 18) & 63];
+    out += t[(v >> 12) & 63];
+    out += i + 1 < data.size() ? t[(v >> 6) & 63] : '=';
+    out += i + 2 < data.size() ? t[v & 63] : '=';
+  }
+  return out;
+}
+
+// A small valid glTF: a ground quad and a tilted quad above it, animated by a translation (LINEAR).
+// No camera and no light: the scene module adds an automatic camera and key light.
+fs::path write_test_scene(const fs::path& dir) {
+  std::vector<float> pos = {-2, 0, 2, 2, 0, 2, 2, 0, -2, -2, 0, -2,               // ground
+                            -0.5f, 0.5f, 0, 0.5f, 0.5f, 0, 0.5f, 1.2f, -0.3f, -0.5f, 1.2f, -0.3f};  // panel
+  std::vector<std::uint16_t> idx = {0, 1, 2, 0, 2, 3};
+  std::vector<float> times = {0.0f, 1.0f};
+  std::vector<float> trans = {-0.5f, 0, 0, 0.5f, 0, 0};
+  std::vector<unsigned char> buf;
+  auto append = [&](const void* p, std::size_t n) {
+    const auto* c = static_cast<const unsigned char*>(p);
+    buf.insert(buf.end(), c, c + n);
+  };
+  append(pos.data(), pos.size() * 4);     // 0..96
+  append(idx.data(), idx.size() * 2);     // 96..108
+  append(times.data(), times.size() * 4); // 108..116
+  append(trans.data(), trans.size() * 4); // 116..140
+  const std::string json = R"({
+  "asset": {"version": "2.0"},
+  "scene": 0,
+  "scenes": [{"nodes": [0, 1]}],
+  "nodes": [{"mesh": 0}, {"mesh": 1}],
+  "meshes": [
+    {"primitives": [{"attributes": {"POSITION": 0}, "indices": 2, "material": 0}]},
+    {"primitives": [{"attributes": {"POSITION": 1}, "indices": 2, "material": 1}]}],
+  "materials": [{"pbrMetallicRoughness": {"baseColorFactor": [0.8, 0.8, 0.8, 1]}},
+                {"pbrMetallicRoughness": {"baseColorFactor": [0.9, 0.3, 0.2, 1]}, "doubleSided": true}],
+  "animations": [{"channels": [{"sampler": 0, "target": {"node": 1, "path": "translation"}}],
+                  "samplers": [{"input": 3, "output": 4, "interpolation": "LINEAR"}]}],
+  "accessors": [
+    {"bufferView": 0, "componentType": 5126, "count": 4, "type": "VEC3", "min": [-2, 0, -2], "max": [2, 0, 2]},
+    {"bufferView": 0, "byteOffset": 48, "componentType": 5126, "count": 4, "type": "VEC3",
+     "min": [-0.5, 0.5, -0.3], "max": [0.5, 1.2, 0]},
+    {"bufferView": 1, "componentType": 5123, "count": 6, "type": "SCALAR"},
+    {"bufferView": 2, "componentType": 5126, "count": 2, "type": "SCALAR", "min": [0], "max": [1]},
+    {"bufferView": 3, "componentType": 5126, "count": 2, "type": "VEC3"}],
+  "bufferViews": [
+    {"buffer": 0, "byteOffset": 0, "byteLength": 96},
+    {"buffer": 0, "byteOffset": 96, "byteLength": 12},
+    {"buffer": 0, "byteOffset": 108, "byteLength": 8},
+    {"buffer": 0, "byteOffset": 116, "byteLength": 24}],
+  "buffers": [{"byteLength": 140, "uri": "data:application/octet-stream;base64,)" +
+                           base64(buf) + R"("}]
+})";
+  const fs::path path = dir / "scene.gltf";
+  std::ofstream(path) << json;
+  return path;
+}
+
+std::string tool() { return test::tool_path("render-gbuffer").string(); }
+
+TEST(RenderCli, MalformedSceneIsAnInputError) {
+  const auto dir = test::scratch_dir("render_cli_malformed");
+  std::ofstream(dir / "bad.gltf") << "{ \"asset\": { \"version\": \"2.0\" }, \"nodes\": [ ";
+  std::string output;
+  const int rc = test::run_command(tool() + " " + (dir / "bad.gltf").string() + " --out " + (dir / "out").string() +
+                                       " --size 32x24",
+                                   &output);
+  EXPECT_EQ(rc, 2) << output;
+  EXPECT_NE(output.find("render-gbuffer: "), std::string::npos) << output;
+  EXPECT_NE(output.find("bad.gltf"), std::string::npos) << output;
+  EXPECT_FALSE(fs::exists(dir / "out" / "gbuffer.0000.exr"));
+}
+
+TEST(RenderCli, MissingBufferAndUnsupportedExtensionAreInputErrors) {
+  const auto dir = test::scratch_dir("render_cli_bad_gltf");
+  const std::string valid = [&] {
+    std::ifstream in(write_test_scene(dir));
+    return std::string(std::istreambuf_iterator<char>(in), {});
+  }();
+  // The same scene with its buffer pointing at a file that does not exist.
+  std::string missing = valid;
+  const auto uri = missing.find("data:application");
+  missing.replace(uri, missing.find('"', uri) - uri, "missing.bin");
+  std::ofstream(dir / "missing_buffer.gltf") << missing;
+  // The same scene requiring an extension nobody implements here.
+  std::string ext = valid;
+  ext.replace(ext.find("\"scene\": 0"), 10, "\"extensionsRequired\": [\"KHR_draco_mesh_compression\"], \"scene\": 0");
+  std::ofstream(dir / "draco.gltf") << ext;
+  std::string output;
+  EXPECT_EQ(test::run_command(tool() + " " + (dir / "missing_buffer.gltf").string() + " --out " + (dir / "o").string(),
+                              &output),
+            2)
+      << output;
+  EXPECT_NE(output.find("missing_buffer.gltf"), std::string::npos) << output;
+  EXPECT_EQ(test::run_command(tool() + " " + (dir / "draco.gltf").string() + " --out " + (dir / "o").string(), &output), 2)
+      << output;
+  EXPECT_NE(output.find("KHR_draco_mesh_compression"), std::string::npos) << output;
+  EXPECT_FALSE(fs::exists(dir / "o" / "gbuffer.0000.exr"));
+}
+
+TEST(RenderCli, MissingSceneIsAnInputError) {
+  const auto dir = test::scratch_dir("render_cli_missing");
+  std::string output;
+  EXPECT_EQ(test::run_command(tool() + " " + (dir / "nope.glb").string() + " --out " + dir.string(), &output), 2)
+      << output;
+}
+
+TEST(RenderCli, BadOptionsAreUsageErrors) {
+  const auto dir = test::scratch_dir("render_cli_usage");
+  const auto scene = write_test_scene(dir).string();
+  std::string output;
+  EXPECT_EQ(test::run_command(tool() + " " + scene + " --out " + dir.string() + " --size 64by48", &output), 1) << output;
+  EXPECT_EQ(test::run_command(tool() + " " + scene + " --out " + dir.string() + " --size 64x48 --factor 5", &output), 1)
+      << output;
+  EXPECT_NE(output.find("--factor"), std::string::npos) << output;
+  EXPECT_EQ(test::run_command(tool() + " " + scene + " --out " + dir.string() + " --payload direct,foo", &output), 1)
+      << output;
+  EXPECT_EQ(test::run_command(tool() + " " + scene + " --out " + dir.string() + " --jitter sobol", &output), 1) << output;
+  EXPECT_EQ(test::run_command(tool() + " " + scene + " --out " + dir.string() + " --frames 0-3 --duration 1", &output), 1)
+      << output;
+  // An output folder that cannot be created is an output error.
+  std::ofstream(dir / "a_file") << "x";
+  EXPECT_EQ(test::run_command(tool() + " " + scene + " --out " + (dir / "a_file" / "sub").string() + " --size 32x24", &output),
+            4)
+      << output;
+}
+
+TEST(RenderCli, WritesOnlyTheLayersAskedFor) {
+  const auto dir = test::scratch_dir("render_cli_layers");
+  const auto scene = write_test_scene(dir).string();
+  const auto out = dir / "out";
+  std::string output;
+  ASSERT_EQ(test::run_command(tool() + " " + scene + " --out " + out.string() +
+                                  " --size 64x48 --frames 0-1 --outputs gbuffer,shade --payload direct,ssao",
+                              &output),
+            0)
+      << output;
+  EXPECT_FALSE(fs::exists(out / "reference.0000.exr"));
+  EXPECT_FALSE(fs::exists(out / "color.0000.exr"));
+  auto g = read_exr_info((out / "gbuffer.0001.exr").string());
+  ASSERT_TRUE(g) << g.error().message;
+  std::vector<std::string> gc = g->channels;
+  std::sort(gc.begin(), gc.end());
+  EXPECT_EQ(gc, (std::vector<std::string>{"N.X", "N.Y", "N.Z", "albedo.B", "albedo.G", "albedo.R", "depth.Z", "id",
+                                          "motion.X", "motion.Y"}));
+  auto s = read_exr_info((out / "shade.0001.exr").string());
+  ASSERT_TRUE(s) << s.error().message;
+  std::vector<std::string> sc = s->channels;
+  std::sort(sc.begin(), sc.end());
+  EXPECT_EQ(sc, (std::vector<std::string>{"B", "G", "R", "direct.B", "direct.G", "direct.R", "ssao.Y"}));
+  EXPECT_EQ(s->width, 16);
+  EXPECT_EQ(s->height, 12);
+  EXPECT_EQ(s->metadata.jitter_factor.value_or(0), 4);
+  EXPECT_EQ(s->metadata.jitter_index.value_or(-1), 1);
+  EXPECT_EQ(s->metadata.frame.value_or(-1), 1);
+  EXPECT_NEAR(s->metadata.time.value_or(-1), 1.0 / 40.0, 1e-9);
+  EXPECT_TRUE(s->metadata.world_to_ndc.has_value());
+  EXPECT_TRUE(s->metadata.compute_ms.has_value());
+  EXPECT_TRUE(s->metadata.timings_ms.count("shadeLow"));
+  auto g0 = read_exr_info((out / "gbuffer.0000.exr").string());
+  ASSERT_TRUE(g0);
+  EXPECT_TRUE(g0->metadata.camera_cut.value_or(false));
+  EXPECT_FALSE(g->metadata.camera_cut.value_or(true));
+  EXPECT_NE(g0->metadata.tool.find("render-gbuffer"), std::string::npos);
+  std::ifstream csv(out / "timings.csv");
+  std::string header, line;
+  std::getline(csv, header);
+  EXPECT_EQ(header, "frame,time,gbuffer,lightMaps,shadeLow,shadeFull,reference,color");
+  int rows = 0;
+  while (std::getline(csv, line)) ++rows;
+  EXPECT_EQ(rows, 2);
+}
+
+TEST(RenderCli, SameCommandTwiceGivesBitIdenticalPixels) {
+  const auto dir = test::scratch_dir("render_cli_determinism");
+  const auto scene = write_test_scene(dir).string();
+  for (const char* run : {"a", "b"}) {
+    std::string output;
+    ASSERT_EQ(test::run_command(tool() + " " + scene + " --out " + (dir / run).string() +
+                                    " --size 32x24 --frames 2-3 --reference-spp 2 --vpls 100 --shadow-map-size 256",
+                                &output),
+              0)
+        << output;
+  }
+  for (const char* name : {"gbuffer", "shade", "reference", "color"}) {
+    const std::string file = std::string(name) + ".0003.exr";
+    auto a = read_exr((dir / "a" / file).string());
+    auto b = read_exr((dir / "b" / file).string());
+    ASSERT_TRUE(a && b) << file;
+    ASSERT_EQ(a->channel_names(), b->channel_names());
+    for (const auto& c : a->channel_names()) {
+      const void* pa = a->channel_type(c) == ChannelType::UInt ? (const void*)a->uint_plane(c) : (const void*)a->plane(c);
+      const void* pb = b->channel_type(c) == ChannelType::UInt ? (const void*)b->uint_plane(c) : (const void*)b->plane(c);
+      EXPECT_EQ(std::memcmp(pa, pb, a->pixel_count() * 4), 0) << file << " " << c;
+    }
+  }
+}
+
+}  // namespace
+}  // namespace temporal

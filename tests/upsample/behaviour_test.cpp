@@ -1,0 +1,401 @@
+// Behaviour of the methods on generated sequences (synthetic.h): convergence, disocclusion, depth edges,
+// camera motion, NaN input, camera cuts, input errors. Tolerances are stated next to each assertion.
+#include "synthetic.h"
+
+#include "temporal/upsample.h"
+
+#include <gtest/gtest.h>
+#include <test_support.h>
+
+#include <cmath>
+#include <cstdio>
+#include <functional>
+#include <limits>
+
+namespace up = temporal::upsample;
+using temporal::Image;
+using temporal::test::make_frame;
+using temporal::test::SyntheticFrame;
+using temporal::test::SyntheticScene;
+
+namespace {
+
+const std::vector<std::string> kRGB = {"R", "G", "B"};
+
+up::Options options_for(up::Method m) {
+  up::Options o;
+  o.method = m;
+  return o;
+}
+
+struct SeqRun {
+  Image output;           // last frame's output (copy)
+  SyntheticFrame frame;   // last frame's inputs and reference
+  up::FrameStats stats;   // last frame's stats
+  std::size_t total_non_finite = 0;
+};
+
+// Runs frames 0..count-1; `edit` may change a frame's inputs before it is processed.
+SeqRun run_seq(const SyntheticScene& scene, up::Options o, int count,
+        const std::function<void(int, SyntheticFrame&, bool&)>& edit = {}) {
+  up::Upsampler u(o);
+  SeqRun r;
+  for (int t = 0; t < count; ++t) {
+    SyntheticFrame f = make_frame(scene, t);
+    bool cut = false;
+    if (edit) edit(t, f, cut);
+    auto out = u.process(f.gbuffer, f.low, kRGB, cut, &r.stats);
+    EXPECT_TRUE(out.has_value()) << (out ? "" : out.error().message);
+    if (!out) return r;
+    r.total_non_finite += r.stats.non_finite_input;
+    if (t == count - 1) {
+      r.output = **out;
+      r.frame = std::move(f);
+    }
+  }
+  return r;
+}
+
+// Mean absolute error over R,G,B where pred(i) holds; also the largest error.
+struct Err {
+  double mean = 0, max = 0;
+  std::size_t n = 0;
+};
+Err error(const Image& out, const Image& ref, const std::function<bool(std::size_t)>& pred = {}) {
+  Err e;
+  double sum = 0;
+  for (const auto& c : kRGB) {
+    const float* a = out.plane(c);
+    const float* b = ref.plane(c);
+    for (std::size_t i = 0; i < out.pixel_count(); ++i) {
+      if (pred && !pred(i)) continue;
+      const double d = std::abs(double(a[i]) - double(b[i]));
+      sum += d;
+      e.max = std::max(e.max, d);
+      ++e.n;
+    }
+  }
+  e.mean = e.n ? sum / double(e.n) : 0.0;
+  return e;
+}
+
+bool all_finite(const Image& img) {
+  for (const auto& c : img.channel_names())
+    if (const float* p = img.plane(c))
+      for (std::size_t i = 0; i < img.pixel_count(); ++i)
+        if (!std::isfinite(p[i])) return false;
+  return true;
+}
+
+}  // namespace
+
+TEST(Upsample, TemporalStaticSceneIsExactAfterKSquaredFrames) {
+  SyntheticScene scene;  // static camera, no object
+  const SeqRun r = run_seq(scene, options_for(up::Method::Temporal), scene.k * scene.k);
+  // Every full-resolution pixel has been shaded once and carried unchanged (motion 0): float copies.
+  const Err e = error(r.output, r.frame.reference);
+  EXPECT_LE(e.max, 1e-6) << "mean " << e.mean;
+  EXPECT_EQ(r.stats.hole_pixels, 0u);
+}
+
+TEST(Upsample, HerzogStaticSceneConverges) {
+  // Pixels at least k from the border: at the border only one side's samples exist, which biases every
+  // kernel-based estimate (spatial included).
+  auto interior = [](const SyntheticScene& sc) {
+    return [=](std::size_t i) {
+      const int X = int(i % sc.width), Y = int(i / sc.width);
+      return X >= sc.k && Y >= sc.k && X < sc.width - sc.k && Y < sc.height - sc.k;
+    };
+  };
+  // A payload with detail at the scale of the low-resolution grid (period 20 px for k = 4).
+  SyntheticScene scene;
+  scene.period = 20.0f;
+  const int kk = scene.k * scene.k;
+  const SeqRun spatial = run_seq(scene, options_for(up::Method::Spatial), kk);
+  const Err es = error(spatial.output, spatial.frame.reference, interior(scene));
+  const SeqRun r = run_seq(scene, options_for(up::Method::Herzog), kk);
+  const Err e = error(r.output, r.frame.reference, interior(scene));
+  std::printf("herzog static (period 20), after k*k frames: mean %.5f max %.5f; spatial mean %.5f max %.5f\n",
+              e.mean, e.max, es.mean, es.max);
+  // The published image kernel (fall-off gamma * w_f at most 4 over the low-res diagonal) keeps ~1/7 of
+  // the weight on the pixel's own sample at convergence, so a slight blur remains: below 0.06 here
+  // (payload amplitude 0.3), and below the spatial method's error.
+  EXPECT_LE(e.max, 0.06);
+  EXPECT_LT(e.mean, 0.85 * es.mean);
+  // The fused variant (eq. 7 with the previous frame's w_f) converges alike in a static scene.
+  up::Options lagged = options_for(up::Method::Herzog);
+  lagged.lagged_wf = true;
+  const SeqRun rl = run_seq(scene, lagged, kk);
+  const Err el = error(rl.output, rl.frame.reference, interior(scene));
+  EXPECT_LE(el.max, 0.06);
+  EXPECT_LT(el.mean, 0.85 * es.mean);
+  // With a steeper kernel (cap of gamma * w_f raised to 64) the result approaches the exact payload.
+  SyntheticScene smooth;
+  up::Options sharp = options_for(up::Method::Herzog);
+  sharp.kernel_gamma = 64.0f;
+  sharp.max_kernel_gamma = 64.0f;
+  const SeqRun rs = run_seq(smooth, sharp, 2 * kk);
+  const Err e2 = error(rs.output, rs.frame.reference, interior(smooth));
+  std::printf("herzog static (period 40), gamma cap 64, after 2 k*k frames: mean %.5f max %.5f\n", e2.mean, e2.max);
+  EXPECT_LE(e2.mean, 0.001);
+  EXPECT_LE(e2.max, 0.02);
+}
+
+TEST(Upsample, DrobotRefreshStaticSceneIsExactAfterKSquaredFrames) {
+  SyntheticScene scene;
+  up::Options o = options_for(up::Method::Drobot);
+  o.drobot_mode = up::DrobotMode::Refresh;
+  const SeqRun r = run_seq(scene, o, scene.k * scene.k);
+  const Err e = error(r.output, r.frame.reference);
+  EXPECT_LE(e.max, 1e-6) << "mean " << e.mean;
+}
+
+TEST(Upsample, DrobotCacheKeepsConstantBackgroundClean) {
+  // Every step (cache, filter, upsampling) is a normalised weighted mean, so a constant background stays
+  // constant except where the other surface leaks in. The soft cache test (Listing 7.2: full trust up to
+  // 2% relative depth, none from 4%) lets a bilinear history tap mix in at most ~1% of the square, whose
+  // payload differs by 0.45: bound 0.01.
+  SyntheticScene scene;
+  scene.amplitude = 0.0f;
+  scene.object = true;
+  scene.object_velocity = {1.0f, 0.5f};
+  const SeqRun r = run_seq(scene, options_for(up::Method::Drobot), 20);
+  const Err e = error(r.output, r.frame.reference, [&](std::size_t i) {
+    return r.frame.object_mask.plane("mask")[i] == 0.0f;
+  });
+  EXPECT_LE(e.max, 0.01);
+  EXPECT_LE(e.mean, 1e-3);
+}
+
+TEST(Upsample, SpatialDoesNotBlurAcrossDepthEdges) {
+  SyntheticScene scene;
+  scene.object = true;
+  scene.amplitude = 0.05f;  // nearly flat background: errors come from edges only
+  for (up::Method m : {up::Method::Spatial, up::Method::Herzog, up::Method::Drobot}) {
+    const SeqRun r = run_seq(scene, options_for(m), 1);
+    // Pixels within k of the square's border, on either side: the payload jumps by ~0.45 there.
+    const float* mask = r.frame.object_mask.plane("mask");
+    const int W = scene.width;
+    auto near_edge = [&](std::size_t i) {
+      const int X = int(i % W), Y = int(i / W);
+      for (int dy = -scene.k; dy <= scene.k; ++dy)
+        for (int dx = -scene.k; dx <= scene.k; ++dx) {
+          const int x = std::clamp(X + dx, 0, W - 1), y = std::clamp(Y + dy, 0, scene.height - 1);
+          if (mask[std::size_t(y) * W + x] != mask[i]) return true;
+        }
+      return false;
+    };
+    const Err e = error(r.output, r.frame.reference, near_edge);
+    ASSERT_GT(e.n, 100u);
+    // A geometry-blind bilinear filter mixes the two sides (errors up to ~0.4); the depth weight keeps
+    // them apart: the remaining error is the smooth payloads' interpolation error.
+    EXPECT_LT(e.max, 0.06) << up::method_name(m);
+  }
+}
+
+TEST(Upsample, NoGhostTrailBehindMovingObject) {
+  SyntheticScene scene;
+  scene.object = true;
+  scene.object_velocity = {1.5f, 0.0f};
+  const int frames = 24;
+  // Disoccluded region at the last frame: background now, covered by the square in one of the last 8 frames.
+  auto region_for = [&](const SyntheticFrame& last) {
+    std::vector<char> region(last.object_mask.pixel_count(), 0);
+    for (int t = frames - 9; t < frames - 1; ++t) {
+      const SyntheticFrame f = make_frame(scene, t);
+      for (std::size_t i = 0; i < region.size(); ++i)
+        if (f.object_mask.plane("mask")[i] > 0 && last.object_mask.plane("mask")[i] == 0) region[i] = 1;
+    }
+    return region;
+  };
+  const SeqRun sp = run_seq(scene, options_for(up::Method::Spatial), frames);
+  const auto region = region_for(sp.frame);
+  auto in_region = [&](std::size_t i) { return region[i] != 0; };
+  const Err es = error(sp.output, sp.frame.reference, in_region);
+  ASSERT_GT(es.n, 300u);
+  for (int variant = 0; variant < 4; ++variant) {
+    up::Options o = options_for(variant == 0 ? up::Method::Temporal : variant == 2 ? up::Method::Drobot : up::Method::Herzog);
+    o.drobot_mode = up::DrobotMode::Refresh;
+    o.lagged_wf = variant == 3;
+    const SeqRun r = run_seq(scene, o, frames);
+    const Err e = error(r.output, r.frame.reference, in_region);
+    std::printf("disoccluded region: %s mean %.5f max %.5f (spatial mean %.5f max %.5f)\n", up::method_name(o.method),
+                e.mean, e.max, es.mean, es.max);
+    // A ghost of the square (payload differs by ~0.45) would give errors of that size; the reconstruction
+    // there may be no worse than the spatial method's plus a margin for the kernel's flatter shape.
+    EXPECT_LE(e.mean, 1.5 * es.mean + 0.005) << up::method_name(o.method);
+    EXPECT_LT(e.max, 1.5 * es.max + 0.01) << up::method_name(o.method);
+  }
+  // Drobot's low-resolution cache blurs a textured background by design (box + bilinear); with a constant
+  // background any error in the disoccluded region is a ghost.
+  SyntheticScene flat = scene;
+  flat.amplitude = 0.0f;
+  const SeqRun dc = run_seq(flat, options_for(up::Method::Drobot), frames);
+  const Err ed = error(dc.output, dc.frame.reference, in_region);
+  EXPECT_LT(ed.max, 0.02) << "drobot cache";
+}
+
+TEST(Upsample, HistorySurvivesCameraTranslation) {
+  SyntheticScene scene;
+  scene.camera_velocity = {1.25f, 0.5f};
+  const int frames = 2 * scene.k * scene.k;
+  const std::size_t N = std::size_t(scene.width) * scene.height;
+  for (up::Method m : {up::Method::Temporal, up::Method::Herzog}) {
+    const SeqRun r = run_seq(scene, options_for(m), frames);
+    // Only the pixels whose previous position is off screen lack history: the last column (48 of 3072).
+    EXPECT_LE(double(r.stats.hole_pixels) / double(N), 0.02) << up::method_name(m);
+  }
+  const SeqRun sp = run_seq(scene, options_for(up::Method::Spatial), frames);
+  const SeqRun hz = run_seq(scene, options_for(up::Method::Herzog), frames);
+  const Err es = error(sp.output, sp.frame.reference), eh = error(hz.output, hz.frame.reference);
+  EXPECT_LT(eh.mean, es.mean) << "herzog " << eh.mean << " spatial " << es.mean;
+}
+
+TEST(Upsample, NonFiniteInputNeverEntersHistory) {
+  SyntheticScene scene;
+  const float nan = std::numeric_limits<float>::quiet_NaN(), inf = std::numeric_limits<float>::infinity();
+  for (up::Method m : {up::Method::Spatial, up::Method::Temporal, up::Method::Herzog, up::Method::Drobot}) {
+    for (up::DrobotMode mode : {up::DrobotMode::Cache, up::DrobotMode::Refresh}) {
+      if (m != up::Method::Drobot && mode == up::DrobotMode::Refresh) continue;
+      up::Options o = options_for(m);
+      o.drobot_mode = mode;
+      const SeqRun r = run_seq(scene, o, 3 * scene.k * scene.k, [&](int t, SyntheticFrame& f, bool&) {
+        if (t >= 3 && t < 6) {  // three bad frames, 5 values each
+          for (int j = 0; j < 5; ++j) f.low.plane(j % 2 ? "G" : "R")[7 * j + 3] = j % 3 ? nan : inf;
+        }
+      });
+      EXPECT_EQ(r.total_non_finite, 15u) << up::method_name(m);
+      EXPECT_TRUE(all_finite(r.output)) << up::method_name(m);
+      // Long after the bad frames, the output is as good as without them.
+      const SeqRun clean = run_seq(scene, o, 3 * scene.k * scene.k);
+      const Err e = error(r.output, clean.output);
+      EXPECT_LE(e.max, m == up::Method::Herzog || m == up::Method::Drobot ? 0.02 : 1e-6) << up::method_name(m);
+    }
+  }
+}
+
+TEST(Upsample, CameraCutDiscardsHistory) {
+  SyntheticScene before;
+  before.amplitude = 0.0f;
+  SyntheticScene after = before;
+  after.payload_offset = -0.3f;  // a different constant payload after the cut
+  for (up::Method m : {up::Method::Temporal, up::Method::Herzog, up::Method::Drobot}) {
+    for (int via_metadata = 0; via_metadata < 2; ++via_metadata) {
+      up::Upsampler u(options_for(m));
+      up::FrameStats stats;
+      for (int t = 0; t < 20; ++t) {
+        SyntheticFrame f = make_frame(t < 19 ? before : after, t);
+        bool cut = false;
+        if (t == 19) {
+          if (via_metadata)
+            f.gbuffer.metadata().camera_cut = true;
+          else
+            cut = true;
+        }
+        auto out = u.process(f.gbuffer, f.low, kRGB, cut, &stats);
+        ASSERT_TRUE(out.has_value());
+        if (t == 19) {
+          EXPECT_TRUE(stats.history_reset);
+          // Without history every pixel is a convex combination of this frame's constant samples.
+          const Err e = error(**out, f.reference);
+          EXPECT_LE(e.max, 1e-5) << up::method_name(m) << " via metadata " << via_metadata;
+        }
+      }
+    }
+  }
+  // Control: without the cut the old payload leaks into the output (the test can fail).
+  up::Upsampler u(options_for(up::Method::Temporal));
+  Image last;
+  SyntheticFrame f;
+  for (int t = 0; t < 20; ++t) {
+    f = make_frame(t < 19 ? before : after, t);
+    last = **u.process(f.gbuffer, f.low, kRGB, false);
+  }
+  EXPECT_GT(error(last, f.reference).max, 0.1);
+}
+
+TEST(Upsample, AntialiasingVariantDownsamples) {
+  SyntheticScene scene;
+  scene.width = 64;
+  scene.height = 48;
+  up::Options o = options_for(up::Method::Temporal);
+  o.aa_factor = 2;
+  const SeqRun r = run_seq(scene, o, scene.k * scene.k);
+  ASSERT_EQ(r.output.width(), 32);
+  ASSERT_EQ(r.output.height(), 24);
+  // Converged temporal result = the full-resolution reference, averaged over 2x2.
+  double worst = 0;
+  for (const auto& c : kRGB)
+    for (int y = 0; y < 24; ++y)
+      for (int x = 0; x < 32; ++x) {
+        const float* ref = r.frame.reference.plane(c);
+        const double mean = 0.25 * (ref[(2 * y) * 64 + 2 * x] + ref[(2 * y) * 64 + 2 * x + 1] +
+                                    ref[(2 * y + 1) * 64 + 2 * x] + ref[(2 * y + 1) * 64 + 2 * x + 1]);
+        worst = std::max(worst, std::abs(mean - r.output.plane(c)[y * 32 + x]));
+      }
+  EXPECT_LE(worst, 1e-6);
+}
+
+TEST(Upsample, DebugLayers) {
+  SyntheticScene scene;
+  scene.object = true;
+  scene.object_velocity = {2.0f, 0.0f};
+  up::Options o = options_for(up::Method::Herzog);
+  o.debug_layers = true;
+  const SeqRun r = run_seq(scene, o, 6);
+  for (const char* name : {"debug.confidence", "debug.disocclusion", "debug.gradient", "debug.wf",
+                           "debug.historyWeight", "debug.convergence"})
+    EXPECT_TRUE(r.output.has_channel(name)) << name;
+  // Disocclusion mask: 1 exactly on the pixels counted as having no history.
+  const float* d = r.output.plane("debug.disocclusion");
+  std::size_t ones = 0;
+  for (std::size_t i = 0; i < r.output.pixel_count(); ++i) ones += d[i] > 0.5f;
+  EXPECT_EQ(ones, r.stats.hole_pixels);
+  EXPECT_GT(ones, 0u);
+  // w_f stays in [0, a]; history weight within its bound 2 k^2 = 32.
+  for (std::size_t i = 0; i < r.output.pixel_count(); ++i) {
+    ASSERT_GE(r.output.plane("debug.wf")[i], 0.0f);
+    ASSERT_LE(r.output.plane("debug.wf")[i], 1.0f);
+    ASSERT_LE(r.output.plane("debug.historyWeight")[i], 32.0f);
+  }
+}
+
+TEST(Upsample, InputErrors) {
+  SyntheticScene scene;
+  SyntheticFrame f = make_frame(scene, 0);
+  up::Upsampler u(options_for(up::Method::Herzog));
+  {
+    SyntheticFrame g = f;
+    g.gbuffer.remove_channel("motion.X");
+    auto out = u.process(g.gbuffer, g.low, kRGB, false, nullptr, {"g.exr", "s.exr"});
+    ASSERT_FALSE(out.has_value());
+    EXPECT_EQ(out.error().kind, temporal::ErrorKind::Input);
+    EXPECT_NE(out.error().message.find("motion"), std::string::npos) << out.error().message;
+  }
+  {
+    SyntheticFrame g = f;
+    g.low = g.low.crop({0, 0, g.low.width() - 1, g.low.height()});
+    auto out = u.process(g.gbuffer, g.low, kRGB, false);
+    ASSERT_FALSE(out.has_value());
+    EXPECT_NE(out.error().message.find("full = k * low"), std::string::npos) << out.error().message;
+  }
+  {
+    SyntheticFrame g = f;
+    g.low.metadata().jitter_factor.reset();
+    auto out = u.process(g.gbuffer, g.low, kRGB, false);
+    ASSERT_FALSE(out.has_value());
+    EXPECT_NE(out.error().message.find("jitterFactor"), std::string::npos);
+  }
+  {
+    SyntheticFrame g = f;
+    g.low.metadata().jitter = glm::vec2(0.1f, 0.0f);  // not on the 4x4 grid
+    auto out = u.process(g.gbuffer, g.low, kRGB, false);
+    ASSERT_FALSE(out.has_value());
+    EXPECT_NE(out.error().message.find("regular"), std::string::npos);
+  }
+  {
+    auto sel = up::select_channels(f.low, "ssao", "s.exr");
+    ASSERT_FALSE(sel.has_value());
+    EXPECT_EQ(sel.error().file, "s.exr");
+  }
+}
