@@ -132,7 +132,7 @@ for scene in "${SCENES[@]}"; do
   echo "== $name: compare (in-between frames vs native 120 Hz)" >&2
   IFS=, ; name_list="${names[*]}"; unset IFS
   "$COMPARE" --reference "$D/ldr120/color.####.exr" "${tests[@]}" --names "$name_list" --frames "$FIRSTCMP-$LASTCMP" \
-    --csv "$D/compare.csv" --json "$D/compare.json"
+    --csv "$D/compare.csv" --json "$D/compare.json" --plot "$D/psnr.png"
 
   echo "== $name: perceived images (hold-type blur under smooth pursuit)" >&2
   "$MORPH" --perceive --input "$D/ldr120/color.####.exr" --gbuffer "$D/r120/gbuffer.####.exr" --frames "$FIRSTCMP-$LASTCMP" \
@@ -145,7 +145,7 @@ for scene in "${SCENES[@]}"; do
     ptests+=("$D/perceived/$m/p.####.exr")
   done
   "$COMPARE" --reference "$D/perceived/native/p.####.exr" "${ptests[@]}" --names "$name_list" \
-    --frames "$FIRSTCMP-$LASTCMP" --csv "$D/perceived.csv" --json "$D/perceived.json"
+    --frames "$FIRSTCMP-$LASTCMP" --csv "$D/perceived.csv" --json "$D/perceived.json" --plot "$D/perceived.png"
 
   for m in "${names[@]}"; do
     inb=$(csv_mean "$D/compare.csv" "$m" psnr_rgb_db "f % $FACTOR != 0")
@@ -162,3 +162,15 @@ echo "perceived = PSNR of the smooth-pursuit perceived images; ms = compute per 
 column -s, -t < "$TABLE"
 echo
 echo "Table: $TABLE"
+{
+  echo "# morph-120hz: seed 004 on the built-in scenes"
+  echo
+  echo "$SIZE, $FRAMES frames at 40 Hz -> 120 Hz. PSNR in dB against the native 120 Hz render (in-between frames"
+  echo "3n+1, 3n+2, and all frames); perceived = PSNR of the smooth-pursuit perceived images (hold-type blur, seed 004"
+  echo "section 3) against those of the native 120 Hz render; ms = compute per output frame (ffmpeg: wall, I/O included);"
+  echo "render ms = render-gbuffer per 40 Hz frame. Plots: <scene>/psnr*.png, <scene>/perceived*.png."
+  echo
+  echo "| scene | method | PSNR in-between | PSNR all | perceived PSNR | ms/output frame | render ms/frame |"
+  echo "|---|---|---|---|---|---|---|"
+  tail -n +2 "$TABLE" | sed 's/^/| /; s/,/ | /g; s/$/ |/'
+} > "$OUT/summary.md"
