@@ -218,19 +218,29 @@ void run_herzog(Upsampler::State& s, const FrameContext& f, const Options& o, Fr
 #pragma GCC ivdep
       for (int X = 0; X < W; ++X) {
         const int dx = cd[X], i0 = ci0[X], i1 = ci1[X];
-        const float e = ekr[X];
         const float zi = z[X], ax = nx[X], ay = ny[X], az = nz[X];
         const float g00 = geo(r0 + i0, zi, ax, ay, az) * cv0[X] * vy0;
         const float g01 = geo(r0 + i1, zi, ax, ay, az) * cv1[X] * vy0;
         const float g10 = geo(r1 + i0, zi, ax, ay, az) * cv0[X] * vy1;
         const float g11 = geo(r1 + i1, zi, ax, ay, az) * cv1[X] * vy1;
-        w00[X] = g00 * fast_exp2(e * lb0[dx]);
-        w01[X] = g01 * fast_exp2(e * lb1[dx]);
-        w10[X] = g10 * fast_exp2(e * lb2[dx]);
-        w11[X] = g11 * fast_exp2(e * lb3[dx]);
-        wt[X] = w00[X] + w01[X] + w10[X] + w11[X];
+        w00[X] = g00;
+        w01[X] = g01;
+        w10[X] = g10;
+        w11[X] = g11;
         // History confidence of this frame's samples: the same weights with the sharp kernel (w_f = 1).
         wc[X] = g00 * ks0[dx] + g01 * ks1[dx] + g10 * ks2[dx] + g11 * ks3[dx];
+      }
+      // The adaptive image kernel, in a loop of its own: fused with the geometry above, the loop body is too
+      // large for GCC's if-conversion and the whole loop stays scalar.
+#pragma GCC ivdep
+      for (int X = 0; X < W; ++X) {
+        const int dx = cd[X];
+        const float e = ekr[X];
+        w00[X] = w00[X] * fast_exp2(e * lb0[dx]);
+        w01[X] = w01[X] * fast_exp2(e * lb1[dx]);
+        w10[X] = w10[X] * fast_exp2(e * lb2[dx]);
+        w11[X] = w11[X] * fast_exp2(e * lb3[dx]);
+        wt[X] = w00[X] + w01[X] + w10[X] + w11[X];
       }
       for (int c = 0; c < C; ++c) {  // eq. 6
         const float* __restrict l0 = f.low[c] + r0;
@@ -239,8 +249,11 @@ void run_herzog(Upsampler::State& s, const FrameContext& f, const Options& o, Fr
 #pragma GCC ivdep
         for (int X = 0; X < W; ++X) {
           const int i0 = ci0[X], i1 = ci1[X];
-          const float a = w00[X] > 0 ? l0[i0] : 0.0f, b = w01[X] > 0 ? l0[i1] : 0.0f;
-          const float cc = w10[X] > 0 ? l1[i0] : 0.0f, d = w11[X] > 0 ? l1[i1] : 0.0f;
+          // Unconditional loads (the indices are clamped, always valid), then a select: conditional loads
+          // would need masked gathers, which keep the loop scalar.
+          const float la = l0[i0], lb = l0[i1], lc = l1[i0], ld = l1[i1];
+          const float a = w00[X] > 0 ? la : 0.0f, b = w01[X] > 0 ? lb : 0.0f;
+          const float cc = w10[X] > 0 ? lc : 0.0f, d = w11[X] > 0 ? ld : 0.0f;
           const float v = w00[X] * a + w01[X] * b + w10[X] * cc + w11[X] * d;
           o_[X] = wt[X] > 0 ? v / wt[X] : 0.0f;
         }

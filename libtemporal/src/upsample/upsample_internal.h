@@ -13,6 +13,13 @@
 
 namespace temporal::upsample {
 
+// floor() for |x| < 2^31, written so that loops using it vectorise: GCC does not vectorise std::floor without
+// -fno-trapping-math (the truncating conversion does vectorise). Same value as std::floor (up to the sign of 0).
+inline float floor_vec(float x) {
+  const float t = float(int(x));
+  return t > x ? t - 1.0f : t;
+}
+
 // Vectorisable exp2 / log2 for the per-tap kernel powers (std::pow does not vectorise without
 // -ffast-math). log2: relative error < 1e-6 on normal positive floats; exp2: relative error < 2e-6 for
 // x in [-126, 0], clamped below.
@@ -26,8 +33,15 @@ inline float fast_log2(float x) {
   return e + s * 2.8853900817779268f;  // 2 / ln 2
 }
 inline float fast_exp2(float x) {
-  x = x < -126.0f ? -126.0f : (x > 0.0f ? 0.0f : x);
-  const float xi = std::floor(x);
+  // Clamp to [-126, 0] on the bits: a float select followed by the float->int conversion below makes GCC
+  // split the paths, and the loop no longer if-converts (stays scalar). x > 0 -> +0 (sign bit clear: mask 0);
+  // for negative x the magnitude orders like the unsigned bits, so min() with the bits of -126 clamps.
+  // Same values as min(max(x, -126), 0) for every non-NaN x.
+  std::uint32_t u = std::bit_cast<std::uint32_t>(x);
+  u &= std::uint32_t(std::int32_t(u) >> 31);
+  u = u < 0xC2FC0000u ? u : 0xC2FC0000u;  // bits of -126.0f
+  x = std::bit_cast<float>(u);
+  const float xi = floor_vec(x);
   const float f = (x - xi) * 0.69314718056f;  // 2^f = e^(f ln 2)
   const float p =
       1.0f + f * (1.0f + f * (0.5f + f * (1.0f / 6 + f * (1.0f / 24 + f * (1.0f / 120 + f * (1.0f / 720 + f * (1.0f / 5040)))))));
@@ -140,7 +154,7 @@ inline void history_row_impl(const Upsampler::State& s, const FrameContext& f, c
     mx = finite ? mx : 0.0f;
     my = finite ? my : 0.0f;
     const float u = float(X) + mx, v = fY + my;
-    const float fu = std::floor(u), fv = std::floor(v);
+    const float fu = floor_vec(u), fv = floor_vec(v);  // |u|, |v| < 1e6 + size
     const float ax = u - fu, ay = v - fv;
     const int x0 = int(fu), y0 = int(fv);
     const bool ix0 = (x0 >= 0) & (x0 < W), ix1 = (x0 + 1 >= 0) & (x0 + 1 < W);

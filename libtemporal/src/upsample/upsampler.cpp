@@ -195,8 +195,11 @@ void spatial_row(const Upsampler::State& s, const FrameContext& f, const Options
     for (int X = 0; X < W; ++X) {
       const float ws = w00[X] + w01[X] + w10[X] + w11[X];
       // Invalid samples carry weight 0, and their value is replaced by 0 so that a NaN never propagates.
-      const float a = w00[X] > 0 ? l0[ci0[X]] : 0.0f, b = w01[X] > 0 ? l0[ci1[X]] : 0.0f;
-      const float cc = w10[X] > 0 ? l1[ci0[X]] : 0.0f, d = w11[X] > 0 ? l1[ci1[X]] : 0.0f;
+      // Unconditional loads (clamped indices, always valid) and a select: conditional loads would need
+      // masked gathers, which keep the loop scalar.
+      const float la = l0[ci0[X]], lb = l0[ci1[X]], lc = l1[ci0[X]], ld = l1[ci1[X]];
+      const float a = w00[X] > 0 ? la : 0.0f, b = w01[X] > 0 ? lb : 0.0f;
+      const float cc = w10[X] > 0 ? lc : 0.0f, d = w11[X] > 0 ? ld : 0.0f;
       const float v = w00[X] * a + w01[X] * b + w10[X] * cc + w11[X] * d;
       o_[X] = ws > 0 ? v / ws : 0.0f;
     }

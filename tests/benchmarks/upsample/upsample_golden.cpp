@@ -1,0 +1,136 @@
+// Regression helper for optimisation work (not a test): runs every upsampling method on two synthetic
+// sequences (the benchmark's 1280x1024 pan, and a small scene with a moving object and per-frame G-buffers,
+// debug layers on) and writes every output float to FILE (`write FILE`), or compares against FILE
+// (`check FILE`), printing the largest absolute and relative differences per method.
+#include "synthetic.h"
+
+#include "temporal/upsample.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <fstream>
+#include <string>
+#include <vector>
+
+namespace up = temporal::upsample;
+using temporal::Image;
+
+namespace {
+
+const std::vector<std::string> kRGB = {"R", "G", "B"};
+
+up::Options options(int method) {
+  up::Options o;
+  switch (method) {
+    case 0: o.method = up::Method::Spatial; break;
+    case 1: o.method = up::Method::Temporal; break;
+    case 2: o.method = up::Method::Herzog; break;
+    case 3: o.method = up::Method::Drobot; break;
+    case 4: o.method = up::Method::Drobot; o.drobot_mode = up::DrobotMode::Refresh; break;
+    default: o.method = up::Method::Herzog; o.lagged_wf = true; break;
+  }
+  return o;
+}
+const char* kNames[] = {"spatial", "temporal", "herzog", "drobot", "drobot-refresh", "herzog-lagged-wf"};
+
+void append(std::vector<float>& v, const Image& img) {
+  for (const auto& n : img.channel_names()) {
+    const float* p = img.plane(n);
+    if (p) v.insert(v.end(), p, p + img.pixel_count());
+  }
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  if (argc != 3) {
+    std::fprintf(stderr, "usage: upsample_golden write|check FILE\n");
+    return 1;
+  }
+  const bool write = std::strcmp(argv[1], "write") == 0;
+  // Scene A: the benchmark's (one G-buffer for every frame).
+  temporal::test::SyntheticScene a;
+  a.width = 1280;
+  a.height = 1024;
+  a.k = 4;
+  a.period = 37.0f;
+  a.camera_velocity = {1.25f, 0.5f};
+  a.object = true;
+  a.object_start = {400.0f, 300.0f};
+  a.object_size = 300;
+  std::vector<temporal::test::SyntheticFrame> fa;
+  for (int t = 1; t <= 16; ++t) fa.push_back(temporal::test::make_frame(a, t));
+  // Scene B: small, moving object, per-frame G-buffers.
+  temporal::test::SyntheticScene b;
+  b.width = 256;
+  b.height = 192;
+  b.k = 4;
+  b.camera_velocity = {0.75f, -0.5f};
+  b.object = true;
+  b.object_start = {40.0f, 30.0f};
+  b.object_velocity = {2.5f, 1.5f};
+  b.object_size = 50;
+  std::vector<temporal::test::SyntheticFrame> fb;
+  for (int t = 1; t <= 24; ++t) fb.push_back(temporal::test::make_frame(b, t));
+
+  std::vector<std::vector<float>> results(6);
+  for (int m = 0; m < 6; ++m) {
+    {
+      up::Upsampler u(options(m));
+      for (int i = 0; i < 40; ++i) {
+        auto r = u.process(fa[0].gbuffer, fa[i % 16].low, kRGB, false);
+        if (!r) return 2;
+        if (i >= 36) append(results[m], **r);
+      }
+    }
+    {
+      up::Options o = options(m);
+      o.debug_layers = true;
+      up::Upsampler u(o);
+      for (int i = 0; i < 24; ++i) {
+        auto r = u.process(fb[i].gbuffer, fb[i].low, kRGB, false);
+        if (!r) return 2;
+        append(results[m], **r);
+      }
+    }
+  }
+  if (write) {
+    std::ofstream f(argv[2], std::ios::binary);
+    for (auto& v : results) {
+      const std::uint64_t n = v.size();
+      f.write(reinterpret_cast<const char*>(&n), sizeof n);
+      f.write(reinterpret_cast<const char*>(v.data()), std::streamsize(n * sizeof(float)));
+    }
+    return f ? 0 : 3;
+  }
+  std::ifstream f(argv[2], std::ios::binary);
+  int bad = 0;
+  for (int m = 0; m < 6; ++m) {
+    std::uint64_t n = 0;
+    f.read(reinterpret_cast<char*>(&n), sizeof n);
+    std::vector<float> ref(n);
+    f.read(reinterpret_cast<char*>(ref.data()), std::streamsize(n * sizeof(float)));
+    if (n != results[m].size()) {
+      std::printf("%-18s size mismatch %zu vs %zu\n", kNames[m], std::size_t(n), results[m].size());
+      ++bad;
+      continue;
+    }
+    double max_abs = 0, max_rel = 0;
+    std::size_t nan_mismatch = 0;
+    for (std::size_t i = 0; i < n; ++i) {
+      const float x = results[m][i], y = ref[i];
+      if (std::isnan(x) != std::isnan(y)) ++nan_mismatch;
+      if (std::isnan(x) || std::isnan(y)) continue;
+      const double d = std::abs(double(x) - double(y));
+      max_abs = std::max(max_abs, d);
+      max_rel = std::max(max_rel, d / std::max(1.0, std::abs(double(y))));
+    }
+    const bool ok = max_rel <= 1e-4 && nan_mismatch == 0;
+    bad += ok ? 0 : 1;
+    std::printf("%-18s max abs %.3g  max rel %.3g  nan mismatch %zu  %s\n", kNames[m], max_abs, max_rel, nan_mismatch,
+                ok ? "OK" : "DIFFERENT");
+  }
+  return bad ? 4 : 0;
+}
