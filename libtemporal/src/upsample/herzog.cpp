@@ -25,18 +25,6 @@
 namespace temporal::upsample {
 namespace {
 
-// Bilinear clamp-to-edge sample of a w x h plane at texel coordinates (u, v) (texel centres at integers).
-float sample_bilinear(const std::vector<float>& p, int w, int h, float u, float v) {
-  u = std::clamp(u, 0.0f, float(w - 1));
-  v = std::clamp(v, 0.0f, float(h - 1));
-  const int x0 = std::min(int(u), w - 1), y0 = std::min(int(v), h - 1);
-  const int x1 = std::min(x0 + 1, w - 1), y1 = std::min(y0 + 1, h - 1);
-  const float ax = u - float(x0), ay = v - float(y0);
-  const float a = p[std::size_t(y0) * w + x0], b = p[std::size_t(y0) * w + x1];
-  const float c = p[std::size_t(y1) * w + x0], d = p[std::size_t(y1) * w + x1];
-  return (1 - ay) * ((1 - ax) * a + ax * b) + ay * ((1 - ax) * c + ax * d);
-}
-
 // Eq. 7 for one row and the bounded history-weight update. wf: w_f per pixel; wt: w~ (adaptive kernel);
 // wc: w~' (sharp kernel, stored); hwf: h_w(i(t-1)) (0 on a miss); hr[c]: h_r(i(t-1)); p[c]: h~ in, h out.
 void blend_row(int W, int C, const float* __restrict wf, const float* __restrict wt, const float* __restrict wc,
@@ -117,6 +105,20 @@ void run_herzog(Upsampler::State& s, const FrameContext& f, const Options& o, Fr
   std::vector<float> ksharp(logb.size());
   const float gamma_full = kernel_gamma(o.kernel_gamma, 1.0f, o.max_kernel_gamma);
   for (std::size_t j = 0; j < logb.size(); ++j) ksharp[j] = std::exp2(gamma_full * logb[j]);
+  // Both tables expanded to full-resolution columns, once per frame: plane (dy, j) holds the entry of tap j
+  // at offset (cols.d[X], dy) for every column X, so the kernel loops read them with unit stride.
+  s.kern_lb.resize(std::size_t(k) * 4 * W);
+  s.kern_ks.resize(std::size_t(k) * 4 * W);
+  for (int dy = 0; dy < k; ++dy)
+    for (int j = 0; j < 4; ++j) {
+      const std::size_t t = std::size_t(j) * k * k + std::size_t(dy) * k;
+      float* __restrict elb = s.kern_lb.data() + (std::size_t(dy) * 4 + j) * W;
+      float* __restrict eks = s.kern_ks.data() + (std::size_t(dy) * 4 + j) * W;
+      for (int X = 0; X < W; ++X) {
+        elb[X] = logb[t + s.cols.d[X]];
+        eks[X] = ksharp[t + s.cols.d[X]];
+      }
+    }
   const float inv_sn2 = 1.0f / (o.sigma_normal * o.sigma_normal), inv_sd2 = 1.0f / (f.sigma_d * f.sigma_d);
   const std::vector<float>& wf_prev = s.wf[prv];
 
@@ -130,9 +132,12 @@ void run_herzog(Upsampler::State& s, const FrameContext& f, const Options& o, Fr
 
   // ---------------- pass A ----------------
   std::atomic<std::size_t> hits{0};
+  // Bands of 8 intermediate rows (16 full rows at gs = 2): the expanded low rows are reused over each band.
   parallel_rows(GH, [&](int gy0, int gy1) {
     thread_local std::vector<float> w4, ekern, wfkrow, ycur, yprev, grad, rowbuf, histw;
     thread_local HistoryRow hist;
+    thread_local ExpandedLowRows low_rows;
+    low_rows.reset(W, k, f.grid.sx, C);
     w4.resize(std::size_t(W) * 4);
     ekern.resize(W);
     wfkrow.resize(W);
@@ -151,10 +156,17 @@ void run_herzog(Upsampler::State& s, const FrameContext& f, const Options& o, Fr
       const int r0 = s.rows.i0[Y] * f.lw, r1 = s.rows.i1[Y] * f.lw;
       const float vy0 = s.rows.v0[Y], vy1 = s.rows.v1[Y];
       const int dy = s.rows.d[Y];
-      const float* lb0 = logb.data() + std::size_t(0) * k * k + dy * k;
-      const float* lb1 = logb.data() + std::size_t(1) * k * k + dy * k;
-      const float* lb2 = logb.data() + std::size_t(2) * k * k + dy * k;
-      const float* lb3 = logb.data() + std::size_t(3) * k * k + dy * k;
+      const float* __restrict lb0 = s.kern_lb.data() + (std::size_t(dy) * 4 + 0) * W;
+      const float* __restrict lb1 = s.kern_lb.data() + (std::size_t(dy) * 4 + 1) * W;
+      const float* __restrict lb2 = s.kern_lb.data() + (std::size_t(dy) * 4 + 2) * W;
+      const float* __restrict lb3 = s.kern_lb.data() + (std::size_t(dy) * 4 + 3) * W;
+      const float* __restrict ks0 = s.kern_ks.data() + (std::size_t(dy) * 4 + 0) * W;
+      const float* __restrict ks1 = s.kern_ks.data() + (std::size_t(dy) * 4 + 1) * W;
+      const float* __restrict ks2 = s.kern_ks.data() + (std::size_t(dy) * 4 + 2) * W;
+      const float* __restrict ks3 = s.kern_ks.data() + (std::size_t(dy) * 4 + 3) * W;
+      // The two low rows' samples expanded to the full-resolution columns (cached over the k rows using them).
+      const float *e0 = nullptr, *e1 = nullptr;
+      low_rows.get(s, f, r0, r1, e0, e1);
       // Kernel fall-off from the previous frame's w_f at the motion-compensated position.
       {
         float* __restrict ek = ekern.data();
@@ -185,30 +197,32 @@ void run_herzog(Upsampler::State& s, const FrameContext& f, const Options& o, Fr
       const float* __restrict nx = f.nx + row;
       const float* __restrict ny = f.ny + row;
       const float* __restrict nz = f.nz + row;
-      const float* __restrict lz = s.lz.data();
-      const float* __restrict lnx = s.lnx.data();
-      const float* __restrict lny = s.lny.data();
-      const float* __restrict lnz = s.lnz.data();
-      const float* __restrict lvalid = s.lvalid.data();
-      const int* __restrict ci0 = s.cols.i0.data();
-      const int* __restrict ci1 = s.cols.i1.data();
-      const int* __restrict cd = s.cols.d.data();
       const float* __restrict cv0 = s.cols.v0.data();
       const float* __restrict cv1 = s.cols.v1.data();
       const float* __restrict ekr = ekern.data();
-      auto geo = [=](int j, float zi, float ax, float ay, float az) {
-        const float dot = ax * lnx[j] + ay * lny[j] + az * lnz[j];
+      // Expanded plane q, tap t of low row e (see ExpandedLowRows).
+      const std::size_t es = low_rows.stride();
+      auto ex = [es, k](const float* e, int q, int t) { return e + std::size_t(q) * es + std::size_t(t) * k; };
+      const float *__restrict z00 = ex(e0, 0, 0), *__restrict z01 = ex(e0, 0, 1), *__restrict z10 = ex(e1, 0, 0),
+                  *__restrict z11 = ex(e1, 0, 1);
+      const float *__restrict x00 = ex(e0, 1, 0), *__restrict x01 = ex(e0, 1, 1), *__restrict x10 = ex(e1, 1, 0),
+                  *__restrict x11 = ex(e1, 1, 1);
+      const float *__restrict y00 = ex(e0, 2, 0), *__restrict y01 = ex(e0, 2, 1), *__restrict y10 = ex(e1, 2, 0),
+                  *__restrict y11 = ex(e1, 2, 1);
+      const float *__restrict n00 = ex(e0, 3, 0), *__restrict n01 = ex(e0, 3, 1), *__restrict n10 = ex(e1, 3, 0),
+                  *__restrict n11 = ex(e1, 3, 1);
+      const float *__restrict v00 = ex(e0, 4, 0), *__restrict v01 = ex(e0, 4, 1), *__restrict v10 = ex(e1, 4, 0),
+                  *__restrict v11 = ex(e1, 4, 1);
+      // Geometric weight (normal and depth tents, cubed) of one low-resolution sample.
+      auto geo = [=](float zi, float ax, float ay, float az, float lx, float ly, float lzn, float lzz, float lv) {
+        const float dot = ax * lx + ay * ly + az * lzn;
         const float xn = std::max(0.0f, 1.0f - dot);
         const float tn = std::max(kKernelEpsilon, 1.0f - xn * xn * inv_sn2);
-        const float dz = zi - lz[j];
+        const float dz = zi - lzz;
         const float td = std::max(kKernelEpsilon, 1.0f - dz * dz * inv_sd2);
-        const float w = tn * tn * tn * td * td * td * lvalid[j];
+        const float w = tn * tn * tn * td * td * td * lv;
         return w >= 0.0f ? w : 0.0f;
       };
-      const float* ks0 = ksharp.data() + std::size_t(0) * k * k + dy * k;
-      const float* ks1 = ksharp.data() + std::size_t(1) * k * k + dy * k;
-      const float* ks2 = ksharp.data() + std::size_t(2) * k * k + dy * k;
-      const float* ks3 = ksharp.data() + std::size_t(3) * k * k + dy * k;
       // Pass A's per-pixel results: whole planes for pass C, or rows when eq. 7 runs here (fused).
       float* __restrict wt = fused ? rowbuf.data() : s.w_tilde.data() + row;
       float* __restrict wc = fused ? rowbuf.data() + W : s.w_conf.data() + row;
@@ -217,41 +231,39 @@ void run_herzog(Upsampler::State& s, const FrameContext& f, const Options& o, Fr
       for (int c = 0; c < C; ++c) hr_rows[c] = fused ? rowbuf.data() + std::size_t(3 + c) * W : s.hr_fetch[c].data() + row;
 #pragma GCC ivdep
       for (int X = 0; X < W; ++X) {
-        const int dx = cd[X], i0 = ci0[X], i1 = ci1[X];
         const float zi = z[X], ax = nx[X], ay = ny[X], az = nz[X];
-        const float g00 = geo(r0 + i0, zi, ax, ay, az) * cv0[X] * vy0;
-        const float g01 = geo(r0 + i1, zi, ax, ay, az) * cv1[X] * vy0;
-        const float g10 = geo(r1 + i0, zi, ax, ay, az) * cv0[X] * vy1;
-        const float g11 = geo(r1 + i1, zi, ax, ay, az) * cv1[X] * vy1;
+        const float g00 = geo(zi, ax, ay, az, x00[X], y00[X], n00[X], z00[X], v00[X]) * cv0[X] * vy0;
+        const float g01 = geo(zi, ax, ay, az, x01[X], y01[X], n01[X], z01[X], v01[X]) * cv1[X] * vy0;
+        const float g10 = geo(zi, ax, ay, az, x10[X], y10[X], n10[X], z10[X], v10[X]) * cv0[X] * vy1;
+        const float g11 = geo(zi, ax, ay, az, x11[X], y11[X], n11[X], z11[X], v11[X]) * cv1[X] * vy1;
         w00[X] = g00;
         w01[X] = g01;
         w10[X] = g10;
         w11[X] = g11;
         // History confidence of this frame's samples: the same weights with the sharp kernel (w_f = 1).
-        wc[X] = g00 * ks0[dx] + g01 * ks1[dx] + g10 * ks2[dx] + g11 * ks3[dx];
+        wc[X] = g00 * ks0[X] + g01 * ks1[X] + g10 * ks2[X] + g11 * ks3[X];
       }
       // The adaptive image kernel, in a loop of its own: fused with the geometry above, the loop body is too
       // large for GCC's if-conversion and the whole loop stays scalar.
 #pragma GCC ivdep
       for (int X = 0; X < W; ++X) {
-        const int dx = cd[X];
         const float e = ekr[X];
-        w00[X] = w00[X] * fast_exp2(e * lb0[dx]);
-        w01[X] = w01[X] * fast_exp2(e * lb1[dx]);
-        w10[X] = w10[X] * fast_exp2(e * lb2[dx]);
-        w11[X] = w11[X] * fast_exp2(e * lb3[dx]);
+        w00[X] = w00[X] * fast_exp2(e * lb0[X]);
+        w01[X] = w01[X] * fast_exp2(e * lb1[X]);
+        w10[X] = w10[X] * fast_exp2(e * lb2[X]);
+        w11[X] = w11[X] * fast_exp2(e * lb3[X]);
         wt[X] = w00[X] + w01[X] + w10[X] + w11[X];
       }
       for (int c = 0; c < C; ++c) {  // eq. 6
-        const float* __restrict l0 = f.low[c] + r0;
-        const float* __restrict l1 = f.low[c] + r1;
+        const float* __restrict l00 = ex(e0, 5 + c, 0);
+        const float* __restrict l01 = ex(e0, 5 + c, 1);
+        const float* __restrict l10 = ex(e1, 5 + c, 0);
+        const float* __restrict l11 = ex(e1, 5 + c, 1);
         float* __restrict o_ = planes[c] + row;
 #pragma GCC ivdep
         for (int X = 0; X < W; ++X) {
-          const int i0 = ci0[X], i1 = ci1[X];
-          // Unconditional loads (the indices are clamped, always valid), then a select: conditional loads
-          // would need masked gathers, which keep the loop scalar.
-          const float la = l0[i0], lb = l0[i1], lc = l1[i0], ld = l1[i1];
+          // Unconditional loads, then a select (an invalid sample's value may be NaN: it must not propagate).
+          const float la = l00[X], lb = l01[X], lc = l10[X], ld = l11[X];
           const float a = w00[X] > 0 ? la : 0.0f, b = w01[X] > 0 ? lb : 0.0f;
           const float cc = w10[X] > 0 ? lc : 0.0f, d = w11[X] > 0 ? ld : 0.0f;
           const float v = w00[X] * a + w01[X] * b + w10[X] * cc + w11[X] * d;
@@ -299,7 +311,9 @@ void run_herzog(Upsampler::State& s, const FrameContext& f, const Options& o, Fr
           // Disoccluded (no history) or no spatial sample: the maximum gradient (Figure 6).
           gr[X] = (hit[X] > 0 && wt[X] > 0) ? g : kMaxGradient;
         }
-        for (int X = 0; X < W; ++X) band_hits += hit[X] > 0 ? 1 : 0;
+        int row_hits = 0;  // an int reduction vectorises (a size_t one with a select does not)
+        for (int X = 0; X < W; ++X) row_hits += int(hit[X] > 0);
+        band_hits += std::size_t(row_hits);
       } else {
         std::fill(hwf, hwf + W, 0.0f);
         for (int c = 0; c < C; ++c) std::fill(hr_rows[c], hr_rows[c] + W, 0.0f);
@@ -308,7 +322,17 @@ void run_herzog(Upsampler::State& s, const FrameContext& f, const Options& o, Fr
       // Average into the intermediate-resolution gradient buffer.
       float* dc = s.dcur.data() + std::size_t(Y / gs) * GW;
       float* dn = s.dcount.data() + std::size_t(Y / gs) * GW;
-      for (int gx = 0; gx < GW; ++gx) {
+      int gx_full = 0;
+      if (gs == 2) {  // the default: whole cells in a loop that vectorises (same sums, same order)
+        const float* __restrict gr = grad.data();
+        gx_full = W / 2;
+#pragma GCC ivdep
+        for (int gx = 0; gx < gx_full; ++gx) {
+          dc[gx] += (0.0f + gr[2 * gx]) + gr[2 * gx + 1];
+          dn[gx] += 2.0f;
+        }
+      }
+      for (int gx = gx_full; gx < GW; ++gx) {
         float sum = 0.0f;
         int n = 0;
         for (int X = gx * gs; X < std::min(W, gx * gs + gs); ++X, ++n) sum += grad[X];
@@ -331,33 +355,44 @@ void run_herzog(Upsampler::State& s, const FrameContext& f, const Options& o, Fr
       }
     }
     hits += band_hits;
-  });
+  }, 8);
 
   // ---------------- pass B ----------------
   auto& dh_prev = s.dhist[prv];
   auto& dh_cur = s.dhist[cur];
   parallel_rows(GH, [&](int gy0, int gy1) {
-    for (int gy = gy0; gy < gy1; ++gy)
+    const float* __restrict p0 = dh_prev[0].data();
+    const float* __restrict p1 = dh_prev[1].data();
+    const float* __restrict p2 = dh_prev[2].data();
+    const float fgs = float(gs), fGW = float(GW), fGH = float(GH);
+    for (int gy = gy0; gy < gy1; ++gy) {
+      const std::size_t grow = std::size_t(gy) * GW;
+      const float* __restrict dcur = s.dcur.data() + grow;
+      const float* __restrict dcnt = s.dcount.data() + grow;
+      float* __restrict c0 = dh_cur[0].data() + grow;
+      float* __restrict c1 = dh_cur[1].data() + grow;
+      float* __restrict c2 = dh_cur[2].data() + grow;
+      float* __restrict gf = s.gfilt.data() + grow;
+      // The motion at the cell's centre pixel (row cy, every gs-th column) moves the three previous gradients.
+      const int cy = std::min(H - 1, gy * gs + gs / 2);
+      const float* __restrict mxr = f.mx + std::size_t(cy) * W;
+      const float* __restrict myr = f.my + std::size_t(cy) * W;
+      const float fcy = float(cy) + 0.5f;
+#pragma GCC ivdep
       for (int gx = 0; gx < GW; ++gx) {
-        const std::size_t g = std::size_t(gy) * GW + gx;
-        const float d0 = s.dcount[g] > 0 ? s.dcur[g] / s.dcount[g] : kMaxGradient;
-        float d1 = kMaxGradient, d2 = kMaxGradient, d3 = kMaxGradient;
-        if (history) {
-          const int cx = std::min(W - 1, gx * gs + gs / 2), cy = std::min(H - 1, gy * gs + gs / 2);
-          const std::size_t i = std::size_t(cy) * W + cx;
-          const float px = (float(cx) + 0.5f + f.mx[i]) / float(gs), py = (float(cy) + 0.5f + f.my[i]) / float(gs);
-          if (px >= 0 && py >= 0 && px < float(GW) && py < float(GH)) {
-            const std::size_t q = std::size_t(py) * GW + std::size_t(px);
-            d1 = dh_prev[0][q];
-            d2 = dh_prev[1][q];
-            d3 = dh_prev[2][q];
-          }
-        }
-        dh_cur[0][g] = d0;
-        dh_cur[1][g] = d1;
-        dh_cur[2][g] = d2;
-        s.gfilt[g] = filtered_gradient(d0, d1, d2, d3);
+        const float d0 = dcnt[gx] > 0 ? dcur[gx] / dcnt[gx] : kMaxGradient;
+        const int cx = std::min(W - 1, gx * gs + gs / 2);
+        const float px = (float(cx) + 0.5f + mxr[cx]) / fgs, py = (fcy + myr[cx]) / fgs;
+        const bool in = history & (px >= 0) & (py >= 0) & (px < fGW) & (py < fGH);  // false for NaN
+        const int q = in ? int(py) * GW + int(px) : 0;
+        const float e1 = p0[q], e2 = p1[q], e3 = p2[q];  // unconditional loads (q is valid), then selects
+        const float d1 = in ? e1 : kMaxGradient, d2 = in ? e2 : kMaxGradient, d3 = in ? e3 : kMaxGradient;
+        c0[gx] = d0;
+        c1[gx] = d1;
+        c2[gx] = d2;
+        gf[gx] = filtered_gradient(d0, d1, d2, d3);
       }
+    }
   });
   // Spatial low-pass: box pyramid above the intermediate level, sampled trilinearly at the mip level.
   const float base_level = std::log2(float(gs));
@@ -387,20 +422,71 @@ void run_herzog(Upsampler::State& s, const FrameContext& f, const Options& o, Fr
                                                src[std::size_t(yb) * pw + xa] + src[std::size_t(yb) * pw + xb]);
       }
   }
+  // Trilinear sampling: the bilinear taps and weights of every column and row, per level, computed once
+  // (bilinear, clamp-to-edge, texel centres at integers; hoisted out of the cell loop so that it vectorises).
+  struct Axis {
+    std::vector<int> i0, i1;
+    std::vector<float> a;
+  };
+  auto make_axis = [](int n_out, int n_in, int j, Axis& ax) {
+    ax.i0.resize(n_out);
+    ax.i1.resize(n_out);
+    ax.a.resize(n_out);
+    const float sc = float(1 << j);
+    for (int g = 0; g < n_out; ++g) {
+      const float u = std::clamp((float(g) + 0.5f) / sc - 0.5f, 0.0f, float(n_in - 1));
+      const int x0 = std::min(int(u), n_in - 1);
+      ax.i0[g] = x0;
+      ax.i1[g] = std::min(x0 + 1, n_in - 1);
+      ax.a[g] = u - float(x0);
+    }
+  };
+  const int nlev = frac > 0 ? 2 : 1;
+  Axis axx[2], axy[2];
+  for (int t = 0; t < nlev; ++t) {
+    make_axis(GW, s.pyr_w[l0 + t], l0 + t, axx[t]);
+    make_axis(GH, s.pyr_h[l0 + t], l0 + t, axy[t]);
+  }
   parallel_rows(GH, [&](int gy0, int gy1) {
-    for (int gy = gy0; gy < gy1; ++gy)
-      for (int gx = 0; gx < GW; ++gx) {
-        auto at = [&](int j) {
-          const float sc = float(1 << j);
-          return sample_bilinear(s.pyramid[j], s.pyr_w[j], s.pyr_h[j], (float(gx) + 0.5f) / sc - 0.5f,
-                                 (float(gy) + 0.5f) / sc - 0.5f);
-        };
-        float g = at(l0);
-        if (frac > 0) g = (1 - frac) * g + frac * at(l0 + 1);
-        const std::size_t q = std::size_t(gy) * GW + gx;
-        s.grad_smooth[q] = g;
-        s.wf[cur][q] = temporal_weight(g, o.a);  // eq. 8
+    thread_local std::vector<float> lev;
+    lev.resize(std::size_t(2) * GW);
+    for (int gy = gy0; gy < gy1; ++gy) {
+      for (int t = 0; t < nlev; ++t) {
+        const int j = l0 + t, pw = s.pyr_w[j];
+        const float* __restrict r0 = s.pyramid[j].data() + std::size_t(axy[t].i0[gy]) * pw;
+        const float* __restrict r1 = s.pyramid[j].data() + std::size_t(axy[t].i1[gy]) * pw;
+        const float ay = axy[t].a[gy];
+        const int* __restrict x0 = axx[t].i0.data();
+        const int* __restrict x1 = axx[t].i1.data();
+        const float* __restrict axa = axx[t].a.data();
+        float* __restrict lout = lev.data() + std::size_t(t) * GW;
+#pragma GCC ivdep
+        for (int gx = 0; gx < GW; ++gx) {
+          const float ax = axa[gx];
+          const float a = r0[x0[gx]], b = r0[x1[gx]], c = r1[x0[gx]], d = r1[x1[gx]];
+          lout[gx] = (1 - ay) * ((1 - ax) * a + ax * b) + ay * ((1 - ax) * c + ax * d);
+        }
       }
+      const float* __restrict g0 = lev.data();
+      const float* __restrict g1 = lev.data() + GW;
+      float* __restrict gsm = s.grad_smooth.data() + std::size_t(gy) * GW;
+      float* __restrict wfo = s.wf[cur].data() + std::size_t(gy) * GW;
+      const float a_ = o.a;
+      if (nlev == 2) {
+#pragma GCC ivdep
+        for (int gx = 0; gx < GW; ++gx) {
+          const float g = (1 - frac) * g0[gx] + frac * g1[gx];
+          gsm[gx] = g;
+          wfo[gx] = temporal_weight(g, a_);  // eq. 8
+        }
+      } else {
+#pragma GCC ivdep
+        for (int gx = 0; gx < GW; ++gx) {
+          gsm[gx] = g0[gx];
+          wfo[gx] = temporal_weight(g0[gx], a_);  // eq. 8
+        }
+      }
+    }
   });
 
   // ---------------- pass C ----------------
@@ -409,6 +495,7 @@ void run_herzog(Upsampler::State& s, const FrameContext& f, const Options& o, Fr
     thread_local std::vector<float> wf_row, hist_w;
     wf_row.resize(W);
     hist_w.resize(W);
+    int wf_row_of = -1;  // the intermediate row wf_row was expanded from (shared by gs full rows)
     for (int Y = y0; Y < y1; ++Y) {
       const std::size_t row = std::size_t(Y) * W;
       const float* wfr = wf_cur.data() + std::size_t(Y / gs) * GW;
@@ -417,8 +504,11 @@ void run_herzog(Upsampler::State& s, const FrameContext& f, const Options& o, Fr
         for (int X = 0; X < W; ++X) dbg_grad[row + X] = gsr[X / gs];
       }
       if (fused) continue;  // eq. 7 already ran in pass A
-      for (int gx = 0; gx < GW; ++gx)
-        for (int X = gx * gs; X < std::min(W, gx * gs + gs); ++X) wf_row[X] = wfr[gx];
+      if (Y / gs != wf_row_of) {
+        for (int gx = 0; gx < GW; ++gx)
+          for (int X = gx * gs; X < std::min(W, gx * gs + gs); ++X) wf_row[X] = wfr[gx];
+        wf_row_of = Y / gs;
+      }
       const float* hr[16];
       float* p[16];
       for (int c = 0; c < C; ++c) {

@@ -74,11 +74,34 @@ void run_temporal(Upsampler::State& s, const FrameContext& f, const Options& o, 
           out_row[X] = computed[X] > 0 ? l[ci0[X]] : h;  // eq. 4, w_t = 1
         }
       }
-      if (row_holes > 0 || dbg_conf) {
-        spatial_row(s, f, o, Y, fill_rows.data(), dbg_conf ? dbg_conf + row : nullptr);
+      if (dbg_conf) {
+        spatial_row(s, f, o, Y, fill_rows.data(), dbg_conf + row);
         for (int c = 0; c < C; ++c)
           for (int X = 0; X < f.W; ++X)
             if (hole[X] > 0) planes[c][row + X] = fill_rows[c][X];
+      } else if (row_holes > 0) {
+        // Only the runs of holes (typically a few pixels at a disocclusion or the screen edge) are upsampled
+        // spatially; runs less than 16 pixels apart are merged to keep the kernel loops long.
+        int X = 0;
+        while (X < f.W) {
+          while (X < f.W && hole[X] == 0.0f) ++X;
+          if (X >= f.W) break;
+          const int a = X;
+          int b = X, gap = 0;
+          for (; X < f.W && gap < 16; ++X) {
+            if (hole[X] > 0) {
+              b = X + 1;
+              gap = 0;
+            } else {
+              ++gap;
+            }
+          }
+          X = b;
+          spatial_row(s, f, o, Y, fill_rows.data(), nullptr, a, b);
+          for (int c = 0; c < C; ++c)
+            for (int x = a; x < b; ++x)
+              if (hole[x] > 0) planes[c][row + x] = fill_rows[c][x];
+        }
       }
       if (dbg_disocc)
         for (int X = 0; X < f.W; ++X) dbg_disocc[row + X] = hole[X];

@@ -95,6 +95,7 @@ struct Upsampler::State {
   std::vector<float> dcur, dcount;
   std::vector<float> dhist[2][3];  // relative gradients of t-1, t-2, t-3 (ping-pong)
   std::vector<float> gfilt, wf[2], grad_smooth;
+  std::vector<float> kern_lb, kern_ks;  // image-kernel tables expanded to full-resolution columns (per dy, tap)
   std::vector<std::vector<float>> pyramid;
   std::vector<int> pyr_w, pyr_h;
   // drobot cache mode: low-resolution history (value, depth, frame count), ping-pong, and filter scratch.
@@ -116,13 +117,105 @@ struct HistoryRow {
   std::vector<int> q[4];
   std::vector<float> w[4];
   std::vector<float> hit;
+  // Runs of the row, in order, covering [0, W): {X0, X1, base}; base >= 0: the taps are the image-aligned
+  // 2x2 block at a constant offset (q0 = base + X, q1 = q0 + 1, q2 = q0 + W, q3 = q2 + 1), read with
+  // contiguous loads; base = -1: gathered through q.
+  struct Segment {
+    int x0, x1, base;
+  };
+  std::vector<Segment> segments;
+  std::vector<int> offset, aligned;  // scratch: q0 - X, and 1 where the taps form the aligned block
   void resize(int W) {
     for (auto& v : q) v.resize(W);
     for (auto& v : w) v.resize(W);
     hit.resize(W);
+    offset.resize(W);
+    aligned.resize(W);
   }
 };
 
+// Splits a row whose q are set into HistoryRow::segments: runs of at least 16 pixels with aligned taps at one
+// offset (camera pans, static regions) are contiguous segments; everything between them is one gather
+// segment. `offset` and `aligned` must be filled.
+inline void build_segments(HistoryRow& h, int W) {
+  h.segments.clear();
+  const int* __restrict off = h.offset.data();
+  const int* __restrict al = h.aligned.data();
+  int gather_start = -1, X = 0;
+  while (X < W) {
+    const int base = off[X];
+    int E = X;
+    if (al[X]) {
+      while (E + 16 <= W) {  // whole blocks first (a reduction the compiler vectorises)
+        int all = 1;
+        for (int i = 0; i < 16; ++i) all &= int(off[E + i] == base) & al[E + i];
+        if (!all) break;
+        E += 16;
+      }
+      while (E < W && off[E] == base && al[E]) ++E;
+    }
+    if (E - X >= 16) {
+      if (gather_start >= 0) h.segments.push_back({gather_start, X, -1});
+      gather_start = -1;
+      h.segments.push_back({X, E, base});
+      X = E;
+    } else {
+      if (gather_start < 0) gather_start = X;
+      X = std::max(E, X + 1);
+    }
+  }
+  if (gather_start >= 0) h.segments.push_back({gather_start, W, -1});
+}
+
+// Depth / id test of the four taps, the renormalised weights and hit flag for pixels [X0, X1) (second step of
+// history_row_impl). e0..e3 hold the bilinear weights already zeroed for taps outside the image; kAligned:
+// the taps are base + X (+1, +W, +W+1), loaded contiguously; otherwise gathered through q.
+template <bool kIds, bool kAligned>
+inline void history_test(const float* __restrict zr, const std::uint32_t* __restrict idr, const float* __restrict pz,
+                         const std::uint32_t* __restrict pid, float tol, int W, int X0, int X1, int base,
+                         HistoryRow& h) {
+  const int* __restrict q0 = h.q[0].data();
+  const int* __restrict q1 = h.q[1].data();
+  const int* __restrict q2 = h.q[2].data();
+  const int* __restrict q3 = h.q[3].data();
+  float* __restrict w0 = h.w[0].data();
+  float* __restrict w1 = h.w[1].data();
+  float* __restrict w2 = h.w[2].data();
+  float* __restrict w3 = h.w[3].data();
+  float* __restrict hit = h.hit.data();
+  auto same = [=](float z, float zp) { return std::abs(z - zp) <= tol * (z > zp ? z : zp); };
+#pragma GCC ivdep
+  for (int X = X0; X < X1; ++X) {
+    const int a = kAligned ? base + X : q0[X], b = kAligned ? base + X + 1 : q1[X];
+    const int c = kAligned ? base + X + W : q2[X], d = kAligned ? base + X + W + 1 : q3[X];
+    const float z = zr[X];
+    bool ok0 = same(z, pz[a]);
+    bool ok1 = same(z, pz[b]);
+    bool ok2 = same(z, pz[c]);
+    bool ok3 = same(z, pz[d]);
+    if constexpr (kIds) {
+      const std::uint32_t id = idr[X];
+      ok0 = ok0 & (pid[a] == id);
+      ok1 = ok1 & (pid[b] == id);
+      ok2 = ok2 & (pid[c] == id);
+      ok3 = ok3 & (pid[d] == id);
+    }
+    const float e0 = ok0 ? w0[X] : 0.0f, e1 = ok1 ? w1[X] : 0.0f;
+    const float e2 = ok2 ? w2[X] : 0.0f, e3 = ok3 ? w3[X] : 0.0f;
+    const float sum = e0 + e1 + e2 + e3;
+    const float inv = sum >= 1e-3f ? 1.0f / sum : 0.0f;
+    w0[X] = e0 * inv;
+    w1[X] = e1 * inv;
+    w2[X] = e2 * inv;
+    w3[X] = e3 * inv;
+    hit[X] = inv > 0.0f ? 1.0f : 0.0f;
+  }
+}
+
+// Two steps: (1) per pixel, the tap indices, the bilinear weights of the taps inside the image and the run
+// structure, without touching the previous frame (vectorises, no gathers); (2) per segment, the depth / id
+// tests against the previous frame, with contiguous loads where the taps are aligned (most of a typical
+// frame) and gathers elsewhere. Same values as testing everything in one gathered loop.
 template <bool kIds>
 inline void history_row_impl(const Upsampler::State& s, const FrameContext& f, const Options& o, int Y,
                              HistoryRow& h) {
@@ -130,11 +223,6 @@ inline void history_row_impl(const Upsampler::State& s, const FrameContext& f, c
   const std::size_t row = std::size_t(Y) * W;
   const float* __restrict mxr = f.mx + row;
   const float* __restrict myr = f.my + row;
-  const float* __restrict zr = f.z + row;
-  const float* __restrict pz = s.prev_z.data();
-  const std::uint32_t* __restrict idr = kIds ? f.id + row : nullptr;
-  const std::uint32_t* __restrict pid = kIds ? s.prev_id.data() : nullptr;
-  const float tol = o.depth_tolerance;
   int* __restrict q0 = h.q[0].data();
   int* __restrict q1 = h.q[1].data();
   int* __restrict q2 = h.q[2].data();
@@ -143,10 +231,10 @@ inline void history_row_impl(const Upsampler::State& s, const FrameContext& f, c
   float* __restrict w1 = h.w[1].data();
   float* __restrict w2 = h.w[2].data();
   float* __restrict w3 = h.w[3].data();
-  float* __restrict hit = h.hit.data();
+  int* __restrict off = h.offset.data();
+  int* __restrict al = h.aligned.data();
   const float fY = float(Y);
-  // Bitwise & instead of && keeps the loop free of branches (it vectorises, with gathers).
-  auto same = [=](float z, float zp) { return std::abs(z - zp) <= tol * (z > zp ? z : zp); };
+  // Bitwise & instead of && keeps the loop free of branches (it vectorises).
 #pragma GCC ivdep
   for (int X = 0; X < W; ++X) {
     float mx = mxr[X], my = myr[X];
@@ -162,31 +250,27 @@ inline void history_row_impl(const Upsampler::State& s, const FrameContext& f, c
     const int cx0 = std::clamp(x0, 0, W - 1), cx1 = std::clamp(x0 + 1, 0, W - 1);
     const int cy0 = std::clamp(y0, 0, H - 1), cy1 = std::clamp(y0 + 1, 0, H - 1);
     const int a = cy0 * W + cx0, b = cy0 * W + cx1, c = cy1 * W + cx0, d = cy1 * W + cx1;
-    const float z = zr[X];
-    bool ok0 = finite & ix0 & iy0 & same(z, pz[a]);
-    bool ok1 = finite & ix1 & iy0 & same(z, pz[b]);
-    bool ok2 = finite & ix0 & iy1 & same(z, pz[c]);
-    bool ok3 = finite & ix1 & iy1 & same(z, pz[d]);
-    if constexpr (kIds) {
-      const std::uint32_t id = idr[X];
-      ok0 = ok0 & (pid[a] == id);
-      ok1 = ok1 & (pid[b] == id);
-      ok2 = ok2 & (pid[c] == id);
-      ok3 = ok3 & (pid[d] == id);
-    }
-    const float e0 = ok0 ? (1 - ax) * (1 - ay) : 0.0f, e1 = ok1 ? ax * (1 - ay) : 0.0f;
-    const float e2 = ok2 ? (1 - ax) * ay : 0.0f, e3 = ok3 ? ax * ay : 0.0f;
-    const float sum = e0 + e1 + e2 + e3;
-    const float inv = sum >= 1e-3f ? 1.0f / sum : 0.0f;
     q0[X] = a;
     q1[X] = b;
     q2[X] = c;
     q3[X] = d;
-    w0[X] = e0 * inv;
-    w1[X] = e1 * inv;
-    w2[X] = e2 * inv;
-    w3[X] = e3 * inv;
-    hit[X] = inv > 0.0f ? 1.0f : 0.0f;
+    w0[X] = (finite & ix0 & iy0) ? (1 - ax) * (1 - ay) : 0.0f;
+    w1[X] = (finite & ix1 & iy0) ? ax * (1 - ay) : 0.0f;
+    w2[X] = (finite & ix0 & iy1) ? (1 - ax) * ay : 0.0f;
+    w3[X] = (finite & ix1 & iy1) ? ax * ay : 0.0f;
+    off[X] = a - X;
+    al[X] = int(b == a + 1) & int(c == a + W) & int(d == c + 1);
+  }
+  build_segments(h, W);
+  const float* zr = f.z + row;
+  const float* pz = s.prev_z.data();
+  const std::uint32_t* idr = kIds ? f.id + row : nullptr;
+  const std::uint32_t* pid = kIds ? s.prev_id.data() : nullptr;
+  for (const auto& sg : h.segments) {
+    if (sg.base >= 0)
+      history_test<kIds, true>(zr, idr, pz, pid, o.depth_tolerance, W, sg.x0, sg.x1, sg.base, h);
+    else
+      history_test<kIds, false>(zr, idr, pz, pid, o.depth_tolerance, W, sg.x0, sg.x1, 0, h);
   }
 }
 
@@ -198,30 +282,10 @@ inline void history_row(const Upsampler::State& s, const FrameContext& f, const 
     history_row_impl<false>(s, f, o, Y, h);
 }
 
-// Segments [X0, X1) of a HistoryRow whose taps are the image-aligned 2x2 block at a constant offset from
-// X (q0 = base + X, q1 = q0 + 1, q2 = q0 + W, q3 = q2 + 1): where the motion is locally constant (camera pans,
-// static regions) the taps can be read with contiguous vector loads instead of gathers.
+// The segments of a HistoryRow (see HistoryRow::segments): f(X0, X1, contiguous, base).
 template <typename F>
-inline void for_each_segment(const HistoryRow& h, int W, F&& f) {
-  const int* q0 = h.q[0].data();
-  const int* q1 = h.q[1].data();
-  const int* q2 = h.q[2].data();
-  const int* q3 = h.q[3].data();
-  int X = 0;
-  while (X < W) {
-    const int base = q0[X] - X;
-    int E = X;
-    while (E < W && q0[E] - E == base && q1[E] == q0[E] + 1 && q2[E] == q0[E] + W && q3[E] == q2[E] + 1) ++E;
-    if (E - X >= 16) {
-      f(X, E, true, base);
-      X = E;
-    } else {
-      // A short run (or a pixel whose taps are clamped at the border): gather until the next long run.
-      int G = std::max(E, X + 1);
-      f(X, G, false, 0);
-      X = G;
-    }
-  }
+inline void for_each_segment(const HistoryRow& h, int /*W*/, F&& f) {
+  for (const auto& sg : h.segments) f(sg.x0, sg.x1, sg.base >= 0, sg.base >= 0 ? sg.base : 0);
 }
 
 // The four-tap gather of up to 4 previous-frame planes with the weights of a HistoryRow, in one pass (the
@@ -269,6 +333,85 @@ inline void gather_history(const HistoryRow& h, const float* prev, float* out, i
   for (int X = 0; X < W; ++X) out[X] = w0[X] * prev[q0[X]] + w1[X] * prev[q1[X]] + w2[X] * prev[q2[X]] + w3[X] * prev[q3[X]];
 }
 
+// The geometry (z, N, validity) and payload of one low-resolution row, expanded to full-resolution columns:
+// plane q (0..4: z, nx, ny, nz, valid; 5 + c: payload channel c) holds W + k values, value[low_row + ext[X]]
+// with ext[X] = clamp(floor((X - sx) / k), 0, lw - 1) (W = k lw). Tap i0 of column X is entry X and tap
+// i1 (x0 + 1) is entry X + k, so one expansion serves both. A run of k full-resolution rows reads the same
+// two low rows: expanding them once turns the per-pixel gathers of the kernel loops into unit-stride loads.
+// Two slots: the rows r0, r1 of the current full row; a band walking down reuses r1 as the next r0.
+class ExpandedLowRows {
+ public:
+  // Forget the cached rows (the low-resolution data changes every frame: call at the start of each band).
+  void reset(int W, int k, int sx, int C) {
+    WE_ = W + k;
+    k_ = k;
+    sx_ = sx;
+    planes_ = 5 + C;
+    for (auto& sl : slot_) {
+      sl.key = -1;
+      sl.v.resize(std::size_t(planes_) * WE_);
+    }
+  }
+  std::size_t stride() const { return std::size_t(WE_); }
+  // Slot pointers for the low rows starting at offsets r0 and r1 (row * lw), filled when not cached.
+  void get(const Upsampler::State& s, const FrameContext& f, int r0, int r1, const float*& p0, const float*& p1) {
+    int a = find(r0);
+    if (a < 0) {
+      a = slot_[0].key == r1 ? 1 : 0;
+      fill(s, f, r0, slot_[a]);
+    }
+    int b = find(r1);
+    if (b < 0) {
+      b = 1 - a;
+      fill(s, f, r1, slot_[b]);
+    }
+    p0 = slot_[a].v.data();
+    p1 = slot_[b].v.data();
+  }
+
+ private:
+  struct Slot {
+    int key = -1;
+    std::vector<float> v;
+  };
+  int find(int r) const { return slot_[0].key == r ? 0 : (slot_[1].key == r ? 1 : -1); }
+  void fill(const Upsampler::State& s, const FrameContext& f, int r, Slot& sl) {
+    const float* src[5 + 16] = {s.lz.data() + r, s.lnx.data() + r, s.lny.data() + r, s.lnz.data() + r,
+                                s.lvalid.data() + r};
+    for (int c = 0; c < f.C; ++c) src[5 + c] = f.low[c] + r;
+    for (int q = 0; q < planes_; ++q) expand(src[q], sl.v.data() + std::size_t(q) * WE_, f.lw);
+    sl.key = r;
+  }
+  // out[X] = in[clamp(floor((X - sx) / k), 0, lw - 1)] for X in [0, W + k): each sample repeated k times
+  // (stores only; a gather per entry is several times slower). k = 2 and 4 get loops the compiler vectorises.
+  [[gnu::noinline]] void expand(const float* __restrict in, float* __restrict out, int lw) const {
+    const int k = k_, sx = sx_;
+    for (int X = 0; X < sx; ++X) out[X] = in[0];
+    float* __restrict o = out + sx;
+    if (k == 4) {
+      for (int x = 0; x < lw; ++x) {
+        const float v = in[x];
+        o[4 * x] = v;
+        o[4 * x + 1] = v;
+        o[4 * x + 2] = v;
+        o[4 * x + 3] = v;
+      }
+    } else if (k == 2) {
+      for (int x = 0; x < lw; ++x) {
+        const float v = in[x];
+        o[2 * x] = v;
+        o[2 * x + 1] = v;
+      }
+    } else {
+      for (int x = 0; x < lw; ++x)
+        for (int i = 0; i < k; ++i) o[k * x + i] = in[x];
+    }
+    for (int X = sx + k * lw; X < WE_; ++X) out[X] = in[lw - 1];
+  }
+  int WE_ = 0, planes_ = 0, k_ = 1, sx_ = 0;
+  Slot slot_[2];
+};
+
 // Per-method implementations (one .cpp each). Each fills s.result[s.cur] and stats.
 void gather_low_geometry(Upsampler::State& s, const FrameContext& f);
 void run_spatial(Upsampler::State& s, const FrameContext& f, const Options& o, FrameStats& stats);
@@ -276,10 +419,10 @@ void run_temporal(Upsampler::State& s, const FrameContext& f, const Options& o, 
 void run_herzog(Upsampler::State& s, const FrameContext& f, const Options& o, FrameStats& stats);
 void run_drobot(Upsampler::State& s, const FrameContext& f, const Options& o, FrameStats& stats);
 
-// Joint-bilateral upsampling (eq. 1-3, hat kernel) of full-resolution row Y into out[c][0 .. W); `wsum`
-// (row of W values) receives the sum of weights when not null. Shared by `spatial` and the hole filling of
-// `temporal`.
+// Joint-bilateral upsampling (eq. 1-3, hat kernel) of full-resolution row Y, columns [X0, X1) (X1 < 0: to the
+// end of the row), into out[c][X0 .. X1) (out rows are indexed by X); `wsum` (a row indexed by X) receives the
+// sum of weights when not null. Shared by `spatial` and the hole filling of `temporal` (only the hole runs).
 void spatial_row(const Upsampler::State& s, const FrameContext& f, const Options& o, int Y, float* const* out,
-                 float* wsum);
+                 float* wsum, int X0 = 0, int X1 = -1);
 
 }  // namespace temporal::upsample

@@ -139,7 +139,7 @@ void gather_low_geometry(Upsampler::State& s, const FrameContext& f) {
 }
 
 void spatial_row(const Upsampler::State& s, const FrameContext& f, const Options& o, int Y, float* const* out,
-                 float* wsum) {
+                 float* wsum, int X0, int X1) {
   // Four weights per pixel are computed into thread-local rows first (a loop that vectorises, with gathers),
   // then each channel is accumulated in its own unit-stride loop. Restrict-qualified locals let the
   // compiler vectorise without alias checks.
@@ -150,6 +150,7 @@ void spatial_row(const Upsampler::State& s, const FrameContext& f, const Options
   float* __restrict w10 = w01 + f.W;
   float* __restrict w11 = w10 + f.W;
   const int W = f.W, k = f.grid.k;
+  if (X1 < 0) X1 = W;
   const int r0 = s.rows.i0[Y] * f.lw, r1 = s.rows.i1[Y] * f.lw;
   const float vy0 = s.rows.v0[Y], vy1 = s.rows.v1[Y];
   const float fy = float(s.rows.d[Y]) / float(k), inv_k = 1.0f / float(k);
@@ -179,7 +180,7 @@ void spatial_row(const Upsampler::State& s, const FrameContext& f, const Options
     return w >= 0.0f ? w : 0.0f;  // NaN geometry at the pixel gives no weight
   };
 #pragma GCC ivdep
-  for (int X = 0; X < W; ++X) {
+  for (int X = X0; X < X1; ++X) {
     const float fx = float(cd[X]) * inv_k;
     const float zi = z[X], ax = nx[X], ay = ny[X], az = nz[X];
     w00[X] = geo(r0 + ci0[X], zi, ax, ay, az) * (1 - fx) * (1 - fy) * cv0[X] * vy0;
@@ -192,7 +193,7 @@ void spatial_row(const Upsampler::State& s, const FrameContext& f, const Options
     const float* __restrict l1 = f.low[c] + r1;
     float* __restrict o_ = out[c];
 #pragma GCC ivdep
-    for (int X = 0; X < W; ++X) {
+    for (int X = X0; X < X1; ++X) {
       const float ws = w00[X] + w01[X] + w10[X] + w11[X];
       // Invalid samples carry weight 0, and their value is replaced by 0 so that a NaN never propagates.
       // Unconditional loads (clamped indices, always valid) and a select: conditional loads would need
@@ -205,7 +206,7 @@ void spatial_row(const Upsampler::State& s, const FrameContext& f, const Options
     }
   }
   if (wsum)
-    for (int X = 0; X < W; ++X) wsum[X] = w00[X] + w01[X] + w10[X] + w11[X];
+    for (int X = X0; X < X1; ++X) wsum[X] = w00[X] + w01[X] + w10[X] + w11[X];
 }
 
 Upsampler::Upsampler(Options options) : options_(std::move(options)), state_(std::make_unique<State>()) {}

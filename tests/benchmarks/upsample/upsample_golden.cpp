@@ -1,6 +1,6 @@
-// Regression helper for optimisation work (not a test): runs every upsampling method on two synthetic
-// sequences (the benchmark's 1280x1024 pan, and a small scene with a moving object and per-frame G-buffers,
-// debug layers on) and writes every output float to FILE (`write FILE`), or compares against FILE
+// Regression helper for optimisation work (not a test): runs every upsampling method on synthetic sequences
+// (the benchmark's 1280x1024 pan; small scenes with a moving object and per-frame G-buffers, debug layers on,
+// k = 4, 3 (odd width) and 2 (gradient scale 4)) and writes every output float to FILE (`write FILE`), or compares against FILE
 // (`check FILE`), printing the largest absolute and relative differences per method.
 #include "synthetic.h"
 
@@ -75,6 +75,21 @@ int main(int argc, char** argv) {
   std::vector<temporal::test::SyntheticFrame> fb;
   for (int t = 1; t <= 24; ++t) fb.push_back(temporal::test::make_frame(b, t));
 
+  // Scenes C and D: other factors, an odd width, another gradient scale and an integer mip level.
+  temporal::test::SyntheticScene k3 = b;
+  k3.width = 99;
+  k3.height = 75;
+  k3.k = 3;
+  temporal::test::SyntheticScene k2 = b;
+  k2.width = 128;
+  k2.height = 96;
+  k2.k = 2;
+  std::vector<temporal::test::SyntheticFrame> fc, fd;
+  for (int t = 1; t <= 12; ++t) {
+    fc.push_back(temporal::test::make_frame(k3, t));
+    fd.push_back(temporal::test::make_frame(k2, t));
+  }
+
   std::vector<std::vector<float>> results(6);
   for (int m = 0; m < 6; ++m) {
     {
@@ -91,6 +106,21 @@ int main(int argc, char** argv) {
       up::Upsampler u(o);
       for (int i = 0; i < 24; ++i) {
         auto r = u.process(fb[i].gbuffer, fb[i].low, kRGB, false);
+        if (!r) return 2;
+        append(results[m], **r);
+      }
+    }
+    for (int scene = 0; scene < 2; ++scene) {
+      up::Options o = options(m);
+      o.debug_layers = true;
+      if (scene == 1) {
+        o.gradient_scale = 4;
+        o.gradient_mip_level = 3.0f;
+      }
+      up::Upsampler u(o);
+      const auto& frames = scene == 0 ? fc : fd;
+      for (const auto& fr : frames) {
+        auto r = u.process(fr.gbuffer, fr.low, kRGB, false);
         if (!r) return 2;
         append(results[m], **r);
       }
