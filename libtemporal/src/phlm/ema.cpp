@@ -10,19 +10,11 @@
 #include <cmath>
 
 namespace temporal {
-namespace {
-const char* suffix(int channels, int c) {
-  static constexpr const char* kRgb[3] = {"R", "G", "B"};
-  return channels == 3 ? kRgb[c] : "Y";
-}
-}  // namespace
 
 EmaFilter::EmaFilter(EmaParams params) : params_(params) {}
 
 std::vector<std::string> EmaFilter::state_channel_names(int channels) {
-  std::vector<std::string> names;
-  for (int c = 0; c < channels; ++c) names.push_back("history." + std::string(suffix(channels, c)));
-  return names;
+  return detail::history_channel_names(channels);
 }
 
 Status EmaFilter::process(const FilterInput& in, Image& output, FilterStats* stats) {
@@ -32,12 +24,7 @@ Status EmaFilter::process(const FilterInput& in, Image& output, FilterStats* sta
   const bool same = have_state_ && channels == channels_ && history_.width() == w && history_.height() == h;
   if (!same) {
     channels_ = channels;
-    history_ = Image(w, h);
-    next_ = Image(w, h);
-    for (const auto& n : state_channel_names(channels)) {
-      history_.add_channel(n);
-      next_.add_channel(n);
-    }
+    detail::allocate_history(history_, next_, channels, w, h);
   }
   // The previous G-buffer planes are part of the state (so --state-in resumes the rejection too).
   if (in.depth) next_.add_channel("history.depth");

@@ -56,5 +56,25 @@ void prepare_output(const FilterInput& in, Image& output, float* out[3]) {
   output.metadata() = img.metadata();
 }
 
+const char* channel_suffix(int channels, int c) {
+  static constexpr const char* kRgb[3] = {"R", "G", "B"};
+  return channels == 3 ? kRgb[c] : "Y";
+}
+
+std::vector<std::string> history_channel_names(int channels) {
+  std::vector<std::string> names;
+  for (int c = 0; c < channels; ++c) names.push_back("history." + std::string(channel_suffix(channels, c)));
+  return names;
+}
+
+void allocate_history(Image& history, Image& next, int channels, int width, int height) {
+  history = Image(width, height);
+  next = Image(width, height);
+  for (const auto& n : history_channel_names(channels)) {
+    history.add_channel(n);
+    next.add_channel(n);
+  }
+}
+
 }  // namespace detail
 }  // namespace temporal

@@ -4,6 +4,7 @@
 #include "temporal/frame_filter.h"
 
 #include <cstdint>
+#include <string>
 #include <vector>
 
 namespace temporal::detail {
@@ -17,4 +18,13 @@ std::size_t prepare_frame(const FilterInput& in, bool want_ycgco, std::vector<fl
 // Sizes `output` like the input (reusing its planes when it already matches), adds the filtered channels
 // with the input's names and returns their planes in `out`.
 void prepare_output(const FilterInput& in, Image& output, float* out[3]);
+
+// Suffix of channel c in state and debug layer names: R, G, B for three channels, Y for one.
+const char* channel_suffix(int channels, int c);
+
+// `history.R/G/B` (or `history.Y`): the state planes of the single-history filters (TAA, EMA).
+std::vector<std::string> history_channel_names(int channels);
+
+// Makes `history` and `next` width x height images holding the history planes of `channels` channels.
+void allocate_history(Image& history, Image& next, int channels, int width, int height);
 }  // namespace temporal::detail

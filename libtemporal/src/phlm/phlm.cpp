@@ -355,10 +355,6 @@ void run_phlm(const FilterInput& in, const PhlmParams& params, bool have_prev, c
   std::memcpy(&max_trace, &bits, sizeof max_trace);
 }
 
-const char* channel_suffix(int channels, int c) {
-  static constexpr const char* kRgb[3] = {"R", "G", "B"};
-  return channels == 3 ? kRgb[c] : "Y";
-}
 
 }  // namespace
 
@@ -368,11 +364,11 @@ std::vector<std::string> PhlmFilter::state_channel_names(int channels) {
   const int n = channels + 1;
   std::vector<std::string> names;
   for (int c = 0; c < channels; ++c)
-    for (int k = 0; k < n; ++k) names.push_back("beta." + std::string(channel_suffix(channels, c)) + std::to_string(k));
+    for (int k = 0; k < n; ++k) names.push_back("beta." + std::string(detail::channel_suffix(channels, c)) + std::to_string(k));
   for (int k = 0; k < n; ++k) names.push_back("P.D" + std::to_string(k));
   for (int i = 0; i < n; ++i)
     for (int j = i + 1; j < n; ++j) names.push_back("P.U" + std::to_string(i) + std::to_string(j));
-  for (int c = 0; c < channels; ++c) names.push_back("feature." + std::string(channel_suffix(channels, c)));
+  for (int c = 0; c < channels; ++c) names.push_back("feature." + std::string(detail::channel_suffix(channels, c)));
   names.push_back("scale.s");
   return names;
 }
@@ -408,7 +404,7 @@ Status PhlmFilter::process(const FilterInput& in, Image& output, FilterStats* st
     dbg[1] = output.add_channel("debug.reset");
     dbg[2] = output.add_channel("debug.traceP");
     for (int c = 0; c < channels; ++c)
-      dbg[3 + c] = output.add_channel(channels == 3 ? "debug.feature" + std::string(channel_suffix(3, c))
+      dbg[3 + c] = output.add_channel(channels == 3 ? "debug.feature" + std::string(detail::channel_suffix(3, c))
                                                     : std::string("debug.feature"));
   }
 

@@ -19,10 +19,6 @@ namespace {
 inline float min_(float a, float b) { return b < a ? b : a; }
 inline float max_(float a, float b) { return a < b ? b : a; }
 
-const char* suffix(int channels, int c) {
-  static constexpr const char* kRgb[3] = {"R", "G", "B"};
-  return channels == 3 ? kRgb[c] : "Y";
-}
 
 template <int C>
 inline void to_box(const float* v, float* b) {
@@ -144,9 +140,7 @@ void run_taa(const FilterInput& in, const TaaParams& params, bool have_history, 
 TaaFilter::TaaFilter(TaaParams params) : params_(params) {}
 
 std::vector<std::string> TaaFilter::state_channel_names(int channels) {
-  std::vector<std::string> names;
-  for (int c = 0; c < channels; ++c) names.push_back("history." + std::string(suffix(channels, c)));
-  return names;
+  return detail::history_channel_names(channels);
 }
 
 Status TaaFilter::process(const FilterInput& in, Image& output, FilterStats* stats) {
@@ -156,12 +150,7 @@ Status TaaFilter::process(const FilterInput& in, Image& output, FilterStats* sta
   const bool same = have_state_ && channels == channels_ && history_.width() == w && history_.height() == h;
   if (!same) {
     channels_ = channels;
-    history_ = Image(w, h);
-    next_ = Image(w, h);
-    for (const auto& n : state_channel_names(channels)) {
-      history_.add_channel(n);
-      next_.add_channel(n);
-    }
+    detail::allocate_history(history_, next_, channels, w, h);
   }
   const std::size_t non_finite = detail::prepare_frame(in, channels == 3, ycgco_, valid_);
   float* out[3] = {};
