@@ -99,21 +99,12 @@ Status EmaFilter::process(const FilterInput& in, Image& output, FilterStats* sta
 }
 
 Status EmaFilter::set_state(const Image& state, int channels) {
-  if (channels != 1 && channels != 3) return Error::usage("ema state: the layer must have 1 or 3 channels");
-  Image copy(state.width(), state.height()), next(state.width(), state.height());
-  for (const auto& n : state_channel_names(channels)) {
-    const float* src = state.plane(n);
-    if (!src) return Error::input({}, "state has no channel '" + n + "': write it with `filter-phlm --method ema --state-out`");
-    if (count_non_finite({src, state.pixel_count()}) != 0)
-      return Error::input({}, "state channel '" + n + "' holds NaN or Inf values");
-    std::copy(src, src + state.pixel_count(), copy.add_channel(n));
-    next.add_channel(n);
-  }
-  if (const float* d = state.plane("history.depth")) std::copy(d, d + state.pixel_count(), copy.add_channel("history.depth"));
+  if (Status s = detail::load_history(state, channels, "ema", history_, next_); !s) return s;
+  // The previous G-buffer planes travel with the state (so a resumed run rejects history the same way).
+  if (const float* d = state.plane("history.depth"))
+    std::copy(d, d + state.pixel_count(), history_.add_channel("history.depth"));
   if (const std::uint32_t* id = state.uint_plane("history.id"))
-    std::copy(id, id + state.pixel_count(), copy.add_uint_channel("history.id"));
-  history_ = std::move(copy);
-  next_ = std::move(next);
+    std::copy(id, id + state.pixel_count(), history_.add_uint_channel("history.id"));
   channels_ = channels;
   have_state_ = true;
   return Status::ok();

@@ -3,6 +3,7 @@
 #include "temporal/color.h"
 #include "temporal/parallel.h"
 
+#include <algorithm>
 #include <atomic>
 #include <cmath>
 
@@ -74,6 +75,25 @@ void allocate_history(Image& history, Image& next, int channels, int width, int 
     history.add_channel(n);
     next.add_channel(n);
   }
+}
+
+Status load_history(const Image& state, int channels, const char* method, Image& history, Image& next) {
+  if (channels != 1 && channels != 3)
+    return Error::usage(std::string(method) + " state: the layer must have 1 or 3 channels");
+  Image copy(state.width(), state.height()), fresh(state.width(), state.height());
+  for (const auto& n : history_channel_names(channels)) {
+    const float* src = state.plane(n);
+    if (!src)
+      return Error::input({}, "state has no channel '" + n + "': write it with `filter-phlm --method " + method +
+                                  " --state-out`");
+    if (count_non_finite({src, state.pixel_count()}) != 0)
+      return Error::input({}, "state channel '" + n + "' holds NaN or Inf values");
+    std::copy(src, src + state.pixel_count(), copy.add_channel(n));
+    fresh.add_channel(n);
+  }
+  history = std::move(copy);
+  next = std::move(fresh);
+  return {};
 }
 
 }  // namespace detail

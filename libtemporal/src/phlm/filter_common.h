@@ -27,4 +27,8 @@ std::vector<std::string> history_channel_names(int channels);
 
 // Makes `history` and `next` width x height images holding the history planes of `channels` channels.
 void allocate_history(Image& history, Image& next, int channels, int width, int height);
+
+// Loads the history planes of a state image written by `--state-out` into `history` (and sizes `next` to
+// match), refusing a missing or non-finite plane. `method` names the method in the messages.
+Status load_history(const Image& state, int channels, const char* method, Image& history, Image& next);
 }  // namespace temporal::detail

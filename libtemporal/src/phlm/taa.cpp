@@ -183,18 +183,7 @@ Status TaaFilter::process(const FilterInput& in, Image& output, FilterStats* sta
 }
 
 Status TaaFilter::set_state(const Image& state, int channels) {
-  if (channels != 1 && channels != 3) return Error::usage("taa state: the layer must have 1 or 3 channels");
-  Image copy(state.width(), state.height()), next(state.width(), state.height());
-  for (const auto& n : state_channel_names(channels)) {
-    const float* src = state.plane(n);
-    if (!src) return Error::input({}, "state has no channel '" + n + "': write it with `filter-phlm --method taa --state-out`");
-    if (count_non_finite({src, state.pixel_count()}) != 0)
-      return Error::input({}, "state channel '" + n + "' holds NaN or Inf values");
-    std::copy(src, src + state.pixel_count(), copy.add_channel(n));
-    next.add_channel(n);
-  }
-  history_ = std::move(copy);
-  next_ = std::move(next);
+  if (Status s = detail::load_history(state, channels, "taa", history_, next_); !s) return s;
   channels_ = channels;
   have_state_ = true;
   return Status::ok();
