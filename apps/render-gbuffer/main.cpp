@@ -47,6 +47,7 @@ struct Options {
   int vpls = 2000;
   int rsm_size = 128;
   bool no_mipmaps = false;
+  std::string shade_mip_bias = "auto";
   std::uint32_t seed = 0;
   std::string compression = "zip";
 };
@@ -91,6 +92,14 @@ Status run(const tool::Tool& tool, const Options& opt) {
   ro.color_jitter = *color_jitter;
   ro.reference_spp = opt.reference_spp;
   ro.mipmaps = !opt.no_mipmaps;
+  if (opt.shade_mip_bias != "auto") {
+    float bias = 0.0f;
+    char extra = 0;
+    std::istringstream in(opt.shade_mip_bias);
+    if (!(in >> bias) || (in >> extra))
+      return Error::usage("--shade-mip-bias '" + opt.shade_mip_bias + "' is not a number or 'auto'");
+    ro.shade_mip_bias = bias;
+  }
   ro.seed = opt.seed;
   ro.outputs = *outputs;
   ro.payload = *payload;
@@ -230,6 +239,8 @@ int main(int argc, char** argv) {
   app.add_option("--vpls", opt.vpls, "Virtual point lights for gi");
   app.add_option("--rsm-size", opt.rsm_size, "Reflective shadow map texels per side (VPL candidates)");
   app.add_flag("--no-mipmaps", opt.no_mipmaps, "Sample textures without mipmaps (severe undersampling)");
+  app.add_option("--shade-mip-bias", opt.shade_mip_bias,
+                 "Texture LOD bias of the low-res payload; auto: -log2(K), the full-res mip level");
   app.add_option("--seed", opt.seed, "Seed of random jitter, SSAO patterns and VPL sets");
   app.add_option("--compression", opt.compression, "EXR compression: zip|piz|none");
   return tool.run(argc, argv, [&]() { return run(tool, opt); });

@@ -140,6 +140,9 @@ TEST(RenderCli, BadOptionsAreUsageErrors) {
   EXPECT_EQ(test::run_command(tool() + " " + scene + " --out " + dir.string() + " --payload direct,foo", &output), 1)
       << output;
   EXPECT_EQ(test::run_command(tool() + " " + scene + " --out " + dir.string() + " --jitter sobol", &output), 1) << output;
+  EXPECT_EQ(test::run_command(tool() + " " + scene + " --out " + dir.string() + " --shade-mip-bias -2x", &output), 1)
+      << output;
+  EXPECT_NE(output.find("--shade-mip-bias"), std::string::npos) << output;
   EXPECT_EQ(test::run_command(tool() + " " + scene + " --out " + dir.string() + " --frames 0-3 --duration 1", &output), 1)
       << output;
   // An output folder that cannot be created is an output error.

@@ -85,7 +85,9 @@ void check_scene(const fs::path& path, double fps, int frame, SceneLoadOptions l
   EXPECT_GT(all.fraction(), expect.all);
   if (moving.considered >= 100) {
     EXPECT_GT(moving.fraction(), 0.9);
-    if (expect.control) EXPECT_LT(negated.fraction(), moving.fraction() - 0.1);
+    if (expect.control) {
+      EXPECT_LT(negated.fraction(), moving.fraction() - 0.1);
+    }
   }
 }
 

@@ -9,6 +9,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
+#include <optional>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -189,6 +191,55 @@ TEST(RenderJitter, RegularPatternCoversEveryFullResPixelOnce) {
   for (std::size_t i = 0; i < hits.size(); ++i) ASSERT_EQ(hits[i], 1) << "pixel " << i;
   // Triangle edges may rasterise differently by a rounding; everything else is the same sample.
   EXPECT_GT(double(equal) / compared, 0.99) << equal << " of " << compared;
+}
+
+// Mean |low - full| over the low-res samples of k*k frames of the static synthetic scene (direct light only),
+// textures mipmapped: the low-res sample (x, y) against full-res pixel (k x + sx, k y + sy).
+static double mean_sample_difference(std::optional<float> shade_mip_bias) {
+  SyntheticScene scene;
+  RenderOptions o = small_options(64, 48);
+  o.payload = *parse_payload_terms("direct", o.payload);
+  o.outputs = RenderOutputs{false, true, false, true};
+  o.color_jitter = JitterMode::None;
+  o.shade_mip_bias = shade_mip_bias;
+  scene.textures[0].nearest = false;
+  const int k = o.factor;
+  auto r = Renderer::create(o, scene.geometry());
+  EXPECT_TRUE(r) << r.error().message;
+  if (!r) return 1e9;
+  const FrameState state = scene.evaluate(0.0);
+  double sum = 0;
+  std::size_t n = 0;
+  for (int frame = 0; frame < k * k; ++frame) {
+    FrameInput in;
+    in.frame = frame;
+    in.current = &state;
+    auto out = r->render(in);
+    EXPECT_TRUE(out) << out.error().message;
+    if (!out) return 1e9;
+    const Image& low = *out->shade;
+    const Image& full = *out->color;
+    const int sx = frame % k, sy = frame / k;
+    for (int y = 0; y < low.height(); ++y)
+      for (int x = 0; x < low.width(); ++x)
+        for (const char* c : {"R", "G", "B"}) {
+          sum += std::fabs(low.plane(c)[std::size_t(y) * low.width() + x] -
+                           full.plane(c)[std::size_t(k * y + sy) * o.width + k * x + sx]);
+          ++n;
+        }
+  }
+  return sum / double(n);
+}
+
+TEST(RenderJitter, LowResolutionPayloadReadsTexturesAtTheFullResolutionMipLevel) {
+  // With mipmaps, the low-res pass's screen derivatives are k times the full-res ones; the default LOD bias
+  // -log2(k) makes it read the same mip level, so its samples match the full-res pixels (up to llvmpipe's
+  // per-quad LOD); without the bias they are the textures prefiltered for the low resolution (the 8x8 checker
+  // of the synthetic ground blurs towards its mean).
+  const double biased = mean_sample_difference(std::nullopt);
+  const double unbiased = mean_sample_difference(0.0f);
+  EXPECT_LT(biased, 0.004) << "unbiased " << unbiased;
+  EXPECT_GT(unbiased, 5.0 * biased) << "biased " << biased;
 }
 
 TEST(RenderJitter, PatternsAndProjection) {
@@ -435,6 +486,11 @@ TEST(RenderOptionsTest, BadValuesAreUsageErrors) {
   auto r = Renderer::create(o, scene.geometry());
   ASSERT_FALSE(r);
   EXPECT_EQ(r.error().kind, ErrorKind::Usage);
+  o.factor = 4;
+  o.shade_mip_bias = std::numeric_limits<float>::quiet_NaN();
+  EXPECT_FALSE(Renderer::create(o, scene.geometry()));
+  o.shade_mip_bias = 17.0f;
+  EXPECT_FALSE(Renderer::create(o, scene.geometry()));
   EXPECT_FALSE(parse_payload_terms("direct,foo"));
   EXPECT_FALSE(RenderOutputs::parse(""));
   auto p = parse_payload_terms("ssao,gi");

@@ -86,6 +86,12 @@ struct RenderOptions {
   JitterMode color_jitter = JitterMode::Random;
   int reference_spp = 16;              // reference samples per pixel (Halton (2,3) sub-pixel positions)
   bool mipmaps = true;                 // false: textures sampled without mipmaps (seed 003, section 7.2)
+  // Texture LOD bias of the low-resolution payload's G-buffer. Unset: -log2(factor), which makes the
+  // low-resolution pass pick the mip level the full-resolution pass picks, so that each jittered low-res
+  // sample is a full-res pixel's sample (what temporal accumulation needs to converge to the full-res image;
+  // with bias 0 the payload's textures are prefiltered for the low resolution and no upsampler can recover
+  // their detail).
+  std::optional<float> shade_mip_bias;
   std::uint32_t seed = 0;              // decorrelates random jitter, SSAO patterns and VPL sets
   PayloadOptions payload;
   RenderOutputs outputs;

@@ -193,7 +193,7 @@ struct Renderer::Impl {
     float znear = 0.1f, zfar = 100.0f;
   };
   View make_view(const FrameInput& in, int w, int h, glm::vec2 jitter) const;
-  void draw_gbuffer(const Fbo& target, const View& v);
+  void draw_gbuffer(const Fbo& target, const View& v, float lod_bias = 0.0f);
   void shade(const Fbo& gbuffer, const Fbo& target, const View& v, std::uint32_t seed, bool accumulate,
              bool clear);
   void read_rgba(const Fbo& f, int attachment, int components);
@@ -427,7 +427,7 @@ Renderer::Impl::View Renderer::Impl::make_view(const FrameInput& in, int w, int 
   return v;
 }
 
-void Renderer::Impl::draw_gbuffer(const Fbo& target, const View& v) {
+void Renderer::Impl::draw_gbuffer(const Fbo& target, const View& v, float lod_bias) {
   const auto& g = gl();
   g.BindFramebuffer(GL_FRAMEBUFFER, target.fbo);
   g.Viewport(0, 0, target.width, target.height);
@@ -449,6 +449,7 @@ void Renderer::Impl::draw_gbuffer(const Fbo& target, const View& v) {
   g.UniformMatrix4fv(g.GetUniformLocation(prog, "u_prev_vp"), 1, GL_FALSE, glm::value_ptr(v.prev_vp));
   g.UniformMatrix4fv(g.GetUniformLocation(prog, "u_view"), 1, GL_FALSE, glm::value_ptr(v.view));
   g.Uniform2f(g.GetUniformLocation(prog, "u_size"), float(target.width), float(target.height));
+  g.Uniform1f(g.GetUniformLocation(prog, "u_lod_bias"), lod_bias);
   gpu->draw_all(prog, true);
   g.Disable(GL_DEPTH_TEST);
 }
@@ -641,6 +642,8 @@ Status validate(const RenderOptions& options) {
     return Error::usage("--factor " + std::to_string(options.factor) + " must divide the width and height (" +
                         std::to_string(options.width) + "x" + std::to_string(options.height) + ")");
   if (options.reference_spp < 1) return Error::usage("--reference-spp must be at least 1");
+  if (options.shade_mip_bias && !(std::abs(*options.shade_mip_bias) <= 16.0f))
+    return Error::usage("--shade-mip-bias must be a number between -16 and 16 (or 'auto')");
   if (p.pcf_kernel < 1 || p.pcf_kernel > 32) return Error::usage("--pcf must be between 1 and 32");
   if (p.shadow_map_size < 16 || p.shadow_map_size > 8192) return Error::usage("--shadow-map-size must be in 16..8192");
   if (p.ssao_directions < 1 || p.ssao_steps < 1) return Error::usage("--ssao-directions and --ssao-steps must be >= 1");
@@ -703,11 +706,12 @@ Expected<RenderedFrame> Renderer::render(const FrameInput& in) {
   if (out.shade) {
     // The low-resolution payload: a G-buffer rendered at 1/k with this frame's jitter (in low-res pixels,
     // conventions "Jitter"), shaded directly. Its samples are exactly full-res pixel centres for the regular
-    // pattern.
+    // pattern. Textures are read at the full-resolution mip level (LOD bias -log2 k by default, RenderOptions).
     const glm::vec2 jitter = frame_jitter(o.shade_jitter, in.frame, k, o.seed);
     const Impl::View low = im.make_view(in, w / k, h / k, jitter);
+    const float lod_bias = o.shade_mip_bias ? *o.shade_mip_bias : -std::log2(float(k));
     const auto t0 = Clock::now();
-    im.draw_gbuffer(im.gbuffer_low, low);
+    im.draw_gbuffer(im.gbuffer_low, low, lod_bias);
     im.shade(im.gbuffer_low, im.shade_low, low, frame_seed, false, true);
     finish();
     result.timings_ms[kPassShadeLow] = ms_since(t0);

@@ -42,6 +42,7 @@ void main() {
   "uniform vec4 u_base_color;\n"                                        \
   "uniform bool u_has_texture;\n"                                       \
   "uniform sampler2D u_texture;\n"                                      \
+  "uniform float u_lod_bias;\n"                                        \
   "uniform bool u_mask;\n"                                              \
   "uniform float u_cutoff;\n"                                           \
   "in vec3 v_world;\n"                                                  \
@@ -52,7 +53,7 @@ void main() {
   "in float v_view_depth;\n"                                            \
   "vec4 base_color() {\n"                                               \
   "  vec4 c = u_base_color;\n"                                          \
-  "  if (u_has_texture) c *= texture(u_texture, v_uv);\n"               \
+  "  if (u_has_texture) c *= texture(u_texture, v_uv, u_lod_bias);\n"   \
   "  if (u_mask && c.a < u_cutoff) discard;\n"                          \
   "  return c;\n"                                                       \
   "}\n"                                                                 \
