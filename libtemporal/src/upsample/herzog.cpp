@@ -1,7 +1,7 @@
 // `herzog`: spatio-temporal upsampling, seed 000 sections 3.3-3.5.
 //
-// Per frame, three passes:
-//  A (full resolution, bands of gradient rows): spatial estimate h~ and its weight w~ (eq. 6) with the
+// Per frame, three passes (run row by row in one sweep, see "schedule" in run_herzog):
+//  A (full resolution): spatial estimate h~ and its weight w~ (eq. 6) with the
 //    image kernel k = g(|x(i) - x(j)|, r, min(gamma w_f, 4)) (section 3.3/3.5); motion-compensated fetch
 //    of the history h_r, h_w (reprojection.h); relative temporal gradient of the payload's luminance
 //    (section 3.5.1), set to its maximum where the history is disoccluded (Figure 6), averaged into the
@@ -10,6 +10,9 @@
 //    previous gradients motion-compensated; spatial low-pass by a box pyramid sampled trilinearly at
 //    level 2.5 (the paper's mip level, counted at full resolution); w_f = a (1 - |grad|)^2 (eq. 8).
 //  C (full resolution): eq. 7 blend and the bounded history update h_w := min(w~ + w_f h_w, max).
+// Several loops pin their floating-point roundings (functions compiled with fp-contract=off and explicit
+// std::fma): GCC fuses a * b + c depending on the surrounding code, and these loops must give the same bits
+// wherever they are inlined (upsample_golden checks every output against a stored run).
 //
 // The kernel's fall-off needs w_f before h~ exists, and w_f needs h~ (the paper approximates h(i, t) by h~);
 // we break the cycle by shaping the kernel with the previous frame's w_f at the motion-compensated position
@@ -51,6 +54,139 @@ void blend_row(int W, int C, const float* __restrict wf, const float* __restrict
   }
 }
 
+// Per-thread buffers (one chunk of rows at a time, see run_herzog): pass A's rows, the history taps, the cached
+// low rows, the ring of pass A results that pass C reads a few rows later, and the rows of the w_f low-pass.
+struct ChunkScratch {
+  std::vector<float> w4, ekern, wfkrow, ycur, yprev, grad, rowbuf, histw, ring, wf_row, lev;
+  HistoryRow hist;
+  HistoryRow bseg;  // pass B: the runs of cells whose previous gradients are contiguous
+  ExpandedLowRows low_rows;
+  int wf_row_of = -1;  // the intermediate row wf_row was expanded from (shared by gs full rows)
+};
+// One per thread, shared by both phases (the ring is a few hundred KiB: allocated once).
+ChunkScratch& chunk_scratch() {
+  thread_local ChunkScratch ts;
+  return ts;
+}
+// Intermediate rows per chunk of the row schedule (rounded up to the pyramid's alignment). Longer chunks leave
+// fewer boundary rows (finished in a second phase from full planes) but balance worse over the threads. With
+// the default mip level 2.5 a chunk has 2 boundary rows at each inner edge (28 of 512 rows at 1280x1024);
+// 32, 64 and 128 measured the same within noise.
+constexpr int kChunkRows = 64;
+
+// Where pass A leaves its per-pixel results of one full row for pass C: w~, w~' (sharp kernel), h_w(i(t-1)),
+// h_r(i(t-1)) per channel.
+struct RowScratch {
+  float* wt;
+  float* wc;
+  float* hwf;
+  float* hr[16];
+};
+
+// Pass B for intermediate row gy: the temporal filter |(0.4, 0.3, 0.2, 0.1) . (g_t .. g_t-3)| (section 3.5.1)
+// with the three previous gradients fetched at the motion-compensated cell centre (nearest); the shifted
+// gradients go to cur3[0..2] and the filtered one to gf. First the index q of every cell's previous gradients
+// (0 where outside: an unconditional load), then the filter in runs like HistoryRow's: where q - gx is
+// constant over 16 cells or more (a pan, a still region) the previous gradients are read with contiguous
+// loads instead of three gathers per cell. Same values either way.
+// Compiled without FMA contraction: GCC fuses a * b + c depending on the surrounding code, so the same source
+// would round differently in the two loops. Without it, every product of filtered_gradient is rounded before
+// the sum, as in the single gathered loop this replaces (whose selects became masked multiplies, not fused).
+[[gnu::noinline, gnu::optimize("fp-contract=off")]] void temporal_filter_row(
+    int gy, int W, int H, int gs, int GW, int GH, bool history, const float* mx, const float* my,
+    const float* __restrict dcur, const float* __restrict dcnt, const float* const* prev3, float* const* cur3,
+    float* __restrict gf, HistoryRow& seg) {
+  const float* __restrict p0 = prev3[0];
+  const float* __restrict p1 = prev3[1];
+  const float* __restrict p2 = prev3[2];
+  float* __restrict c0 = cur3[0];
+  float* __restrict c1 = cur3[1];
+  float* __restrict c2 = cur3[2];
+  const float fgs = float(gs), fGW = float(GW), fGH = float(GH);
+  // The motion at the cell's centre pixel (row cy, every gs-th column) moves the three previous gradients.
+  const int cy = std::min(H - 1, gy * gs + gs / 2);
+  const float* __restrict mxr = mx + std::size_t(cy) * W;
+  const float* __restrict myr = my + std::size_t(cy) * W;
+  const float fcy = float(cy) + 0.5f;
+  seg.offset.resize(GW);
+  seg.aligned.resize(GW);
+  seg.q[0].resize(GW);
+  int* __restrict qv = seg.q[0].data();
+  int* __restrict off = seg.offset.data();
+  int* __restrict al = seg.aligned.data();
+  auto index = [&](int gx, int cx, float mxv, float myv) {
+    const float px = (float(cx) + 0.5f + mxv) / fgs, py = (fcy + myv) / fgs;
+    const bool in = history & (px >= 0) & (py >= 0) & (px < fGW) & (py < fGH);  // false for NaN
+    const int q = in ? int(py) * GW + int(px) : 0;
+    qv[gx] = q;
+    off[gx] = q - gx;
+    al[gx] = int(in);
+  };
+  if (gs == 2 && W % 2 == 0) {  // the default: cx = 2 gx + 1 < W, stride-2 loads instead of two gathers
+#pragma GCC ivdep
+    for (int gx = 0; gx < GW; ++gx) index(gx, 2 * gx + 1, mxr[2 * gx + 1], myr[2 * gx + 1]);
+  } else {
+#pragma GCC ivdep
+    for (int gx = 0; gx < GW; ++gx) {
+      const int cx = std::min(W - 1, gx * gs + gs / 2);
+      index(gx, cx, mxr[cx], myr[cx]);
+    }
+  }
+  build_segments(seg, GW);
+  for (const auto& sg : seg.segments) {
+    if (sg.base >= 0) {  // every cell of the run is inside: q = base + gx
+      const float* __restrict a0 = p0 + sg.base;
+      const float* __restrict a1 = p1 + sg.base;
+      const float* __restrict a2 = p2 + sg.base;
+#pragma GCC ivdep
+      for (int gx = sg.x0; gx < sg.x1; ++gx) {
+        const float d0 = dcnt[gx] > 0 ? dcur[gx] / dcnt[gx] : kMaxGradient;
+        const float d1 = a0[gx], d2 = a1[gx], d3 = a2[gx];
+        c0[gx] = d0;
+        c1[gx] = d1;
+        c2[gx] = d2;
+        gf[gx] = filtered_gradient(d0, d1, d2, d3);
+      }
+    } else {
+#pragma GCC ivdep
+      for (int gx = sg.x0; gx < sg.x1; ++gx) {
+        const float d0 = dcnt[gx] > 0 ? dcur[gx] / dcnt[gx] : kMaxGradient;
+        const int q = qv[gx];
+        const bool in = al[gx] != 0;
+        const float e1 = p0[q], e2 = p1[q], e3 = p2[q];  // unconditional loads (q is valid), then selects
+        const float d1 = in ? e1 : kMaxGradient, d2 = in ? e2 : kMaxGradient, d3 = in ? e3 : kMaxGradient;
+        c0[gx] = d0;
+        c1[gx] = d1;
+        c2[gx] = d2;
+        gf[gx] = filtered_gradient(d0, d1, d2, d3);
+      }
+    }
+  }
+}
+
+// The trilinear sampling of pass B split into its two bilinear halves, with the roundings of the single loop
+// it replaces (GCC fused it as below; written out with std::fma and compiled without contraction so that no
+// context changes them): each sampled pyramid row resampled once to the GW columns,
+// h[gx] = (1 - ax) r[x0] + ax r[x1], then per intermediate row (1 - ay) h_i0 + ay h_i1. Each pyramid row
+// serves several intermediate rows: half as many gathers as sampling every cell's four texels.
+[[gnu::noinline, gnu::optimize("fp-contract=off")]] void resample_columns(const float* __restrict r,
+                                                                          const int* __restrict x0,
+                                                                          const int* __restrict x1,
+                                                                          const float* __restrict ax, int n,
+                                                                          float* __restrict h) {
+#pragma GCC ivdep
+  for (int gx = 0; gx < n; ++gx) {
+    const float a = ax[gx];
+    h[gx] = std::fma(1 - a, r[x0[gx]], a * r[x1[gx]]);
+  }
+}
+[[gnu::noinline, gnu::optimize("fp-contract=off")]] void lerp_rows(const float* __restrict h0,
+                                                                   const float* __restrict h1, float ay, int n,
+                                                                   float* __restrict out) {
+#pragma GCC ivdep
+  for (int gx = 0; gx < n; ++gx) out[gx] = std::fma(1 - ay, h0[gx], ay * h1[gx]);
+}
+
 }  // namespace
 
 void run_herzog(Upsampler::State& s, const FrameContext& f, const Options& o, FrameStats& stats) {
@@ -64,7 +200,8 @@ void run_herzog(Upsampler::State& s, const FrameContext& f, const Options& o, Fr
   s.GW = GW;
   s.GH = GH;
   for (auto& v : s.hw) v.resize(N, 0.0f);
-  // Three-pass mode keeps pass A's results for pass C; the fused mode (o.lagged_wf) needs only rows.
+  // Three-pass mode keeps pass A's results for pass C (full planes, used only by the chunk-boundary rows; see
+  // the schedule below); the fused mode (o.lagged_wf) needs only rows.
   const bool fused = o.lagged_wf;
   const std::size_t NS = fused ? 0 : N;
   s.w_tilde.resize(NS);
@@ -72,11 +209,10 @@ void run_herzog(Upsampler::State& s, const FrameContext& f, const Options& o, Fr
   s.hw_fetch.resize(NS);
   s.hr_fetch.resize(C);
   for (auto& v : s.hr_fetch) v.resize(NS);
-  s.dcur.assign(GN, 0.0f);
-  s.dcount.assign(GN, 0.0f);
+  s.dcur.resize(GN);  // zeroed row by row in pass A
+  s.dcount.resize(GN);
   for (auto& a : s.dhist)
     for (auto& v : a) v.resize(GN, kMaxGradient);
-  s.gfilt.resize(GN);
   s.grad_smooth.resize(GN);
   for (auto& v : s.wf) v.resize(GN, 0.0f);
   const float max_hw = o.max_history_weight > 0 ? o.max_history_weight : 2.0f * float(k * k);
@@ -130,271 +266,8 @@ void run_herzog(Upsampler::State& s, const FrameContext& f, const Options& o, Fr
   float* dbg_conv = o.debug_layers ? out.add_channel("debug.convergence") : nullptr;
   float* hw_new = s.hw[cur].data();
 
-  // ---------------- pass A ----------------
-  std::atomic<std::size_t> hits{0};
-  // Bands of 8 intermediate rows (16 full rows at gs = 2): the expanded low rows are reused over each band.
-  parallel_rows(GH, [&](int gy0, int gy1) {
-    thread_local std::vector<float> w4, ekern, wfkrow, ycur, yprev, grad, rowbuf, histw;
-    thread_local HistoryRow hist;
-    thread_local ExpandedLowRows low_rows;
-    low_rows.reset(W, k, f.grid.sx, C);
-    w4.resize(std::size_t(W) * 4);
-    ekern.resize(W);
-    wfkrow.resize(W);
-    histw.resize(W);
-    rowbuf.resize(fused ? std::size_t(W) * (3 + C) : 0);
-    ycur.resize(W);
-    yprev.resize(W);
-    grad.resize(W);
-    float* __restrict w00 = w4.data();
-    float* __restrict w01 = w00 + W;
-    float* __restrict w10 = w01 + W;
-    float* __restrict w11 = w10 + W;
-    std::size_t band_hits = 0;
-    for (int Y = gy0 * gs; Y < std::min(H, gy1 * gs); ++Y) {
-      const std::size_t row = std::size_t(Y) * W;
-      const int r0 = s.rows.i0[Y] * f.lw, r1 = s.rows.i1[Y] * f.lw;
-      const float vy0 = s.rows.v0[Y], vy1 = s.rows.v1[Y];
-      const int dy = s.rows.d[Y];
-      const float* __restrict lb0 = s.kern_lb.data() + (std::size_t(dy) * 4 + 0) * W;
-      const float* __restrict lb1 = s.kern_lb.data() + (std::size_t(dy) * 4 + 1) * W;
-      const float* __restrict lb2 = s.kern_lb.data() + (std::size_t(dy) * 4 + 2) * W;
-      const float* __restrict lb3 = s.kern_lb.data() + (std::size_t(dy) * 4 + 3) * W;
-      const float* __restrict ks0 = s.kern_ks.data() + (std::size_t(dy) * 4 + 0) * W;
-      const float* __restrict ks1 = s.kern_ks.data() + (std::size_t(dy) * 4 + 1) * W;
-      const float* __restrict ks2 = s.kern_ks.data() + (std::size_t(dy) * 4 + 2) * W;
-      const float* __restrict ks3 = s.kern_ks.data() + (std::size_t(dy) * 4 + 3) * W;
-      // The two low rows' samples expanded to the full-resolution columns (cached over the k rows using them).
-      const float *e0 = nullptr, *e1 = nullptr;
-      low_rows.get(s, f, r0, r1, e0, e1);
-      // Kernel fall-off from the previous frame's w_f at the motion-compensated position.
-      {
-        float* __restrict ek = ekern.data();
-        float* __restrict wfk_ = wfkrow.data();
-        if (history) {
-          const float* __restrict mxr = f.mx + row;
-          const float* __restrict myr = f.my + row;
-          const float* __restrict wfp = wf_prev.data();
-          const float inv_gs = 1.0f / float(gs), fGW = float(GW), fGH = float(GH), fY = float(Y) + 0.5f;
-          const float gamma = o.kernel_gamma, cap = o.max_kernel_gamma, floor_g = o.min_kernel_gamma;
-          const int gw = GW;
-#pragma GCC ivdep
-          for (int X = 0; X < W; ++X) {
-            float px = (float(X) + 0.5f + mxr[X]) * inv_gs, py = (fY + myr[X]) * inv_gs;
-            const bool in = (px >= 0) & (py >= 0) & (px < fGW) & (py < fGH);  // false for NaN
-            px = in ? px : 0.0f;
-            py = in ? py : 0.0f;
-            const float wfk = in ? wfp[int(py) * gw + int(px)] : 0.0f;
-            wfk_[X] = wfk;
-            ek[X] = std::max(floor_g, std::min(gamma * wfk, cap));  // kernel_gamma(), floored
-          }
-        } else {
-          std::fill(ek, ek + W, o.min_kernel_gamma);
-          std::fill(wfk_, wfk_ + W, 0.0f);
-        }
-      }
-      const float* __restrict z = f.z + row;
-      const float* __restrict nx = f.nx + row;
-      const float* __restrict ny = f.ny + row;
-      const float* __restrict nz = f.nz + row;
-      const float* __restrict cv0 = s.cols.v0.data();
-      const float* __restrict cv1 = s.cols.v1.data();
-      const float* __restrict ekr = ekern.data();
-      // Expanded plane q, tap t of low row e (see ExpandedLowRows).
-      const std::size_t es = low_rows.stride();
-      auto ex = [es, k](const float* e, int q, int t) { return e + std::size_t(q) * es + std::size_t(t) * k; };
-      const float *__restrict z00 = ex(e0, 0, 0), *__restrict z01 = ex(e0, 0, 1), *__restrict z10 = ex(e1, 0, 0),
-                  *__restrict z11 = ex(e1, 0, 1);
-      const float *__restrict x00 = ex(e0, 1, 0), *__restrict x01 = ex(e0, 1, 1), *__restrict x10 = ex(e1, 1, 0),
-                  *__restrict x11 = ex(e1, 1, 1);
-      const float *__restrict y00 = ex(e0, 2, 0), *__restrict y01 = ex(e0, 2, 1), *__restrict y10 = ex(e1, 2, 0),
-                  *__restrict y11 = ex(e1, 2, 1);
-      const float *__restrict n00 = ex(e0, 3, 0), *__restrict n01 = ex(e0, 3, 1), *__restrict n10 = ex(e1, 3, 0),
-                  *__restrict n11 = ex(e1, 3, 1);
-      const float *__restrict v00 = ex(e0, 4, 0), *__restrict v01 = ex(e0, 4, 1), *__restrict v10 = ex(e1, 4, 0),
-                  *__restrict v11 = ex(e1, 4, 1);
-      // Geometric weight (normal and depth tents, cubed) of one low-resolution sample.
-      auto geo = [=](float zi, float ax, float ay, float az, float lx, float ly, float lzn, float lzz, float lv) {
-        const float dot = ax * lx + ay * ly + az * lzn;
-        const float xn = std::max(0.0f, 1.0f - dot);
-        const float tn = std::max(kKernelEpsilon, 1.0f - xn * xn * inv_sn2);
-        const float dz = zi - lzz;
-        const float td = std::max(kKernelEpsilon, 1.0f - dz * dz * inv_sd2);
-        const float w = tn * tn * tn * td * td * td * lv;
-        return w >= 0.0f ? w : 0.0f;
-      };
-      // Pass A's per-pixel results: whole planes for pass C, or rows when eq. 7 runs here (fused).
-      float* __restrict wt = fused ? rowbuf.data() : s.w_tilde.data() + row;
-      float* __restrict wc = fused ? rowbuf.data() + W : s.w_conf.data() + row;
-      float* hwf_row = fused ? rowbuf.data() + 2 * W : s.hw_fetch.data() + row;
-      float* hr_rows[16];
-      for (int c = 0; c < C; ++c) hr_rows[c] = fused ? rowbuf.data() + std::size_t(3 + c) * W : s.hr_fetch[c].data() + row;
-#pragma GCC ivdep
-      for (int X = 0; X < W; ++X) {
-        const float zi = z[X], ax = nx[X], ay = ny[X], az = nz[X];
-        const float g00 = geo(zi, ax, ay, az, x00[X], y00[X], n00[X], z00[X], v00[X]) * cv0[X] * vy0;
-        const float g01 = geo(zi, ax, ay, az, x01[X], y01[X], n01[X], z01[X], v01[X]) * cv1[X] * vy0;
-        const float g10 = geo(zi, ax, ay, az, x10[X], y10[X], n10[X], z10[X], v10[X]) * cv0[X] * vy1;
-        const float g11 = geo(zi, ax, ay, az, x11[X], y11[X], n11[X], z11[X], v11[X]) * cv1[X] * vy1;
-        w00[X] = g00;
-        w01[X] = g01;
-        w10[X] = g10;
-        w11[X] = g11;
-        // History confidence of this frame's samples: the same weights with the sharp kernel (w_f = 1).
-        wc[X] = g00 * ks0[X] + g01 * ks1[X] + g10 * ks2[X] + g11 * ks3[X];
-      }
-      // The adaptive image kernel, in a loop of its own: fused with the geometry above, the loop body is too
-      // large for GCC's if-conversion and the whole loop stays scalar.
-#pragma GCC ivdep
-      for (int X = 0; X < W; ++X) {
-        const float e = ekr[X];
-        w00[X] = w00[X] * fast_exp2(e * lb0[X]);
-        w01[X] = w01[X] * fast_exp2(e * lb1[X]);
-        w10[X] = w10[X] * fast_exp2(e * lb2[X]);
-        w11[X] = w11[X] * fast_exp2(e * lb3[X]);
-        wt[X] = w00[X] + w01[X] + w10[X] + w11[X];
-      }
-      for (int c = 0; c < C; ++c) {  // eq. 6
-        const float* __restrict l00 = ex(e0, 5 + c, 0);
-        const float* __restrict l01 = ex(e0, 5 + c, 1);
-        const float* __restrict l10 = ex(e1, 5 + c, 0);
-        const float* __restrict l11 = ex(e1, 5 + c, 1);
-        float* __restrict o_ = planes[c] + row;
-#pragma GCC ivdep
-        for (int X = 0; X < W; ++X) {
-          // Unconditional loads, then a select (an invalid sample's value may be NaN: it must not propagate).
-          const float la = l00[X], lb = l01[X], lc = l10[X], ld = l11[X];
-          const float a = w00[X] > 0 ? la : 0.0f, b = w01[X] > 0 ? lb : 0.0f;
-          const float cc = w10[X] > 0 ? lc : 0.0f, d = w11[X] > 0 ? ld : 0.0f;
-          const float v = w00[X] * a + w01[X] * b + w10[X] * cc + w11[X] * d;
-          o_[X] = wt[X] > 0 ? v / wt[X] : 0.0f;
-        }
-      }
-      // History fetch at i(t-1) and the relative temporal gradient (section 3.5.1).
-      float* __restrict hwf = hwf_row;
-      float* __restrict yc = ycur.data();
-      float* __restrict yp = yprev.data();
-      if (history) {
-        history_row(s, f, o, Y, hist);
-        {
-          const float* src[9];
-          float* dst[9];
-          int n = 0;
-          src[n] = s.hw[prv].data();
-          dst[n++] = hwf;
-          for (int c = 0; c < C; ++c) {
-            src[n] = prev_planes[c];
-            dst[n++] = hr_rows[c];
-            if (n == 4 || c == C - 1) {
-              gather_history_planes(hist, src, dst, n, W);
-              n = 0;
-            }
-          }
-        }
-        std::fill(yc, yc + W, 0.0f);
-        std::fill(yp, yp + W, 0.0f);
-        for (int c = 0; c < C; ++c) {
-          float* hr = hr_rows[c];
-          const float lc = f.luma[c];
-          const float* __restrict cur_c = planes[c] + row;
-#pragma GCC ivdep
-          for (int X = 0; X < W; ++X) {
-            yc[X] += lc * cur_c[X];
-            yp[X] += lc * hr[X];
-          }
-        }
-        const float* __restrict hit = hist.hit.data();
-        float* __restrict gr = grad.data();
-#pragma GCC ivdep
-        for (int X = 0; X < W; ++X) {
-          const float g = std::clamp(relative_gradient(yc[X], yp[X]), -kMaxGradient, kMaxGradient);
-          // Disoccluded (no history) or no spatial sample: the maximum gradient (Figure 6).
-          gr[X] = (hit[X] > 0 && wt[X] > 0) ? g : kMaxGradient;
-        }
-        int row_hits = 0;  // an int reduction vectorises (a size_t one with a select does not)
-        for (int X = 0; X < W; ++X) row_hits += int(hit[X] > 0);
-        band_hits += std::size_t(row_hits);
-      } else {
-        std::fill(hwf, hwf + W, 0.0f);
-        for (int c = 0; c < C; ++c) std::fill(hr_rows[c], hr_rows[c] + W, 0.0f);
-        std::fill(grad.begin(), grad.end(), kMaxGradient);
-      }
-      // Average into the intermediate-resolution gradient buffer.
-      float* dc = s.dcur.data() + std::size_t(Y / gs) * GW;
-      float* dn = s.dcount.data() + std::size_t(Y / gs) * GW;
-      int gx_full = 0;
-      if (gs == 2) {  // the default: whole cells in a loop that vectorises (same sums, same order)
-        const float* __restrict gr = grad.data();
-        gx_full = W / 2;
-#pragma GCC ivdep
-        for (int gx = 0; gx < gx_full; ++gx) {
-          dc[gx] += (0.0f + gr[2 * gx]) + gr[2 * gx + 1];
-          dn[gx] += 2.0f;
-        }
-      }
-      for (int gx = gx_full; gx < GW; ++gx) {
-        float sum = 0.0f;
-        int n = 0;
-        for (int X = gx * gs; X < std::min(W, gx * gs + gs); ++X, ++n) sum += grad[X];
-        dc[gx] += sum;
-        dn[gx] += float(n);
-      }
-      if (fused) {
-        // Eq. 7 with the previous frame's w_f at the motion-compensated position (the one that shaped k).
-        float* prow[16];
-        for (int c = 0; c < C; ++c) prow[c] = planes[c] + row;
-        blend_row(W, C, wfkrow.data(), wt, wc, hwf, hr_rows, prow, hw_new + row, histw.data(), max_hw);
-        if (dbg_conf)
-          for (int X = 0; X < W; ++X) {
-            dbg_conf[row + X] = wt[X];
-            dbg_disocc[row + X] = hwf[X] > 0 ? 0.0f : 1.0f;
-            dbg_wf[row + X] = wfkrow[X];
-            dbg_hw[row + X] = hw_new[row + X];
-            dbg_conv[row + X] = hw_new[row + X] / max_hw;
-          }
-      }
-    }
-    hits += band_hits;
-  }, 8);
-
-  // ---------------- pass B ----------------
-  auto& dh_prev = s.dhist[prv];
-  auto& dh_cur = s.dhist[cur];
-  parallel_rows(GH, [&](int gy0, int gy1) {
-    const float* __restrict p0 = dh_prev[0].data();
-    const float* __restrict p1 = dh_prev[1].data();
-    const float* __restrict p2 = dh_prev[2].data();
-    const float fgs = float(gs), fGW = float(GW), fGH = float(GH);
-    for (int gy = gy0; gy < gy1; ++gy) {
-      const std::size_t grow = std::size_t(gy) * GW;
-      const float* __restrict dcur = s.dcur.data() + grow;
-      const float* __restrict dcnt = s.dcount.data() + grow;
-      float* __restrict c0 = dh_cur[0].data() + grow;
-      float* __restrict c1 = dh_cur[1].data() + grow;
-      float* __restrict c2 = dh_cur[2].data() + grow;
-      float* __restrict gf = s.gfilt.data() + grow;
-      // The motion at the cell's centre pixel (row cy, every gs-th column) moves the three previous gradients.
-      const int cy = std::min(H - 1, gy * gs + gs / 2);
-      const float* __restrict mxr = f.mx + std::size_t(cy) * W;
-      const float* __restrict myr = f.my + std::size_t(cy) * W;
-      const float fcy = float(cy) + 0.5f;
-#pragma GCC ivdep
-      for (int gx = 0; gx < GW; ++gx) {
-        const float d0 = dcnt[gx] > 0 ? dcur[gx] / dcnt[gx] : kMaxGradient;
-        const int cx = std::min(W - 1, gx * gs + gs / 2);
-        const float px = (float(cx) + 0.5f + mxr[cx]) / fgs, py = (fcy + myr[cx]) / fgs;
-        const bool in = history & (px >= 0) & (py >= 0) & (px < fGW) & (py < fGH);  // false for NaN
-        const int q = in ? int(py) * GW + int(px) : 0;
-        const float e1 = p0[q], e2 = p1[q], e3 = p2[q];  // unconditional loads (q is valid), then selects
-        const float d1 = in ? e1 : kMaxGradient, d2 = in ? e2 : kMaxGradient, d3 = in ? e3 : kMaxGradient;
-        c0[gx] = d0;
-        c1[gx] = d1;
-        c2[gx] = d2;
-        gf[gx] = filtered_gradient(d0, d1, d2, d3);
-      }
-    }
-  });
-  // Spatial low-pass: box pyramid above the intermediate level, sampled trilinearly at the mip level.
+  // Spatial low-pass of pass B: a box pyramid above the intermediate level (level 0 = the temporally
+  // filtered gradient), sampled trilinearly at the mip level.
   const float base_level = std::log2(float(gs));
   const float rel = std::max(0.0f, o.gradient_mip_level - base_level);
   const int l0 = int(std::floor(rel));
@@ -403,24 +276,13 @@ void run_herzog(Upsampler::State& s, const FrameContext& f, const Options& o, Fr
   s.pyramid.resize(levels + 1);
   s.pyr_w.resize(levels + 1);
   s.pyr_h.resize(levels + 1);
-  s.pyramid[0] = s.gfilt;
   s.pyr_w[0] = GW;
   s.pyr_h[0] = GH;
+  s.pyramid[0].resize(GN);
   for (int j = 1; j <= levels; ++j) {
-    const int pw = s.pyr_w[j - 1], ph = s.pyr_h[j - 1];
-    const int w = std::max(1, (pw + 1) / 2), h = std::max(1, (ph + 1) / 2);
-    s.pyr_w[j] = w;
-    s.pyr_h[j] = h;
-    auto& dst = s.pyramid[j];
-    const auto& src = s.pyramid[j - 1];
-    dst.resize(std::size_t(w) * h);
-    for (int y = 0; y < h; ++y)
-      for (int x = 0; x < w; ++x) {
-        const int xa = std::min(2 * x, pw - 1), xb = std::min(2 * x + 1, pw - 1);
-        const int ya = std::min(2 * y, ph - 1), yb = std::min(2 * y + 1, ph - 1);
-        dst[std::size_t(y) * w + x] = 0.25f * (src[std::size_t(ya) * pw + xa] + src[std::size_t(ya) * pw + xb] +
-                                               src[std::size_t(yb) * pw + xa] + src[std::size_t(yb) * pw + xb]);
-      }
+    s.pyr_w[j] = std::max(1, (s.pyr_w[j - 1] + 1) / 2);
+    s.pyr_h[j] = std::max(1, (s.pyr_h[j - 1] + 1) / 2);
+    s.pyramid[j].resize(std::size_t(s.pyr_w[j]) * s.pyr_h[j]);
   }
   // Trilinear sampling: the bilinear taps and weights of every column and row, per level, computed once
   // (bilinear, clamp-to-edge, texel centres at integers; hoisted out of the cell loop so that it vectorises).
@@ -446,87 +308,443 @@ void run_herzog(Upsampler::State& s, const FrameContext& f, const Options& o, Fr
   for (int t = 0; t < nlev; ++t) {
     make_axis(GW, s.pyr_w[l0 + t], l0 + t, axx[t]);
     make_axis(GH, s.pyr_h[l0 + t], l0 + t, axy[t]);
+    s.pyr_hx[t].resize(std::size_t(s.pyr_h[l0 + t]) * GW);
   }
-  parallel_rows(GH, [&](int gy0, int gy1) {
-    thread_local std::vector<float> lev;
-    lev.resize(std::size_t(2) * GW);
-    for (int gy = gy0; gy < gy1; ++gy) {
-      for (int t = 0; t < nlev; ++t) {
-        const int j = l0 + t, pw = s.pyr_w[j];
-        const float* __restrict r0 = s.pyramid[j].data() + std::size_t(axy[t].i0[gy]) * pw;
-        const float* __restrict r1 = s.pyramid[j].data() + std::size_t(axy[t].i1[gy]) * pw;
-        const float ay = axy[t].a[gy];
-        const int* __restrict x0 = axx[t].i0.data();
-        const int* __restrict x1 = axx[t].i1.data();
-        const float* __restrict axa = axx[t].a.data();
-        float* __restrict lout = lev.data() + std::size_t(t) * GW;
-#pragma GCC ivdep
-        for (int gx = 0; gx < GW; ++gx) {
-          const float ax = axa[gx];
-          const float a = r0[x0[gx]], b = r0[x1[gx]], c = r1[x0[gx]], d = r1[x1[gx]];
-          lout[gx] = (1 - ay) * ((1 - ax) * a + ax * b) + ay * ((1 - ax) * c + ax * d);
-        }
-      }
-      const float* __restrict g0 = lev.data();
-      const float* __restrict g1 = lev.data() + GW;
-      float* __restrict gsm = s.grad_smooth.data() + std::size_t(gy) * GW;
-      float* __restrict wfo = s.wf[cur].data() + std::size_t(gy) * GW;
-      const float a_ = o.a;
-      if (nlev == 2) {
-#pragma GCC ivdep
-        for (int gx = 0; gx < GW; ++gx) {
-          const float g = (1 - frac) * g0[gx] + frac * g1[gx];
-          gsm[gx] = g;
-          wfo[gx] = temporal_weight(g, a_);  // eq. 8
-        }
-      } else {
-#pragma GCC ivdep
-        for (int gx = 0; gx < GW; ++gx) {
-          gsm[gx] = g0[gx];
-          wfo[gx] = temporal_weight(g0[gx], a_);  // eq. 8
-        }
+
+  // ---------------- schedule ----------------
+  // Pass C reads back everything pass A wrote (w~, w~', h_w, h_r and h~: 3 + 2C full planes); run one pass
+  // after the other and those planes make a round trip through DRAM. Instead each thread walks a chunk of
+  // intermediate rows top-down and runs B, the pyramid rows and C for a row as soon as the rows it depends
+  // on are done, a few rows behind A, while A's results are still in its L2 cache (a ring of rows). Row gy
+  // of the low-passed gradient reads the intermediate rows [lo[gy], hi[gy]] through the pyramid taps; rows
+  // whose range leaves their chunk (a few at each chunk boundary) keep A's results in full planes and are
+  // finished after every chunk is done. The values computed are the same as three separate passes: only
+  // the order in which rows are computed changes.
+  std::vector<int> lo(GH), hi(GH);
+  {
+    // Intermediate rows under each pyramid row (box of 2x2 with clamp-to-edge, as built below).
+    std::vector<std::vector<int>> plo(levels + 1), phi(levels + 1);
+    plo[0].resize(GH);
+    phi[0].resize(GH);
+    for (int i = 0; i < GH; ++i) plo[0][i] = phi[0][i] = i;
+    for (int j = 1; j <= levels; ++j) {
+      const int ph = s.pyr_h[j - 1];
+      plo[j].resize(s.pyr_h[j]);
+      phi[j].resize(s.pyr_h[j]);
+      for (int i = 0; i < s.pyr_h[j]; ++i) {
+        plo[j][i] = plo[j - 1][std::min(2 * i, ph - 1)];
+        phi[j][i] = phi[j - 1][std::min(2 * i + 1, ph - 1)];
       }
     }
-  });
-
-  // ---------------- pass C ----------------
-  const std::vector<float>& wf_cur = s.wf[cur];
-  parallel_rows(H, [&](int y0, int y1) {
-    thread_local std::vector<float> wf_row, hist_w;
-    wf_row.resize(W);
-    hist_w.resize(W);
-    int wf_row_of = -1;  // the intermediate row wf_row was expanded from (shared by gs full rows)
-    for (int Y = y0; Y < y1; ++Y) {
+    for (int g = 0; g < GH; ++g) {
+      lo[g] = GH;
+      hi[g] = g;  // never before its own row
+      for (int t = 0; t < nlev; ++t) {
+        lo[g] = std::min({lo[g], plo[l0 + t][axy[t].i0[g]], plo[l0 + t][axy[t].i1[g]]});
+        hi[g] = std::max({hi[g], phi[l0 + t][axy[t].i0[g]], phi[l0 + t][axy[t].i1[g]]});
+      }
+    }
+  }
+  // Chunks of intermediate rows, aligned to the pyramid's top level so that no pyramid row straddles two.
+  const int align = 1 << levels;
+  const int chunk = std::max(align, (kChunkRows + align - 1) / align * align);
+  const int nchunks = (GH + chunk - 1) / chunk;
+  std::vector<char> interior(GH);
+  int max_lag = 0;
+  for (int g = 0; g < GH; ++g) {
+    const int c0 = g / chunk * chunk, c1 = std::min(GH, c0 + chunk);
+    interior[g] = char(lo[g] >= c0 && hi[g] < c1);
+    max_lag = std::max(max_lag, hi[g] - g);
+  }
+  // Ring of pass A results for the interior rows: full row Y uses slot Y % ring_rows. Row gy is blended when A
+  // has reached hi[gy] <= gy + max_lag, before A overwrites its slot (at gy + max_lag + 2).
+  const int ring_rows = gs * (max_lag + 2);
+  const std::size_t ring_planes = std::size_t(3 + C);
+  auto row_scratch = [&](ChunkScratch& ts, int Y, bool in_ring) {
+    RowScratch rs;
+    if (fused) {
+      float* b = ts.rowbuf.data();
+      rs.wt = b;
+      rs.wc = b + W;
+      rs.hwf = b + 2 * W;
+      for (int c = 0; c < C; ++c) rs.hr[c] = b + std::size_t(3 + c) * W;
+    } else if (in_ring) {
+      float* b = ts.ring.data() + std::size_t(Y % ring_rows) * ring_planes * W;
+      rs.wt = b;
+      rs.wc = b + W;
+      rs.hwf = b + 2 * W;
+      for (int c = 0; c < C; ++c) rs.hr[c] = b + std::size_t(3 + c) * W;
+    } else {
       const std::size_t row = std::size_t(Y) * W;
-      const float* wfr = wf_cur.data() + std::size_t(Y / gs) * GW;
-      if (dbg_grad) {
-        const float* gsr = s.grad_smooth.data() + std::size_t(Y / gs) * GW;
-        for (int X = 0; X < W; ++X) dbg_grad[row + X] = gsr[X / gs];
-      }
-      if (fused) continue;  // eq. 7 already ran in pass A
-      if (Y / gs != wf_row_of) {
-        for (int gx = 0; gx < GW; ++gx)
-          for (int X = gx * gs; X < std::min(W, gx * gs + gs); ++X) wf_row[X] = wfr[gx];
-        wf_row_of = Y / gs;
-      }
-      const float* hr[16];
-      float* p[16];
-      for (int c = 0; c < C; ++c) {
-        hr[c] = s.hr_fetch[c].data() + row;
-        p[c] = planes[c] + row;
-      }
-      blend_row(W, C, wf_row.data(), s.w_tilde.data() + row, s.w_conf.data() + row, s.hw_fetch.data() + row, hr, p,
-                hw_new + row, hist_w.data(), max_hw);
-      if (dbg_conf) {
+      rs.wt = s.w_tilde.data() + row;
+      rs.wc = s.w_conf.data() + row;
+      rs.hwf = s.hw_fetch.data() + row;
+      for (int c = 0; c < C; ++c) rs.hr[c] = s.hr_fetch[c].data() + row;
+    }
+    return rs;
+  };
+  auto prepare = [&](ChunkScratch& ts) {
+    ts.low_rows.reset(W, k, f.grid.sx, C);
+    ts.w4.resize(std::size_t(W) * 4);
+    ts.ekern.resize(W);
+    ts.wfkrow.resize(W);
+    ts.histw.resize(W);
+    ts.rowbuf.resize(fused ? std::size_t(W) * (3 + C) : 0);
+    ts.ring.resize(fused ? 0 : std::size_t(ring_rows) * ring_planes * W);
+    ts.ycur.resize(W);
+    ts.yprev.resize(W);
+    ts.grad.resize(W);
+    ts.wf_row.resize(W);
+    ts.lev.resize(std::size_t(2) * GW);
+    ts.wf_row_of = -1;  // w_f changes every frame
+  };
+
+  // ---------------- pass A: one full row ----------------
+  // Returns the number of pixels with history.
+  auto pass_a_row = [&](ChunkScratch& ts, int Y, const RowScratch& rs) -> int {
+    float* __restrict w00 = ts.w4.data();
+    float* __restrict w01 = w00 + W;
+    float* __restrict w10 = w01 + W;
+    float* __restrict w11 = w10 + W;
+    int row_hits = 0;
+    const std::size_t row = std::size_t(Y) * W;
+    const int r0 = s.rows.i0[Y] * f.lw, r1 = s.rows.i1[Y] * f.lw;
+    const float vy0 = s.rows.v0[Y], vy1 = s.rows.v1[Y];
+    const int dy = s.rows.d[Y];
+    const float* __restrict lb0 = s.kern_lb.data() + (std::size_t(dy) * 4 + 0) * W;
+    const float* __restrict lb1 = s.kern_lb.data() + (std::size_t(dy) * 4 + 1) * W;
+    const float* __restrict lb2 = s.kern_lb.data() + (std::size_t(dy) * 4 + 2) * W;
+    const float* __restrict lb3 = s.kern_lb.data() + (std::size_t(dy) * 4 + 3) * W;
+    const float* __restrict ks0 = s.kern_ks.data() + (std::size_t(dy) * 4 + 0) * W;
+    const float* __restrict ks1 = s.kern_ks.data() + (std::size_t(dy) * 4 + 1) * W;
+    const float* __restrict ks2 = s.kern_ks.data() + (std::size_t(dy) * 4 + 2) * W;
+    const float* __restrict ks3 = s.kern_ks.data() + (std::size_t(dy) * 4 + 3) * W;
+    // The two low rows' samples expanded to the full-resolution columns (cached over the k rows using them).
+    const float *e0 = nullptr, *e1 = nullptr;
+    ts.low_rows.get(s, f, r0, r1, e0, e1);
+    // Kernel fall-off from the previous frame's w_f at the motion-compensated position.
+    {
+      float* __restrict ek = ts.ekern.data();
+      float* __restrict wfk_ = ts.wfkrow.data();
+      if (history) {
+        const float* __restrict mxr = f.mx + row;
+        const float* __restrict myr = f.my + row;
+        const float* __restrict wfp = wf_prev.data();
+        const float inv_gs = 1.0f / float(gs), fGW = float(GW), fGH = float(GH), fY = float(Y) + 0.5f;
+        const float gamma = o.kernel_gamma, cap = o.max_kernel_gamma, floor_g = o.min_kernel_gamma;
+        const int gw = GW;
+#pragma GCC ivdep
         for (int X = 0; X < W; ++X) {
-          dbg_conf[row + X] = s.w_tilde[row + X];
-          dbg_disocc[row + X] = s.hw_fetch[row + X] > 0 ? 0.0f : 1.0f;
-          dbg_wf[row + X] = wf_row[X];
+          float px = (float(X) + 0.5f + mxr[X]) * inv_gs, py = (fY + myr[X]) * inv_gs;
+          const bool in = (px >= 0) & (py >= 0) & (px < fGW) & (py < fGH);  // false for NaN
+          px = in ? px : 0.0f;
+          py = in ? py : 0.0f;
+          const float wfk = in ? wfp[int(py) * gw + int(px)] : 0.0f;
+          wfk_[X] = wfk;
+          ek[X] = std::max(floor_g, std::min(gamma * wfk, cap));  // kernel_gamma(), floored
+        }
+      } else {
+        std::fill(ek, ek + W, o.min_kernel_gamma);
+        std::fill(wfk_, wfk_ + W, 0.0f);
+      }
+    }
+    const float* __restrict z = f.z + row;
+    const float* __restrict nx = f.nx + row;
+    const float* __restrict ny = f.ny + row;
+    const float* __restrict nz = f.nz + row;
+    const float* __restrict cv0 = s.cols.v0.data();
+    const float* __restrict cv1 = s.cols.v1.data();
+    const float* __restrict ekr = ts.ekern.data();
+    // Expanded plane q, tap t of low row e (see ExpandedLowRows).
+    const std::size_t es = ts.low_rows.stride();
+    auto ex = [es, k](const float* e, int q, int t) { return e + std::size_t(q) * es + std::size_t(t) * k; };
+    const float *__restrict z00 = ex(e0, 0, 0), *__restrict z01 = ex(e0, 0, 1), *__restrict z10 = ex(e1, 0, 0),
+                *__restrict z11 = ex(e1, 0, 1);
+    const float *__restrict x00 = ex(e0, 1, 0), *__restrict x01 = ex(e0, 1, 1), *__restrict x10 = ex(e1, 1, 0),
+                *__restrict x11 = ex(e1, 1, 1);
+    const float *__restrict y00 = ex(e0, 2, 0), *__restrict y01 = ex(e0, 2, 1), *__restrict y10 = ex(e1, 2, 0),
+                *__restrict y11 = ex(e1, 2, 1);
+    const float *__restrict n00 = ex(e0, 3, 0), *__restrict n01 = ex(e0, 3, 1), *__restrict n10 = ex(e1, 3, 0),
+                *__restrict n11 = ex(e1, 3, 1);
+    const float *__restrict v00 = ex(e0, 4, 0), *__restrict v01 = ex(e0, 4, 1), *__restrict v10 = ex(e1, 4, 0),
+                *__restrict v11 = ex(e1, 4, 1);
+    // Geometric weight (normal and depth tents, cubed) of one low-resolution sample.
+    auto geo = [=](float zi, float ax, float ay, float az, float lx, float ly, float lzn, float lzz, float lv) {
+      const float dot = ax * lx + ay * ly + az * lzn;
+      const float xn = std::max(0.0f, 1.0f - dot);
+      const float tn = std::max(kKernelEpsilon, 1.0f - xn * xn * inv_sn2);
+      const float dz = zi - lzz;
+      const float td = std::max(kKernelEpsilon, 1.0f - dz * dz * inv_sd2);
+      const float w = tn * tn * tn * td * td * td * lv;
+      return w >= 0.0f ? w : 0.0f;
+    };
+    float* __restrict wt = rs.wt;
+    float* __restrict wc = rs.wc;
+#pragma GCC ivdep
+    for (int X = 0; X < W; ++X) {
+      const float zi = z[X], ax = nx[X], ay = ny[X], az = nz[X];
+      const float g00 = geo(zi, ax, ay, az, x00[X], y00[X], n00[X], z00[X], v00[X]) * cv0[X] * vy0;
+      const float g01 = geo(zi, ax, ay, az, x01[X], y01[X], n01[X], z01[X], v01[X]) * cv1[X] * vy0;
+      const float g10 = geo(zi, ax, ay, az, x10[X], y10[X], n10[X], z10[X], v10[X]) * cv0[X] * vy1;
+      const float g11 = geo(zi, ax, ay, az, x11[X], y11[X], n11[X], z11[X], v11[X]) * cv1[X] * vy1;
+      w00[X] = g00;
+      w01[X] = g01;
+      w10[X] = g10;
+      w11[X] = g11;
+      // History confidence of this frame's samples: the same weights with the sharp kernel (w_f = 1).
+      wc[X] = g00 * ks0[X] + g01 * ks1[X] + g10 * ks2[X] + g11 * ks3[X];
+    }
+    // The adaptive image kernel, in a loop of its own: fused with the geometry above, the loop body is too
+    // large for GCC's if-conversion and the whole loop stays scalar.
+#pragma GCC ivdep
+    for (int X = 0; X < W; ++X) {
+      const float e = ekr[X];
+      w00[X] = w00[X] * fast_exp2(e * lb0[X]);
+      w01[X] = w01[X] * fast_exp2(e * lb1[X]);
+      w10[X] = w10[X] * fast_exp2(e * lb2[X]);
+      w11[X] = w11[X] * fast_exp2(e * lb3[X]);
+      wt[X] = w00[X] + w01[X] + w10[X] + w11[X];
+    }
+    for (int c = 0; c < C; ++c) {  // eq. 6
+      const float* __restrict l00 = ex(e0, 5 + c, 0);
+      const float* __restrict l01 = ex(e0, 5 + c, 1);
+      const float* __restrict l10 = ex(e1, 5 + c, 0);
+      const float* __restrict l11 = ex(e1, 5 + c, 1);
+      float* __restrict o_ = planes[c] + row;
+#pragma GCC ivdep
+      for (int X = 0; X < W; ++X) {
+        // Unconditional loads, then a select (an invalid sample's value may be NaN: it must not propagate).
+        const float la = l00[X], lb = l01[X], lc = l10[X], ld = l11[X];
+        const float a = w00[X] > 0 ? la : 0.0f, b = w01[X] > 0 ? lb : 0.0f;
+        const float cc = w10[X] > 0 ? lc : 0.0f, d = w11[X] > 0 ? ld : 0.0f;
+        const float v = w00[X] * a + w01[X] * b + w10[X] * cc + w11[X] * d;
+        o_[X] = wt[X] > 0 ? v / wt[X] : 0.0f;
+      }
+    }
+    // History fetch at i(t-1) and the relative temporal gradient (section 3.5.1).
+    float* __restrict hwf = rs.hwf;
+    float* __restrict yc = ts.ycur.data();
+    float* __restrict yp = ts.yprev.data();
+    if (history) {
+      HistoryRow& hist = ts.hist;
+      history_row(s, f, o, Y, hist);
+      {
+        const float* src[9];
+        float* dst[9];
+        int n = 0;
+        src[n] = s.hw[prv].data();
+        dst[n++] = hwf;
+        for (int c = 0; c < C; ++c) {
+          src[n] = prev_planes[c];
+          dst[n++] = rs.hr[c];
+          if (n == 4 || c == C - 1) {
+            gather_history_planes(hist, src, dst, n, W);
+            n = 0;
+          }
+        }
+      }
+      std::fill(yc, yc + W, 0.0f);
+      std::fill(yp, yp + W, 0.0f);
+      for (int c = 0; c < C; ++c) {
+        float* hr = rs.hr[c];
+        const float lc = f.luma[c];
+        const float* __restrict cur_c = planes[c] + row;
+#pragma GCC ivdep
+        for (int X = 0; X < W; ++X) {
+          yc[X] += lc * cur_c[X];
+          yp[X] += lc * hr[X];
+        }
+      }
+      const float* __restrict hit = hist.hit.data();
+      float* __restrict gr = ts.grad.data();
+#pragma GCC ivdep
+      for (int X = 0; X < W; ++X) {
+        const float g = std::clamp(relative_gradient(yc[X], yp[X]), -kMaxGradient, kMaxGradient);
+        // Disoccluded (no history) or no spatial sample: the maximum gradient (Figure 6).
+        gr[X] = (hit[X] > 0 && wt[X] > 0) ? g : kMaxGradient;
+      }
+      for (int X = 0; X < W; ++X) row_hits += int(hit[X] > 0);  // an int reduction vectorises
+    } else {
+      std::fill(hwf, hwf + W, 0.0f);
+      for (int c = 0; c < C; ++c) std::fill(rs.hr[c], rs.hr[c] + W, 0.0f);
+      std::fill(ts.grad.begin(), ts.grad.end(), kMaxGradient);
+    }
+    // Average into the intermediate-resolution gradient buffer (its row is zeroed before its first full row).
+    float* dc = s.dcur.data() + std::size_t(Y / gs) * GW;
+    float* dn = s.dcount.data() + std::size_t(Y / gs) * GW;
+    int gx_full = 0;
+    if (gs == 2) {  // the default: whole cells in a loop that vectorises (same sums, same order)
+      const float* __restrict gr = ts.grad.data();
+      gx_full = W / 2;
+#pragma GCC ivdep
+      for (int gx = 0; gx < gx_full; ++gx) {
+        dc[gx] += (0.0f + gr[2 * gx]) + gr[2 * gx + 1];
+        dn[gx] += 2.0f;
+      }
+    }
+    for (int gx = gx_full; gx < GW; ++gx) {
+      float sum = 0.0f;
+      int n = 0;
+      for (int X = gx * gs; X < std::min(W, gx * gs + gs); ++X, ++n) sum += ts.grad[X];
+      dc[gx] += sum;
+      dn[gx] += float(n);
+    }
+    if (fused) {
+      // Eq. 7 with the previous frame's w_f at the motion-compensated position (the one that shaped k).
+      float* prow[16];
+      for (int c = 0; c < C; ++c) prow[c] = planes[c] + row;
+      blend_row(W, C, ts.wfkrow.data(), wt, rs.wc, hwf, rs.hr, prow, hw_new + row, ts.histw.data(), max_hw);
+      if (dbg_conf)
+        for (int X = 0; X < W; ++X) {
+          dbg_conf[row + X] = wt[X];
+          dbg_disocc[row + X] = hwf[X] > 0 ? 0.0f : 1.0f;
+          dbg_wf[row + X] = ts.wfkrow[X];
           dbg_hw[row + X] = hw_new[row + X];
           dbg_conv[row + X] = hw_new[row + X] / max_hw;
         }
+    }
+    return row_hits;
+  };
+
+  // ---------------- pass B: temporal filter of one intermediate row (pyramid level 0) ----------------
+  auto& dh_prev = s.dhist[prv];
+  auto& dh_cur = s.dhist[cur];
+  auto pass_b_row = [&](ChunkScratch& ts, int gy) {
+    const std::size_t grow = std::size_t(gy) * GW;
+    const float* prev3[3] = {dh_prev[0].data(), dh_prev[1].data(), dh_prev[2].data()};
+    float* cur3[3] = {dh_cur[0].data() + grow, dh_cur[1].data() + grow, dh_cur[2].data() + grow};
+    temporal_filter_row(gy, W, H, gs, GW, GH, history, f.mx, f.my, s.dcur.data() + grow, s.dcount.data() + grow,
+                        prev3, cur3, s.pyramid[0].data() + grow, ts.bseg);
+  };
+  // Pyramid level j, row y: 2x2 box of level j - 1 (clamp-to-edge).
+  auto pyramid_row = [&](int j, int y) {
+    const int pw = s.pyr_w[j - 1], ph = s.pyr_h[j - 1], w = s.pyr_w[j];
+    float* __restrict dst = s.pyramid[j].data() + std::size_t(y) * w;
+    const float* __restrict src = s.pyramid[j - 1].data();
+    const int ya = std::min(2 * y, ph - 1), yb = std::min(2 * y + 1, ph - 1);
+    for (int x = 0; x < w; ++x) {
+      const int xa = std::min(2 * x, pw - 1), xb = std::min(2 * x + 1, pw - 1);
+      dst[x] = 0.25f * (src[std::size_t(ya) * pw + xa] + src[std::size_t(ya) * pw + xb] +
+                        src[std::size_t(yb) * pw + xa] + src[std::size_t(yb) * pw + xb]);
+    }
+  };
+  // Trilinear sample of the pyramid for one intermediate row, and eq. 8.
+  // Level l0 + t of the pyramid, row i, resampled to the GW columns (the sampled levels only).
+  auto resample_row = [&](int j, int i) {
+    const int t = j - l0;
+    if (t < 0 || t >= nlev) return;
+    resample_columns(s.pyramid[j].data() + std::size_t(i) * s.pyr_w[j], axx[t].i0.data(), axx[t].i1.data(),
+                     axx[t].a.data(), GW, s.pyr_hx[t].data() + std::size_t(i) * GW);
+  };
+  // Trilinear sample of the pyramid for one intermediate row, and eq. 8.
+  auto low_pass_row = [&](ChunkScratch& ts, int gy) {
+    for (int t = 0; t < nlev; ++t) {
+      const float* hx = s.pyr_hx[t].data();
+      lerp_rows(hx + std::size_t(axy[t].i0[gy]) * GW, hx + std::size_t(axy[t].i1[gy]) * GW, axy[t].a[gy], GW,
+                ts.lev.data() + std::size_t(t) * GW);
+    }
+    const float* __restrict g0 = ts.lev.data();
+    const float* __restrict g1 = ts.lev.data() + GW;
+    float* __restrict gsm = s.grad_smooth.data() + std::size_t(gy) * GW;
+    float* __restrict wfo = s.wf[cur].data() + std::size_t(gy) * GW;
+    const float a_ = o.a;
+    if (nlev == 2) {
+#pragma GCC ivdep
+      for (int gx = 0; gx < GW; ++gx) {
+        const float g = (1 - frac) * g0[gx] + frac * g1[gx];
+        gsm[gx] = g;
+        wfo[gx] = temporal_weight(g, a_);  // eq. 8
+      }
+    } else {
+#pragma GCC ivdep
+      for (int gx = 0; gx < GW; ++gx) {
+        gsm[gx] = g0[gx];
+        wfo[gx] = temporal_weight(g0[gx], a_);  // eq. 8
       }
     }
+  };
+
+  // ---------------- pass C: eq. 7 for one full row ----------------
+  const std::vector<float>& wf_cur = s.wf[cur];
+  auto pass_c_row = [&](ChunkScratch& ts, int Y, const RowScratch& rs) {
+    const std::size_t row = std::size_t(Y) * W;
+    const float* wfr = wf_cur.data() + std::size_t(Y / gs) * GW;
+    if (dbg_grad) {
+      const float* gsr = s.grad_smooth.data() + std::size_t(Y / gs) * GW;
+      for (int X = 0; X < W; ++X) dbg_grad[row + X] = gsr[X / gs];
+    }
+    if (fused) return;  // eq. 7 already ran in pass A
+    float* wf_row = ts.wf_row.data();
+    if (Y / gs != ts.wf_row_of) {  // w_f of each intermediate cell repeated over its gs columns
+      int gx0 = 0;
+      if (gs == 2) {  // the default, in a loop that vectorises
+        gx0 = W / 2;
+        float* __restrict d = wf_row;
+        const float* __restrict sw = wfr;
+        for (int gx = 0; gx < gx0; ++gx) {
+          d[2 * gx] = sw[gx];
+          d[2 * gx + 1] = sw[gx];
+        }
+      }
+      for (int gx = gx0; gx < GW; ++gx)
+        for (int X = gx * gs; X < std::min(W, gx * gs + gs); ++X) wf_row[X] = wfr[gx];
+      ts.wf_row_of = Y / gs;
+    }
+    float* p[16];
+    for (int c = 0; c < C; ++c) p[c] = planes[c] + row;
+    blend_row(W, C, wf_row, rs.wt, rs.wc, rs.hwf, rs.hr, p, hw_new + row, ts.histw.data(), max_hw);
+    if (dbg_conf) {
+      for (int X = 0; X < W; ++X) {
+        dbg_conf[row + X] = rs.wt[X];
+        dbg_disocc[row + X] = rs.hwf[X] > 0 ? 0.0f : 1.0f;
+        dbg_wf[row + X] = wf_row[X];
+        dbg_hw[row + X] = hw_new[row + X];
+        dbg_conv[row + X] = hw_new[row + X] / max_hw;
+      }
+    }
+  };
+  // Low-pass and eq. 7 for every full row of intermediate row gy.
+  auto finish_row = [&](ChunkScratch& ts, int gy, bool in_ring) {
+    low_pass_row(ts, gy);
+    for (int Y = gy * gs; Y < std::min(H, gy * gs + gs); ++Y) pass_c_row(ts, Y, row_scratch(ts, Y, in_ring));
+  };
+
+  // Phase 1: chunks in parallel; in each, A, B and the pyramid row by row, C for the interior rows.
+  std::atomic<std::size_t> hits{0};
+  parallel_rows(nchunks, [&](int ch0, int ch1) {
+    ChunkScratch& ts = chunk_scratch();
+    std::size_t band_hits = 0;
+    for (int ch = ch0; ch < ch1; ++ch) {
+      prepare(ts);
+      const int c0 = ch * chunk, c1 = std::min(GH, c0 + chunk);
+      int next = c0;  // the next low-passed row to finish
+      for (int gy = c0; gy < c1; ++gy) {
+        std::fill_n(s.dcur.data() + std::size_t(gy) * GW, GW, 0.0f);
+        std::fill_n(s.dcount.data() + std::size_t(gy) * GW, GW, 0.0f);
+        const bool in_ring = interior[gy] != 0;
+        for (int Y = gy * gs; Y < std::min(H, gy * gs + gs); ++Y)
+          band_hits += std::size_t(pass_a_row(ts, Y, row_scratch(ts, Y, in_ring)));
+        pass_b_row(ts, gy);
+        resample_row(0, gy);
+        for (int j = 1; j <= levels; ++j)  // the pyramid rows whose last source row this was
+          if ((gy + 1) % (1 << j) == 0 || gy == GH - 1) {
+            pyramid_row(j, gy >> j);
+            resample_row(j, gy >> j);
+          }
+        for (; next < c1 && hi[next] <= gy; ++next)  // hi never decreases (monotone taps): rows in order
+          if (interior[next]) finish_row(ts, next, true);
+      }
+    }
+    hits += band_hits;
+  }, 1);
+  // Phase 2: the rows whose low-pass reaches into a neighbouring chunk.
+  std::vector<int> boundary;
+  for (int g = 0; g < GH; ++g)
+    if (!interior[g]) boundary.push_back(g);
+  parallel_rows(int(boundary.size()), [&](int b0, int b1) {
+    ChunkScratch& ts = chunk_scratch();
+    prepare(ts);
+    for (int b = b0; b < b1; ++b) finish_row(ts, boundary[b], false);
   });
   stats.history_pixels = hits;
   stats.hole_pixels = N - hits;

@@ -94,10 +94,11 @@ struct Upsampler::State {
   int GW = 0, GH = 0;
   std::vector<float> dcur, dcount;
   std::vector<float> dhist[2][3];  // relative gradients of t-1, t-2, t-3 (ping-pong)
-  std::vector<float> gfilt, wf[2], grad_smooth;
+  std::vector<float> wf[2], grad_smooth;
   std::vector<float> kern_lb, kern_ks;  // image-kernel tables expanded to full-resolution columns (per dy, tap)
   std::vector<std::vector<float>> pyramid;
   std::vector<int> pyr_w, pyr_h;
+  std::vector<float> pyr_hx[2];  // the two sampled pyramid levels, rows resampled to the gradient's columns
   // drobot cache mode: low-resolution history (value, depth, frame count), ping-pong, and filter scratch.
   std::vector<std::vector<float>> hb_val[2];
   std::vector<float> hb_z[2], hb_n[2];
@@ -288,6 +289,32 @@ inline void for_each_segment(const HistoryRow& h, int /*W*/, F&& f) {
   for (const auto& sg : h.segments) f(sg.x0, sg.x1, sg.base >= 0, sg.base >= 0 ? sg.base : 0);
 }
 
+// The image-aligned four-tap gather (taps base + X, + 1, + W, + W + 1) of N = 3 or 4 planes in one loop: the
+// weights are loaded once for all planes. Same expression per plane as the loop of gather_history_planes.
+template <int N>
+inline void gather_aligned(const float* const* prev, float* const* out, const float* __restrict w0,
+                           const float* __restrict w1, const float* __restrict w2, const float* __restrict w3, int X0,
+                           int X1, int base, int W) {
+  static_assert(N == 3 || N == 4);
+  const float* __restrict pa = prev[0];
+  const float* __restrict pb = prev[1];
+  const float* __restrict pc = prev[2];
+  const float* __restrict pd = prev[N - 1];
+  float* __restrict oa = out[0];
+  float* __restrict ob = out[1];
+  float* __restrict oc = out[2];
+  float* __restrict od = out[N - 1];
+#pragma GCC ivdep
+  for (int X = X0; X < X1; ++X) {
+    const int a = base + X;
+    const float a0 = w0[X], a1 = w1[X], a2 = w2[X], a3 = w3[X];
+    oa[X] = a0 * pa[a] + a1 * pa[a + 1] + a2 * pa[a + W] + a3 * pa[a + W + 1];
+    ob[X] = a0 * pb[a] + a1 * pb[a + 1] + a2 * pb[a + W] + a3 * pb[a + W + 1];
+    oc[X] = a0 * pc[a] + a1 * pc[a + 1] + a2 * pc[a + W] + a3 * pc[a + W + 1];
+    if constexpr (N == 4) od[X] = a0 * pd[a] + a1 * pd[a + 1] + a2 * pd[a + W] + a3 * pd[a + W + 1];
+  }
+}
+
 // The four-tap gather of up to 4 previous-frame planes with the weights of a HistoryRow, in one pass (the
 // indices and weights are loaded once for all planes).
 inline void gather_history_planes(const HistoryRow& h, const float* const* prev, float* const* out, int n, int W) {
@@ -300,6 +327,14 @@ inline void gather_history_planes(const HistoryRow& h, const float* const* prev,
   const float* __restrict w2 = h.w[2].data();
   const float* __restrict w3 = h.w[3].data();
   for_each_segment(h, W, [&](int X0, int X1, bool contiguous, int base) {
+    if (contiguous && n == 4) {  // h_w and R, G, B (herzog)
+      gather_aligned<4>(prev, out, w0, w1, w2, w3, X0, X1, base, W);
+      return;
+    }
+    if (contiguous && n == 3) {  // R, G, B (temporal)
+      gather_aligned<3>(prev, out, w0, w1, w2, w3, X0, X1, base, W);
+      return;
+    }
     for (int i = 0; i < n; ++i) {
       const float* __restrict p = prev[i];
       float* __restrict o = out[i];

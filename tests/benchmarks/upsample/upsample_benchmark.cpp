@@ -10,6 +10,7 @@
 
 #include <benchmark/benchmark.h>
 
+#include <cstdlib>
 #include <cstring>
 #include <memory>
 #include <vector>
@@ -27,10 +28,10 @@ const std::vector<std::string> kRGB = {"R", "G", "B"};
 struct Inputs {
   Image gbuffer;
   std::vector<Image> low;
-  Inputs() {
+  explicit Inputs(int scale = 1) {
     temporal::test::SyntheticScene scene;
-    scene.width = kW;
-    scene.height = kH;
+    scene.width = kW / scale;
+    scene.height = kH / scale;
     scene.k = kK;
     scene.period = 37.0f;
     scene.camera_velocity = {1.25f, 0.5f};
@@ -47,6 +48,12 @@ struct Inputs {
 
 const Inputs& inputs() {
   static const Inputs in;
+  return in;
+}
+// The same scene at a quarter of the size per axis: every buffer a method touches (about 7 MB for herzog)
+// stays in the 32 MB L3 cache.
+const Inputs& small_inputs() {
+  static const Inputs in(4);
   return in;
 }
 
@@ -81,6 +88,26 @@ void BM_Upsample(benchmark::State& state) {
   state.counters["MB"] = double(bytes) / 1e6;
 }
 
+// Time per full-resolution pixel on one thread, at the full size (range(1) = 1) and at the L3-resident quarter
+// size (range(1) = 4): equal rates mean the method is bound by its arithmetic, not by memory traffic.
+void BM_PerPixel(benchmark::State& state) {
+  const int m = int(state.range(0)), scale = int(state.range(1));
+  const Inputs& in = scale == 1 ? inputs() : small_inputs();
+  temporal::ThreadLimit one(1);
+  up::Upsampler u(options(m));
+  std::size_t t = 0;
+  for (int i = 0; i < 2 * kK * kK; ++i) (void)u.process(in.gbuffer, in.low[t++ % in.low.size()], kRGB, false);
+  for (auto _ : state) {
+    auto r = u.process(in.gbuffer, in.low[t++ % in.low.size()], kRGB, false);
+    benchmark::DoNotOptimize(r);
+  }
+  state.SetLabel(std::string(kNames[m]) + (scale == 1 ? " full size, 1 thread" : " L3-resident size, 1 thread"));
+  const double pixels = double(in.gbuffer.width()) * in.gbuffer.height();
+  // Seconds per pixel (printed with an SI prefix, e.g. 9.5n = 9.5 ns).
+  state.counters["per_pixel"] =
+      benchmark::Counter(pixels * double(state.iterations()), benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+}
+
 void BM_Stream(benchmark::State& state) {
   const int m = int(state.range(0));
   const std::size_t bytes = up::Upsampler::streamed_bytes(options(m), kW, kH, kK, 3);
@@ -99,6 +126,25 @@ void BM_Stream(benchmark::State& state) {
 
 }  // namespace
 
-BENCHMARK(BM_Upsample)->DenseRange(0, 5)->Unit(benchmark::kMillisecond)->UseRealTime();
-BENCHMARK(BM_Stream)->DenseRange(0, 5)->Unit(benchmark::kMillisecond)->UseRealTime();
-BENCHMARK_MAIN();
+// UPSAMPLE_BENCH_ITERATIONS=N fixes the iteration count (for `perf stat -e cycles,instructions` comparisons on a
+// busy machine: run with two counts and divide the difference of the counters by the difference of N).
+int main(int argc, char** argv) {
+  const char* fixed = std::getenv("UPSAMPLE_BENCH_ITERATIONS");
+  const benchmark::IterationCount n = fixed ? std::atoll(fixed) : 0;
+  auto* u = benchmark::RegisterBenchmark("BM_Upsample", BM_Upsample)->DenseRange(0, 5)->Unit(benchmark::kMillisecond)->UseRealTime();
+  auto* m = benchmark::RegisterBenchmark("BM_Stream", BM_Stream)->DenseRange(0, 5)->Unit(benchmark::kMillisecond)->UseRealTime();
+  auto* p = benchmark::RegisterBenchmark("BM_PerPixel", BM_PerPixel)
+                ->ArgsProduct({{0, 1, 2}, {1, 4}})
+                ->Unit(benchmark::kMillisecond)
+                ->UseRealTime();
+  if (n > 0) {
+    u->Iterations(n);
+    m->Iterations(n);
+    p->Iterations(n);
+  }
+  benchmark::Initialize(&argc, argv);
+  if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
+  benchmark::RunSpecifiedBenchmarks();
+  benchmark::Shutdown();
+  return 0;
+}

@@ -148,19 +148,25 @@ int main(int argc, char** argv) {
       continue;
     }
     double max_abs = 0, max_rel = 0;
-    std::size_t nan_mismatch = 0;
+    std::size_t nan_mismatch = 0, differing = 0, first = n;
     for (std::size_t i = 0; i < n; ++i) {
       const float x = results[m][i], y = ref[i];
       if (std::isnan(x) != std::isnan(y)) ++nan_mismatch;
       if (std::isnan(x) || std::isnan(y)) continue;
       const double d = std::abs(double(x) - double(y));
+      if (d > 0) {
+        first = std::min(first, i);
+        ++differing;
+      }
       max_abs = std::max(max_abs, d);
       max_rel = std::max(max_rel, d / std::max(1.0, std::abs(double(y))));
     }
     const bool ok = max_rel <= 1e-4 && nan_mismatch == 0;
     bad += ok ? 0 : 1;
-    std::printf("%-18s max abs %.3g  max rel %.3g  nan mismatch %zu  %s\n", kNames[m], max_abs, max_rel, nan_mismatch,
+    std::printf("%-18s max abs %.3g  max rel %.3g  nan mismatch %zu  %s", kNames[m], max_abs, max_rel, nan_mismatch,
                 ok ? "OK" : "DIFFERENT");
+    if (differing) std::printf("  (%zu values differ, the first at float %zu of %zu)", differing, first, std::size_t(n));
+    std::printf("\n");
   }
   return bad ? 4 : 0;
 }
