@@ -101,6 +101,8 @@ int main(int argc, char** argv) {
   app.add_option("--filter-amp", o.filter_amp, "drobot: IN_BilateralFilterAmp of Listing 7.3 (per relative depth)")
       ->check(CLI::NonNegativeNumber);
   // seed 000 section 4
+  app.add_flag("--demodulate", o.demodulate,
+               "Upsample lighting only: divide R,G,B by the G-buffer albedo, multiply the result back (section 4)");
   app.add_option("--aa-factor", o.aa_factor,
                  "Antialiasing variant: the G-buffer is m x m the output resolution; the result is downsampled")
       ->check(CLI::Range(1, 8));

@@ -75,6 +75,12 @@ struct Options {
 
   // --- seed 000 section 4 ---
   int aa_factor = 1;  // m: G-buffer is m x m the output; the result is box-downsampled
+  // Split the shader (section 4: "most high-frequency components (such as textures ...) are not expensive and
+  // could be efficiently computed for every pixel"): colour channels (R, G, B, or X.R, X.G, X.B) are divided
+  // by the G-buffer albedo at their sample pixel before upsampling, the method (and its history) works on the
+  // untextured lighting, and the result is multiplied by the full-resolution albedo. Off by default: the
+  // paper's own results "refrained from such decompositions".
+  bool demodulate = false;
 
   bool debug_layers = false;  // add debug.* layers to the result
 };
@@ -133,6 +139,8 @@ class Upsampler {
  private:
   Options options_;
   std::unique_ptr<State> state_;
+  struct Demodulation;
+  std::unique_ptr<Demodulation> demod_;
 };
 
 }  // namespace temporal::upsample

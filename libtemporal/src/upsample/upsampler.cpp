@@ -40,6 +40,7 @@ std::vector<std::string> gbuffer_layers(const Options& o) {
   std::vector<std::string> layers = {"depth", "N"};
   if (o.method != Method::Spatial) layers.push_back("motion");
   if ((o.method == Method::Temporal || o.method == Method::Herzog) && o.use_ids) layers.push_back("id");
+  if (o.demodulate) layers.push_back("albedo");
   return layers;
 }
 
@@ -209,7 +210,30 @@ void spatial_row(const Upsampler::State& s, const FrameContext& f, const Options
     for (int X = X0; X < X1; ++X) wsum[X] = w00[X] + w01[X] + w10[X] + w11[X];
 }
 
-Upsampler::Upsampler(Options options) : options_(std::move(options)), state_(std::make_unique<State>()) {}
+// Options::demodulate: the demodulated low-resolution planes and the remodulated output (the method's own
+// result, and so its history, stays demodulated).
+struct Upsampler::Demodulation {
+  std::vector<std::vector<float>> low;  // per channel, lw x lh
+  std::vector<const float*> albedo;     // per channel: the G-buffer albedo plane, nullptr = not a colour channel
+  Image out;
+};
+
+namespace {
+// Albedo below this is not divided by (black or nearly black surfaces, background): the payload passes
+// through unchanged there, and the same rule on the way back keeps the round trip exact.
+constexpr float kMinAlbedo = 1.0e-3f;
+
+// The albedo channel of a payload channel: "R"/"X.R" -> "albedo.R" (also G, B); "" for other channels.
+std::string albedo_channel(const std::string& c) {
+  const bool colour = c.size() == 1 || (c.size() > 2 && c[c.size() - 2] == '.');
+  const char last = c.empty() ? ' ' : c.back();
+  if (!colour || (last != 'R' && last != 'G' && last != 'B')) return {};
+  return std::string("albedo.") + last;
+}
+}  // namespace
+
+Upsampler::Upsampler(Options options)
+    : options_(std::move(options)), state_(std::make_unique<State>()), demod_(std::make_unique<Demodulation>()) {}
 Upsampler::~Upsampler() = default;
 
 void Upsampler::reset() { state_->have_history = false; }
@@ -250,10 +274,12 @@ Expected<Image*> Upsampler::process(const Image& gbuffer, const Image& low, std:
   };
   for (const std::string& layer : gbuffer_layers(o)) {
     const auto have = gbuffer.layer_channels(layer);
-    const bool ok = layer == "id" ? gbuffer.uint_plane("id") != nullptr
-                                  : (layer == "depth" ? need("depth.Z") != nullptr
-                                                      : (layer == "N" ? need("N.X") && need("N.Y") && need("N.Z")
-                                                                      : need("motion.X") && need("motion.Y")));
+    bool ok = false;
+    if (layer == "id") ok = gbuffer.uint_plane("id") != nullptr;
+    else if (layer == "depth") ok = need("depth.Z") != nullptr;
+    else if (layer == "N") ok = need("N.X") && need("N.Y") && need("N.Z");
+    else if (layer == "albedo") ok = need("albedo.R") && need("albedo.G") && need("albedo.B");
+    else ok = need("motion.X") && need("motion.Y");
     if (!ok)
       return Error::input(gname, "no layer '" + layer + "' (have: " + join(gbuffer.channel_names()) +
                                      "); render the G-buffer with render-gbuffer --outputs gbuffer" +
@@ -297,6 +323,22 @@ Expected<Image*> Upsampler::process(const Image& gbuffer, const Image& low, std:
     sy = i / k;
   } else {
     return Error::input(lname, "no temporal:jitter or temporal:jitterIndex in the header (docs/conventions.md, Jitter)");
+  }
+  if (o.demodulate) {
+    demod_->albedo.assign(channels.size(), nullptr);
+    int n = 0;
+    for (std::size_t c = 0; c < channels.size(); ++c) {
+      const std::string a = albedo_channel(channels[c]);
+      if (a.empty()) continue;
+      demod_->albedo[c] = gbuffer.plane(a);
+      if (!demod_->albedo[c])
+        return Error::input(gname, "no channel '" + a + "' for --demodulate (have: " + join(gbuffer.channel_names()) +
+                                       "); render the G-buffer with render-gbuffer --outputs gbuffer");
+      ++n;
+    }
+    if (n == 0)
+      return Error::usage("--demodulate needs colour channels (R, G, B or LAYER.R, .G, .B) in the payload; "
+                          "the selected ones are " + join(std::vector<std::string>(channels.begin(), channels.end())));
   }
   f.W = gbuffer.width();
   f.H = gbuffer.height();
@@ -365,6 +407,29 @@ Expected<Image*> Upsampler::process(const Image& gbuffer, const Image& low, std:
   std::size_t nonfinite = 0;
   for (int c = 0; c < f.C; ++c) nonfinite += count_non_finite({f.low[c], std::size_t(f.lw) * f.lh});
   stats.non_finite_input = nonfinite;
+  if (o.demodulate) {
+    // Low-resolution sample (x, y) lies on full-resolution pixel (k x + sx, k y + sy) (docs/conventions.md).
+    demod_->low.resize(f.C);
+    for (int c = 0; c < f.C; ++c) {
+      if (!demod_->albedo[c]) continue;
+      auto& dst = demod_->low[c];
+      dst.resize(std::size_t(f.lw) * f.lh);
+      const float* src = f.low[c];
+      const float* alb = demod_->albedo[c];
+      parallel_rows(f.lh, [&](int y0, int y1) {
+        for (int y = y0; y < y1; ++y) {
+          const float* ar = alb + std::size_t(k * y + sy) * f.W + sx;
+          const float* sr = src + std::size_t(y) * f.lw;
+          float* dr = dst.data() + std::size_t(y) * f.lw;
+          for (int x = 0; x < f.lw; ++x) {
+            const float a = ar[std::size_t(k) * x];
+            dr[x] = a >= kMinAlbedo ? sr[x] / a : sr[x];
+          }
+        }
+      });
+      f.low[c] = dst.data();
+    }
+  }
   gather_low_geometry(s, f);
 
   switch (o.method) {
@@ -383,6 +448,27 @@ Expected<Image*> Upsampler::process(const Image& gbuffer, const Image& low, std:
   s.prev_sy = sy;
 
   Image* result = &s.result[s.cur];
+  if (o.demodulate) {
+    // Multiply by the full-resolution albedo into a separate image: s.result stays the (demodulated) history.
+    Image& out = demod_->out;
+    if (out.width() != f.W || out.height() != f.H) out = Image(f.W, f.H);
+    for (const auto& name : result->channel_names()) {
+      const float* src = result->plane(name);
+      float* dst = out.add_channel(name);
+      const float* alb = nullptr;
+      for (int c = 0; c < f.C; ++c)
+        if (channels[c] == name) alb = demod_->albedo[c];
+      parallel_rows(f.H, [&](int y0, int y1) {
+        const std::size_t b = std::size_t(y0) * f.W, e = std::size_t(y1) * f.W;
+        if (!alb) {
+          std::copy(src + b, src + e, dst + b);
+          return;
+        }
+        for (std::size_t i = b; i < e; ++i) dst[i] = alb[i] >= kMinAlbedo ? src[i] * alb[i] : src[i];
+      });
+    }
+    result = &out;
+  }
   if (m > 1) {
     // Seed 000 section 4: the upsampled result at m x m the display resolution, box-downsampled.
     const int ow = f.W / m, oh = f.H / m;
