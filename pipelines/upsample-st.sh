@@ -1,20 +1,27 @@
 #!/usr/bin/env bash
 # Reproduces seed 000's Table 1 and Figure 8 (Herzog et al. 2010, "Spatio-Temporal Upsampling on the GPU") on the
 # built-in scenes: each scene is rendered by render-gbuffer (full-resolution G-buffer, the payload at 1/4 x 1/4
-# under the regular 4x4 jitter pattern, the full-resolution payload's cost, and a supersampled reference), every
-# upsample-st method rebuilds the full-resolution payload, and compare reports PSNR per frame (Figure 8's PSNR, as
-# PNG charts) and the table of Table 1: per method, low-resolution shading ms + upsampling ms next to the
-# full-resolution shading ms, and mean PSNR against the reference.
+# under the regular 4x4 jitter pattern, and the same payload at full resolution, one sample at each pixel centre),
+# every upsample-st method rebuilds the full-resolution payload, and compare reports PSNR per frame against the
+# full-resolution payload (Figure 8's measure, as PNG charts) and the table of Table 1: per method,
+# low-resolution shading ms + upsampling ms next to the full-resolution shading ms, and mean PSNR.
 #
 # Usage: pipelines/upsample-st.sh [BUILD_DIR] [OUT_DIR] [SCENE.glb ...]
 #   BUILD_DIR  where the tools were built (default build/release)
 #   OUT_DIR    report folder (default report/upsample-st)
 #   SCENE      scenes to run (default: the built-in walkers (the horses scene), tower and fan of assets/scenes)
-# Environment: SIZE (default 640x512; the paper used 1280x1024), FRAMES (default 0-63), FPS (default 30),
-#   FACTOR (default 4), METHODS (default "spatial temporal herzog drobot"; also "herzog-lagged" = herzog
-#   --lagged-wf and "drobot-refresh" = drobot --mode refresh), REFERENCE_SPP (default 16),
-#   RENDER_ARGS (extra render-gbuffer options; default "--payload direct,shadow,ssao"), UPSAMPLE_ARGS (extra
-#   upsample-st options for every method).
+# Environment: SIZE (default 640x512; the paper used 1280x1024), FRAMES (default 0-47), FPS (default 30),
+#   FACTOR (default 4), METHODS (default "spatial temporal herzog herzog-favor-spatial drobot spatial-demod
+#   herzog-demod"; a method name takes variant suffixes: -lagged = herzog --lagged-wf, -favor-spatial =
+#   herzog --favor-spatial (a = 0.7, as the paper's elephant scene), -refresh = drobot --mode refresh, -demod =
+#   --demodulate (lighting upsampled, albedo from the G-buffer; seed 000 section 4)), REFERENCE_SPP (default 0: none; N > 0 also renders an N-spp supersampled reference and
+#   adds a PSNR column against it), RENDER_ARGS (extra render-gbuffer options; default "--payload
+#   direct,shadow,ssao,gi", Table 1's "Horses (AO+GI)"), UPSAMPLE_ARGS (extra upsample-st options for every method).
+#
+# Ground truth: the issue and the paper's Figure 8 measure against full-resolution rendering of the same payload
+# (render-gbuffer's `color` with `--jitter none`: one sample at every pixel centre, the samples the regular
+# pattern visits). A supersampled reference also scores the aliasing of that full-resolution payload itself and
+# the per-frame SSAO / VPL noise, which no upsampler is asked to remove; it is optional.
 #
 # Costs: shading ms are render-gbuffer's `shadeLow` (payload at 1/FACTOR resolution) and `shadeFull` (the same
 # payload at full resolution) from timings.csv, upsampling ms are upsample-st's `temporal:computeMs` (mean
@@ -26,12 +33,12 @@ BUILD="${1:-build/release}"
 OUT="${2:-report/upsample-st}"
 shift $(( $# > 2 ? 2 : $# ))
 SIZE="${SIZE:-640x512}"
-FRAMES="${FRAMES:-0-63}"
+FRAMES="${FRAMES:-0-47}"
 FPS="${FPS:-30}"
 FACTOR="${FACTOR:-4}"
-METHODS="${METHODS:-spatial temporal herzog drobot}"
-REFERENCE_SPP="${REFERENCE_SPP:-16}"
-RENDER_ARGS="${RENDER_ARGS:---payload direct,shadow,ssao}"
+METHODS="${METHODS:-spatial temporal herzog herzog-favor-spatial drobot spatial-demod herzog-demod}"
+REFERENCE_SPP="${REFERENCE_SPP:-0}"
+RENDER_ARGS="${RENDER_ARGS:---payload direct,shadow,ssao,gi}"
 UPSAMPLE_ARGS="${UPSAMPLE_ARGS:-}"
 
 case "$BUILD" in /*) ;; *) BUILD="$PWD/$BUILD" ;; esac
@@ -69,12 +76,16 @@ summary="$OUT/summary.md"
 {
   echo "# upsample-st: seed 000 Table 1 / Figure 8 on the built-in scenes"
   echo
-  echo "Size $SIZE, factor $FACTOR, frames $FRAMES at $FPS fps; reference: $REFERENCE_SPP spp; render options: $RENDER_ARGS."
+  echo "Size $SIZE, factor $FACTOR, frames $FRAMES at $FPS fps; render options: $RENDER_ARGS."
   echo "shade = render-gbuffer shadeLow (1/$FACTOR payload), up = upsample-st compute ms, full = shadeFull"
-  echo "(payload at full resolution); PSNR (RGB, dB) against the reference, mean over frames."
+  ss_note="."
+  [[ "$REFERENCE_SPP" -gt 0 ]] && ss_note=" (and against a $REFERENCE_SPP-spp supersampled reference)."
+  echo "(payload at full resolution); PSNR (RGB, dB, mean over frames) against the full-resolution payload$ss_note"
   echo
 } > "$summary"
 
+outputs="gbuffer,shade,color"
+[[ "$REFERENCE_SPP" -gt 0 ]] && outputs+=",reference"
 for scene in "${scenes[@]}"; do
   name="$(basename "${scene%.*}")"
   dir="$OUT/$name"
@@ -82,16 +93,19 @@ for scene in "${scenes[@]}"; do
   echo "== $name: rendering ($SIZE, factor $FACTOR, frames $FRAMES)" >&2
   # shellcheck disable=SC2086
   "$render" "$scene" --out "$dir/render" --size "$SIZE" --fps "$FPS" --frames "$FRAMES" --factor "$FACTOR" \
-    --outputs gbuffer,shade,reference,color --reference-spp "$REFERENCE_SPP" $RENDER_ARGS
+    --outputs "$outputs" --jitter none --reference-spp "$(( REFERENCE_SPP > 0 ? REFERENCE_SPP : 1 ))" $RENDER_ARGS
 
   tests=()
   names=""
   for m in $METHODS; do
-    case "$m" in
-      herzog-lagged) args="--method herzog --lagged-wf" ;;
-      drobot-refresh) args="--method drobot --mode refresh" ;;
-      *) args="--method $m" ;;
-    esac
+    # METHOD[-VARIANT...]: lagged = --lagged-wf, favor-spatial = --favor-spatial (a = 0.7), refresh = drobot
+    # --mode refresh, demod = --demodulate (lighting upsampled, albedo from the G-buffer).
+    args="--method ${m%%-*}"
+    rest="${m#"${m%%-*}"}"
+    [[ "$rest" == *-lagged* ]] && args+=" --lagged-wf"
+    [[ "$rest" == *-favor-spatial* ]] && args+=" --favor-spatial"
+    [[ "$rest" == *-refresh* ]] && args+=" --mode refresh"
+    [[ "$rest" == *-demod* ]] && args+=" --demodulate"
     echo "== $name: upsample-st $args" >&2
     # shellcheck disable=SC2086
     "$upsample" --gbuffer "$dir/render/gbuffer.####.exr" --input "$dir/render/shade.####.exr" \
@@ -100,24 +114,42 @@ for scene in "${scenes[@]}"; do
     names+="${names:+,}$m"
   done
 
-  echo "== $name: compare" >&2
-  "$compare" --reference "$dir/render/reference.####.exr" "${tests[@]}" --names "$names" \
+  echo "== $name: compare against the full-resolution payload" >&2
+  "$compare" --reference "$dir/render/color.####.exr" "${tests[@]}" --names "$names" \
     --gbuffer "$dir/render/gbuffer.####.exr" --csv "$dir/metrics.csv" --json "$dir/metrics.json" \
     --plot "$dir/psnr.png" | tee "$dir/compare.txt"
+  if [[ "$REFERENCE_SPP" -gt 0 ]]; then
+    echo "== $name: compare against the $REFERENCE_SPP-spp reference" >&2
+    "$compare" --reference "$dir/render/reference.####.exr" "${tests[@]}" --names "$names" \
+      --csv "$dir/metrics-supersampled.csv" | tee "$dir/compare-supersampled.txt"
+  fi
 
   shade_low="$(csv_mean "$dir/render/timings.csv" shadeLow)"
   shade_full="$(csv_mean "$dir/render/timings.csv" shadeFull)"
   {
     echo "## $name"
     echo
-    echo "| method | shade ms | up ms | total ms | full-res shade ms | speed-up | PSNR dB |"
-    echo "|---|---|---|---|---|---|---|"
+    if [[ "$REFERENCE_SPP" -gt 0 ]]; then
+      echo "| method | shade ms | up ms | total ms | full-res shade ms | speed-up | PSNR dB | PSNR vs ${REFERENCE_SPP} spp |"
+      echo "|---|---|---|---|---|---|---|---|"
+    else
+      echo "| method | shade ms | up ms | total ms | full-res shade ms | speed-up | PSNR dB |"
+      echo "|---|---|---|---|---|---|---|"
+    fi
     # compare's table: sequence frames psnr_rgb psnr_y ssim flicker compute_ms
-    awk -v low="$shade_low" -v full="$shade_full" '
+    awk -v low="$shade_low" -v full="$shade_full" -v ss="$dir/compare-supersampled.txt" -v has_ss="$REFERENCE_SPP" '
+      BEGIN { if (has_ss > 0) while ((getline line < ss) > 0) { split(line, f, " "); if (f[1] != "sequence") sspsnr[f[1]] = f[3] } }
       NR > 1 && NF >= 7 {
         up = ($7 == "-") ? 0 : $7; total = low + up
-        printf "| %s | %s | %s | %.3f | %s | %.1fx | %s |\n", $1, low, $7, total, full, (total > 0 ? full / total : 0), $3
+        printf "| %s | %s | %s | %.3f | %s | %.1fx | %s |", $1, low, $7, total, full, (total > 0 ? full / total : 0), $3
+        if (has_ss > 0) printf " %s |", ($1 in sspsnr) ? sspsnr[$1] : "-"
+        printf "\n"
       }' "$dir/compare.txt"
+    # The issue's reading of Table 1: herzog's margin over both baselines.
+    awk 'NR > 1 && NF >= 7 { p[$1] = $3 }
+      END { if (("herzog" in p) && ("spatial" in p) && ("temporal" in p))
+              printf "\nherzog - spatial: %+.2f dB, herzog - temporal: %+.2f dB.\n", p["herzog"] - p["spatial"], p["herzog"] - p["temporal"] }' \
+      "$dir/compare.txt"
     echo
     echo "Per-frame PSNR: $name/psnr.png; metrics: $name/metrics.csv, $name/metrics.json."
     echo

@@ -14,7 +14,8 @@ namespace {
 class MorphCli : public ::testing::Test {
  protected:
   void SetUp() override {
-    dir_ = test::scratch_dir("morph_cli");
+    // One folder per test: CTest runs the tests of this fixture in parallel processes.
+    dir_ = test::scratch_dir(std::string("morph_cli_") + ::testing::UnitTest::GetInstance()->current_test_info()->name());
     for (int n = 0; n < 2; ++n) {
       Image c = test::make_color(32, 24, [n](float x, float y, int ch) { return test::texture(x - 3.0f * n, y, ch); });
       c.metadata().fps = 40.0;

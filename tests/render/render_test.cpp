@@ -143,14 +143,21 @@ TEST(RenderMotion, BackgroundCarriesCameraMotionAndFarDepth) {
   EXPECT_GT(std::fabs(g.plane("motion.X")[0]), 0.1f);
 }
 
-TEST(RenderJitter, RegularPatternCoversEveryFullResPixelOnce) {
-  // Static scene, direct light only (no random terms): the low-res sample of frame i at (x, y) must be
-  // full-res pixel (k x + sx, k y + sy), i.e. equal the unjittered full-res payload there.
-  SyntheticScene scene;
+// The jitter tests' set-up: 64x48, direct light only (no random terms), the low-resolution payload and the
+// unjittered full-resolution colour.
+static RenderOptions jitter_test_options() {
   RenderOptions o = small_options(64, 48);
   o.payload = *parse_payload_terms("direct", o.payload);
   o.outputs = RenderOutputs{false, true, false, true};
   o.color_jitter = JitterMode::None;
+  return o;
+}
+
+TEST(RenderJitter, RegularPatternCoversEveryFullResPixelOnce) {
+  // Static scene: the low-res sample of frame i at (x, y) must be full-res pixel (k x + sx, k y + sy), i.e.
+  // equal the unjittered full-res payload there.
+  SyntheticScene scene;
+  RenderOptions o = jitter_test_options();
   // Texture filtering must depend on the sample point only: no mip levels, and bilinear for both
   // magnification (full res) and minification (low res).
   o.mipmaps = false;
@@ -197,10 +204,7 @@ TEST(RenderJitter, RegularPatternCoversEveryFullResPixelOnce) {
 // textures mipmapped: the low-res sample (x, y) against full-res pixel (k x + sx, k y + sy).
 static double mean_sample_difference(std::optional<float> shade_mip_bias) {
   SyntheticScene scene;
-  RenderOptions o = small_options(64, 48);
-  o.payload = *parse_payload_terms("direct", o.payload);
-  o.outputs = RenderOutputs{false, true, false, true};
-  o.color_jitter = JitterMode::None;
+  RenderOptions o = jitter_test_options();
   o.shade_mip_bias = shade_mip_bias;
   scene.textures[0].nearest = false;
   const int k = o.factor;
