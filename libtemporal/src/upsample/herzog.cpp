@@ -409,7 +409,6 @@ void run_herzog(Upsampler::State& s, const FrameContext& f, const Options& o, Fr
     int row_hits = 0;
     const std::size_t row = std::size_t(Y) * W;
     const int r0 = s.rows.i0[Y] * f.lw, r1 = s.rows.i1[Y] * f.lw;
-    const float vy0 = s.rows.v0[Y], vy1 = s.rows.v1[Y];
     const int dy = s.rows.d[Y];
     const float* __restrict lb0 = s.kern_lb.data() + (std::size_t(dy) * 4 + 0) * W;
     const float* __restrict lb1 = s.kern_lb.data() + (std::size_t(dy) * 4 + 1) * W;
@@ -448,52 +447,17 @@ void run_herzog(Upsampler::State& s, const FrameContext& f, const Options& o, Fr
         std::fill(wfk_, wfk_ + W, 0.0f);
       }
     }
-    const float* __restrict z = f.z + row;
-    const float* __restrict nx = f.nx + row;
-    const float* __restrict ny = f.ny + row;
-    const float* __restrict nz = f.nz + row;
-    const float* __restrict cv0 = s.cols.v0.data();
-    const float* __restrict cv1 = s.cols.v1.data();
     const float* __restrict ekr = ts.ekern.data();
     // Expanded plane q, tap t of low row e (see ExpandedLowRows).
     const std::size_t es = ts.low_rows.stride();
     auto ex = [es, k](const float* e, int q, int t) { return e + std::size_t(q) * es + std::size_t(t) * k; };
-    const float *__restrict z00 = ex(e0, 0, 0), *__restrict z01 = ex(e0, 0, 1), *__restrict z10 = ex(e1, 0, 0),
-                *__restrict z11 = ex(e1, 0, 1);
-    const float *__restrict x00 = ex(e0, 1, 0), *__restrict x01 = ex(e0, 1, 1), *__restrict x10 = ex(e1, 1, 0),
-                *__restrict x11 = ex(e1, 1, 1);
-    const float *__restrict y00 = ex(e0, 2, 0), *__restrict y01 = ex(e0, 2, 1), *__restrict y10 = ex(e1, 2, 0),
-                *__restrict y11 = ex(e1, 2, 1);
-    const float *__restrict n00 = ex(e0, 3, 0), *__restrict n01 = ex(e0, 3, 1), *__restrict n10 = ex(e1, 3, 0),
-                *__restrict n11 = ex(e1, 3, 1);
-    const float *__restrict v00 = ex(e0, 4, 0), *__restrict v01 = ex(e0, 4, 1), *__restrict v10 = ex(e1, 4, 0),
-                *__restrict v11 = ex(e1, 4, 1);
-    // Geometric weight (normal and depth tents, cubed) of one low-resolution sample.
-    auto geo = [=](float zi, float ax, float ay, float az, float lx, float ly, float lzn, float lzz, float lv) {
-      const float dot = ax * lx + ay * ly + az * lzn;
-      const float xn = std::max(0.0f, 1.0f - dot);
-      const float tn = std::max(kKernelEpsilon, 1.0f - xn * xn * inv_sn2);
-      const float dz = zi - lzz;
-      const float td = std::max(kKernelEpsilon, 1.0f - dz * dz * inv_sd2);
-      const float w = tn * tn * tn * td * td * td * lv;
-      return w >= 0.0f ? w : 0.0f;
-    };
+    // Geometric weights of the four taps (normal and depth tents, cubed, times tap existence).
+    expanded_geometric_weights(s, f, inv_sn2, inv_sd2, Y, e0, e1, es, w00, w01, w10, w11);
     float* __restrict wt = rs.wt;
     float* __restrict wc = rs.wc;
+    // History confidence of this frame's samples: the same weights with the sharp kernel (w_f = 1).
 #pragma GCC ivdep
-    for (int X = 0; X < W; ++X) {
-      const float zi = z[X], ax = nx[X], ay = ny[X], az = nz[X];
-      const float g00 = geo(zi, ax, ay, az, x00[X], y00[X], n00[X], z00[X], v00[X]) * cv0[X] * vy0;
-      const float g01 = geo(zi, ax, ay, az, x01[X], y01[X], n01[X], z01[X], v01[X]) * cv1[X] * vy0;
-      const float g10 = geo(zi, ax, ay, az, x10[X], y10[X], n10[X], z10[X], v10[X]) * cv0[X] * vy1;
-      const float g11 = geo(zi, ax, ay, az, x11[X], y11[X], n11[X], z11[X], v11[X]) * cv1[X] * vy1;
-      w00[X] = g00;
-      w01[X] = g01;
-      w10[X] = g10;
-      w11[X] = g11;
-      // History confidence of this frame's samples: the same weights with the sharp kernel (w_f = 1).
-      wc[X] = g00 * ks0[X] + g01 * ks1[X] + g10 * ks2[X] + g11 * ks3[X];
-    }
+    for (int X = 0; X < W; ++X) wc[X] = w00[X] * ks0[X] + w01[X] * ks1[X] + w10[X] * ks2[X] + w11[X] * ks3[X];
     // The adaptive image kernel, in a loop of its own: fused with the geometry above, the loop body is too
     // large for GCC's if-conversion and the whole loop stays scalar.
 #pragma GCC ivdep

@@ -171,23 +171,19 @@ void spatial_row(const Upsampler::State& s, const FrameContext& f, const Options
   const float* __restrict lny = s.lny.data();
   const float* __restrict lnz = s.lnz.data();
   const float* __restrict lvalid = s.lvalid.data();
+  // Geometric weights (eq. 2-3, shared with the expanded-row kernels: same operations in the same order, so
+  // the same bits) times tap existence, then the hat image kernel.
   auto geo = [=](int j, float zi, float ax, float ay, float az) {
-    const float dot = ax * lnx[j] + ay * lny[j] + az * lnz[j];
-    const float xn = std::max(0.0f, 1.0f - dot);
-    const float tn = std::max(kKernelEpsilon, 1.0f - xn * xn * inv_sn2);
-    const float dz = zi - lz[j];
-    const float td = std::max(kKernelEpsilon, 1.0f - dz * dz * inv_sd2);
-    const float w = tn * tn * tn * td * td * td * lvalid[j];
-    return w >= 0.0f ? w : 0.0f;  // NaN geometry at the pixel gives no weight
+    return geometric_weight(zi, ax, ay, az, lnx[j], lny[j], lnz[j], lz[j], lvalid[j], inv_sn2, inv_sd2);
   };
 #pragma GCC ivdep
   for (int X = X0; X < X1; ++X) {
     const float fx = float(cd[X]) * inv_k;
     const float zi = z[X], ax = nx[X], ay = ny[X], az = nz[X];
-    w00[X] = geo(r0 + ci0[X], zi, ax, ay, az) * (1 - fx) * (1 - fy) * cv0[X] * vy0;
-    w01[X] = geo(r0 + ci1[X], zi, ax, ay, az) * fx * (1 - fy) * cv1[X] * vy0;
-    w10[X] = geo(r1 + ci0[X], zi, ax, ay, az) * (1 - fx) * fy * cv0[X] * vy1;
-    w11[X] = geo(r1 + ci1[X], zi, ax, ay, az) * fx * fy * cv1[X] * vy1;
+    w00[X] = geo(r0 + ci0[X], zi, ax, ay, az) * cv0[X] * vy0 * (1 - fx) * (1 - fy);
+    w01[X] = geo(r0 + ci1[X], zi, ax, ay, az) * cv1[X] * vy0 * fx * (1 - fy);
+    w10[X] = geo(r1 + ci0[X], zi, ax, ay, az) * cv0[X] * vy1 * (1 - fx) * fy;
+    w11[X] = geo(r1 + ci1[X], zi, ax, ay, az) * cv1[X] * vy1 * fx * fy;
   }
   for (int c = 0; c < f.C; ++c) {
     const float* __restrict l0 = f.low[c] + r0;
