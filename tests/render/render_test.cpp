@@ -9,6 +9,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <functional>
 #include <limits>
 #include <optional>
 #include <cstdio>
@@ -153,6 +154,26 @@ static RenderOptions jitter_test_options() {
   return o;
 }
 
+// Renders the k*k frames of the regular pattern of the static synthetic scene and hands each frame's
+// low-resolution payload and full-resolution colour to visit(frame, low, full). False when rendering fails.
+static bool render_pattern(const SyntheticScene& scene, const RenderOptions& o,
+                           const std::function<void(int, const Image&, const Image&)>& visit) {
+  auto r = Renderer::create(o, scene.geometry());
+  EXPECT_TRUE(r) << r.error().message;
+  if (!r) return false;
+  const FrameState state = scene.evaluate(0.0);
+  for (int frame = 0; frame < o.factor * o.factor; ++frame) {
+    FrameInput in;
+    in.frame = frame;
+    in.current = &state;
+    auto out = r->render(in);
+    EXPECT_TRUE(out) << out.error().message;
+    if (!out) return false;
+    visit(frame, *out->shade, *out->color);
+  }
+  return true;
+}
+
 TEST(RenderJitter, RegularPatternCoversEveryFullResPixelOnce) {
   // Static scene: the low-res sample of frame i at (x, y) must be full-res pixel (k x + sx, k y + sy), i.e.
   // equal the unjittered full-res payload there.
@@ -163,19 +184,9 @@ TEST(RenderJitter, RegularPatternCoversEveryFullResPixelOnce) {
   o.mipmaps = false;
   scene.textures[0].nearest = false;
   const int k = o.factor;
-  auto r = Renderer::create(o, scene.geometry());
-  ASSERT_TRUE(r) << r.error().message;
-  const FrameState state = scene.evaluate(0.0);
   std::vector<int> hits(std::size_t(o.width) * o.height, 0);
   int compared = 0, equal = 0;
-  for (int frame = 0; frame < k * k; ++frame) {
-    FrameInput in;
-    in.frame = frame;
-    in.current = &state;
-    auto out = r->render(in);
-    ASSERT_TRUE(out) << out.error().message;
-    const Image& low = *out->shade;
-    const Image& full = *out->color;
+  ASSERT_TRUE(render_pattern(scene, o, [&](int frame, const Image& low, const Image& full) {
     ASSERT_EQ(low.width(), o.width / k);
     ASSERT_EQ(low.metadata().jitter_index.value_or(-1), frame);
     const glm::vec2 j = *low.metadata().jitter;
@@ -194,7 +205,7 @@ TEST(RenderJitter, RegularPatternCoversEveryFullResPixelOnce) {
           else if (std::getenv("RENDER_TEST_DEBUG")) std::printf("f%d low(%d,%d) full(%d,%d) %s %.5f vs %.5f\n", frame, x, y, fx, fy, c, a, b);
         }
       }
-  }
+  }));
   for (std::size_t i = 0; i < hits.size(); ++i) ASSERT_EQ(hits[i], 1) << "pixel " << i;
   // Triangle edges may rasterise differently by a rounding; everything else is the same sample.
   EXPECT_GT(double(equal) / compared, 0.99) << equal << " of " << compared;
@@ -208,21 +219,9 @@ static double mean_sample_difference(std::optional<float> shade_mip_bias) {
   o.shade_mip_bias = shade_mip_bias;
   scene.textures[0].nearest = false;
   const int k = o.factor;
-  auto r = Renderer::create(o, scene.geometry());
-  EXPECT_TRUE(r) << r.error().message;
-  if (!r) return 1e9;
-  const FrameState state = scene.evaluate(0.0);
   double sum = 0;
   std::size_t n = 0;
-  for (int frame = 0; frame < k * k; ++frame) {
-    FrameInput in;
-    in.frame = frame;
-    in.current = &state;
-    auto out = r->render(in);
-    EXPECT_TRUE(out) << out.error().message;
-    if (!out) return 1e9;
-    const Image& low = *out->shade;
-    const Image& full = *out->color;
+  const bool ok = render_pattern(scene, o, [&](int frame, const Image& low, const Image& full) {
     const int sx = frame % k, sy = frame / k;
     for (int y = 0; y < low.height(); ++y)
       for (int x = 0; x < low.width(); ++x)
@@ -231,7 +230,8 @@ static double mean_sample_difference(std::optional<float> shade_mip_bias) {
                            full.plane(c)[std::size_t(k * y + sy) * o.width + k * x + sx]);
           ++n;
         }
-  }
+  });
+  if (!ok) return 1e9;
   return sum / double(n);
 }
 

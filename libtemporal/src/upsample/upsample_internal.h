@@ -354,20 +354,6 @@ inline void gather_history_planes(const HistoryRow& h, const float* const* prev,
   });
 }
 
-// The four-tap gather of a previous-frame plane with the weights of a HistoryRow.
-inline void gather_history(const HistoryRow& h, const float* prev, float* out, int W) {
-  const int* __restrict q0 = h.q[0].data();
-  const int* __restrict q1 = h.q[1].data();
-  const int* __restrict q2 = h.q[2].data();
-  const int* __restrict q3 = h.q[3].data();
-  const float* __restrict w0 = h.w[0].data();
-  const float* __restrict w1 = h.w[1].data();
-  const float* __restrict w2 = h.w[2].data();
-  const float* __restrict w3 = h.w[3].data();
-#pragma GCC ivdep
-  for (int X = 0; X < W; ++X) out[X] = w0[X] * prev[q0[X]] + w1[X] * prev[q1[X]] + w2[X] * prev[q2[X]] + w3[X] * prev[q3[X]];
-}
-
 // The geometry (z, N, validity) and payload of one low-resolution row, expanded to full-resolution columns:
 // plane q (0..4: z, nx, ny, nz, valid; 5 + c: payload channel c) holds W + k values, value[low_row + ext[X]]
 // with ext[X] = clamp(floor((X - sx) / k), 0, lw - 1) (W = k lw). Tap i0 of column X is entry X and tap

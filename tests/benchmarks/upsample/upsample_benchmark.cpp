@@ -4,6 +4,7 @@
 // moving that many bytes (half read, half written). Targets (issue 4): herzog <= 1.5x spatial, and within
 // 2.5x of its streaming bound.
 #include "synthetic.h"
+#include "upsample_variants.h"
 
 #include "temporal/parallel.h"
 #include "temporal/upsample.h"
@@ -57,20 +58,9 @@ const Inputs& small_inputs() {
   return in;
 }
 
-up::Options options(int method) {
-  up::Options o;
-  switch (method) {
-    case 0: o.method = up::Method::Spatial; break;
-    case 1: o.method = up::Method::Temporal; break;
-    case 2: o.method = up::Method::Herzog; break;
-    case 3: o.method = up::Method::Drobot; break;
-    case 4: o.method = up::Method::Drobot; o.drobot_mode = up::DrobotMode::Refresh; break;
-    default: o.method = up::Method::Herzog; o.lagged_wf = true; break;
-  }
-  return o;
-}
+up::Options options(int method) { return temporal::test::upsample_variant(method); }
 
-const char* kNames[] = {"spatial", "temporal", "herzog", "drobot", "drobot-refresh", "herzog-lagged-wf"};
+const auto& kNames = temporal::test::kUpsampleVariantNames;
 
 void BM_Upsample(benchmark::State& state) {
   const int m = int(state.range(0));

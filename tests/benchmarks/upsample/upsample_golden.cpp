@@ -3,6 +3,7 @@
 // k = 4, 3 (odd width) and 2 (gradient scale 4)) and writes every output float to FILE (`write FILE`), or compares against FILE
 // (`check FILE`), printing the largest absolute and relative differences per method.
 #include "synthetic.h"
+#include "upsample_variants.h"
 
 #include "temporal/upsample.h"
 
@@ -21,19 +22,8 @@ namespace {
 
 const std::vector<std::string> kRGB = {"R", "G", "B"};
 
-up::Options options(int method) {
-  up::Options o;
-  switch (method) {
-    case 0: o.method = up::Method::Spatial; break;
-    case 1: o.method = up::Method::Temporal; break;
-    case 2: o.method = up::Method::Herzog; break;
-    case 3: o.method = up::Method::Drobot; break;
-    case 4: o.method = up::Method::Drobot; o.drobot_mode = up::DrobotMode::Refresh; break;
-    default: o.method = up::Method::Herzog; o.lagged_wf = true; break;
-  }
-  return o;
-}
-const char* kNames[] = {"spatial", "temporal", "herzog", "drobot", "drobot-refresh", "herzog-lagged-wf"};
+up::Options options(int method) { return temporal::test::upsample_variant(method); }
+const auto& kNames = temporal::test::kUpsampleVariantNames;
 
 void append(std::vector<float>& v, const Image& img) {
   for (const auto& n : img.channel_names()) {
