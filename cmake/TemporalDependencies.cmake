@@ -24,9 +24,10 @@ pkg_check_modules(OSMESA REQUIRED IMPORTED_TARGET osmesa)
 find_package(TinyGLTF CONFIG REQUIRED)
 
 find_package(MPI REQUIRED COMPONENTS C)
-find_package(VTK 9.1 REQUIRED COMPONENTS CommonCore CommonDataModel ChartsCore ViewsContext2D
-  RenderingContext2D RenderingContextOpenGL2 RenderingCore RenderingOpenGL2 RenderingFreeType IOImage
-  InteractionStyle)
+set(TEMPORAL_VTK_COMPONENTS CommonCore CommonDataModel ChartsCore ViewsContext2D RenderingContext2D
+  RenderingContextOpenGL2 RenderingCore RenderingOpenGL2 RenderingFreeType IOImage InteractionStyle)
+find_package(VTK 9.1 REQUIRED COMPONENTS ${TEMPORAL_VTK_COMPONENTS})
+list(JOIN TEMPORAL_VTK_COMPONENTS " " TEMPORAL_VTK_COMPONENTS)  # for temporalConfig.cmake
 
 if(TEMPORAL_BUILD_TESTS)
   find_package(GTest CONFIG REQUIRED)

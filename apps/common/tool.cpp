@@ -1,6 +1,6 @@
 #include "tool.h"
 
-#include "temporal/parallel.h"
+#include "temporal/core/parallel.h"
 
 #include <unistd.h>
 

@@ -3,7 +3,7 @@
 // No algorithm lives here.
 #pragma once
 
-#include "temporal/error.h"
+#include "temporal/core/error.h"
 
 #include <CLI/CLI.hpp>
 

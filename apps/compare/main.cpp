@@ -1,10 +1,10 @@
 // compare: per-frame PSNR, SSIM and flicker of test sequences against a reference, as CSV, JSON, error-map EXRs
-// and VTK plots, with pass/fail thresholds for pipelines. The metrics live in libtemporal (temporal/comparison.h);
+// and VTK plots, with pass/fail thresholds for pipelines. The metrics live in libtemporal (temporal/metrics/comparison.h);
 // docs/compare.md defines them.
 #include "tool.h"
 
-#include "temporal/comparison.h"
-#include "temporal/plot.h"
+#include "temporal/metrics/comparison.h"
+#include "temporal/plot/plot.h"
 
 #include <cmath>
 #include <cstdio>

@@ -3,12 +3,12 @@
 // its eq. 1. Options, defaults and every choice: docs/filter-phlm.md.
 #include "tool.h"
 
-#include "temporal/ema.h"
-#include "temporal/exr.h"
-#include "temporal/fxaa.h"
-#include "temporal/phlm.h"
-#include "temporal/sequence.h"
-#include "temporal/taa.h"
+#include "temporal/phlm/ema.h"
+#include "temporal/core/exr.h"
+#include "temporal/phlm/fxaa.h"
+#include "temporal/phlm/phlm.h"
+#include "temporal/core/sequence.h"
+#include "temporal/phlm/taa.h"
 
 #include <algorithm>
 #include <chrono>

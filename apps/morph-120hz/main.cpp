@@ -3,11 +3,11 @@
 // tracking the motion perceives on a hold-type display (seed 004 section 3). docs/morph-120hz.md.
 #include "tool.h"
 
-#include "temporal/color.h"
-#include "temporal/exr.h"
-#include "temporal/hold_blur.h"
-#include "temporal/morph.h"
-#include "temporal/sequence.h"
+#include "temporal/core/color.h"
+#include "temporal/core/exr.h"
+#include "temporal/morph/hold_blur.h"
+#include "temporal/morph/morph.h"
+#include "temporal/core/sequence.h"
 
 #include <chrono>
 #include <cmath>

@@ -1,12 +1,12 @@
 // render-gbuffer: replays an animated glTF scene with OSMesa into multi-layer EXR sequences
 // (docs/render-gbuffer.md). Parses options, evaluates the scene per frame, renders and writes; the
-// rendering lives in libtemporal (temporal/render.h), the scene in temporal/scene.h.
+// rendering lives in libtemporal (temporal/render/render.h), the scene in temporal/scene/scene.h.
 #include "tool.h"
 
-#include "temporal/exr.h"
-#include "temporal/render.h"
-#include "temporal/scene.h"
-#include "temporal/sequence.h"
+#include "temporal/core/exr.h"
+#include "temporal/render/render.h"
+#include "temporal/scene/scene.h"
+#include "temporal/core/sequence.h"
 
 #include <cmath>
 #include <cstdio>

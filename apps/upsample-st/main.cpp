@@ -1,11 +1,11 @@
 // upsample-st: rebuilds the full-resolution shading payload from 1/k-resolution jittered shading and the
 // full-resolution G-buffer, with the methods of seed 000 (spatial, temporal, herzog) and seed 002 (drobot).
-// The algorithms live in libtemporal (temporal/upsample.h); docs/upsample-st.md describes them.
+// The algorithms live in libtemporal (temporal/upsample/upsample.h); docs/upsample-st.md describes them.
 #include "tool.h"
 
-#include "temporal/exr.h"
-#include "temporal/sequence.h"
-#include "temporal/upsample.h"
+#include "temporal/core/exr.h"
+#include "temporal/core/sequence.h"
+#include "temporal/upsample/upsample.h"
 
 #include <algorithm>
 #include <cstdio>

@@ -1,5 +1,5 @@
-#include "temporal/color.h"
-#include "temporal/image.h"
+#include "temporal/core/color.h"
+#include "temporal/core/image.h"
 
 #include "test_support.h"
 

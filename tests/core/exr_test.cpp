@@ -1,4 +1,4 @@
-#include "temporal/exr.h"
+#include "temporal/core/exr.h"
 
 #include "test_support.h"
 

@@ -1,5 +1,5 @@
-#include "temporal/image.h"
-#include "temporal/parallel.h"
+#include "temporal/core/image.h"
+#include "temporal/core/parallel.h"
 
 #include <gtest/gtest.h>
 

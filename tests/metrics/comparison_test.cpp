@@ -1,8 +1,8 @@
 // The comparison engine on EXR sequences: values against idiff and hand computations, identical sequences,
 // masks, error maps, outputs without NaN, and every kind of bad input.
-#include "temporal/comparison.h"
-#include "temporal/exr.h"
-#include "temporal/image.h"
+#include "temporal/metrics/comparison.h"
+#include "temporal/core/exr.h"
+#include "temporal/core/image.h"
 
 #include "test_support.h"
 

@@ -1,9 +1,9 @@
 // Unit tests of the metric kernels: PSNR, SSIM (against an independent direct computation and hand values),
 // the motion-compensated fetch and flicker.
-#include "temporal/flicker.h"
-#include "temporal/image.h"
-#include "temporal/metrics.h"
-#include "temporal/warp.h"
+#include "temporal/metrics/flicker.h"
+#include "temporal/core/image.h"
+#include "temporal/metrics/metrics.h"
+#include "temporal/metrics/warp.h"
 
 #include <gtest/gtest.h>
 

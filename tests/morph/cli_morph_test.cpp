@@ -1,5 +1,5 @@
 // The morph-120hz command line: frame numbering and timing of the output, metadata, bad input exit codes.
-#include "temporal/exr.h"
+#include "temporal/core/exr.h"
 
 #include "synthetic.h"
 #include "test_support.h"

@@ -1,6 +1,6 @@
 // High-frequency compensation (seed 004 section 5.1) and the eye-tracking limit (section 6).
-#include "temporal/grid_warp.h"
-#include "temporal/morph.h"
+#include "temporal/morph/grid_warp.h"
+#include "temporal/morph/morph.h"
 
 #include "synthetic.h"
 

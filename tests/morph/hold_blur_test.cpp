@@ -1,6 +1,6 @@
 // Hold-type blur under smooth pursuit (seed 004 section 3).
-#include "temporal/hold_blur.h"
-#include "temporal/morph.h"
+#include "temporal/morph/hold_blur.h"
+#include "temporal/morph/morph.h"
 
 #include "synthetic.h"
 

@@ -1,6 +1,6 @@
 // Grid morphing (seed 004 sections 5-6) against analytically known in-between frames, and the baselines.
-#include "temporal/grid_warp.h"
-#include "temporal/morph.h"
+#include "temporal/morph/grid_warp.h"
+#include "temporal/morph/morph.h"
 
 #include "synthetic.h"
 

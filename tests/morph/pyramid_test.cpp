@@ -1,6 +1,6 @@
 // Max-pyramid with argmax (seed 004 Figure 6) and the 3-tap binomial blur pyramid.
-#include "temporal/blur_pyramid.h"
-#include "temporal/max_pyramid.h"
+#include "temporal/morph/blur_pyramid.h"
+#include "temporal/morph/max_pyramid.h"
 
 #include <gtest/gtest.h>
 

@@ -2,7 +2,7 @@
 // in-between image of a known motion is exact (no renderer needed).
 #pragma once
 
-#include "temporal/image.h"
+#include "temporal/core/image.h"
 
 #include <cmath>
 #include <functional>

@@ -1,7 +1,7 @@
 // TAA (Karis 2014), EMA (seed 003 eq. 1) and FXAA (Lottes 2011) on synthetic frames with hand-computed values.
-#include "temporal/ema.h"
-#include "temporal/fxaa.h"
-#include "temporal/taa.h"
+#include "temporal/phlm/ema.h"
+#include "temporal/phlm/fxaa.h"
+#include "temporal/phlm/taa.h"
 
 #include <gtest/gtest.h>
 

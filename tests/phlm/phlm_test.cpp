@@ -1,6 +1,6 @@
 // PHLM (seed 003) on synthetic sequences: the numerically hard cases of issue 5, each with a numeric assertion.
-#include "temporal/exr.h"
-#include "temporal/phlm.h"
+#include "temporal/core/exr.h"
+#include "temporal/phlm/phlm.h"
 
 #include "test_support.h"
 

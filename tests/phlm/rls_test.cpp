@@ -1,5 +1,5 @@
-// The UD-factored RLS step (temporal/rls.h) against seed 003 eq. 6-7 evaluated directly in double precision.
-#include "temporal/rls.h"
+// The UD-factored RLS step (temporal/phlm/rls.h) against seed 003 eq. 6-7 evaluated directly in double precision.
+#include "temporal/phlm/rls.h"
 
 #include <gtest/gtest.h>
 

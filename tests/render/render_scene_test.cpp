@@ -6,8 +6,8 @@
 // larger than a pixel, negated vectors must do clearly worse (so the test can fail).
 #include "test_support.h"
 
-#include "temporal/render.h"
-#include "temporal/scene.h"
+#include "temporal/render/render.h"
+#include "temporal/scene/scene.h"
 
 #include <gtest/gtest.h>
 

@@ -3,8 +3,8 @@
 #include "synthetic_scene.h"
 #include "test_support.h"
 
-#include "temporal/render.h"
-#include "temporal/render_jitter.h"
+#include "temporal/render/render.h"
+#include "temporal/core/jitter.h"
 
 #include <gtest/gtest.h>
 

@@ -3,8 +3,8 @@
 // can be switched on one at a time. Independent of the glTF loader.
 #pragma once
 
-#include "temporal/render.h"
-#include "temporal/scene.h"
+#include "temporal/render/render.h"
+#include "temporal/scene/scene.h"
 
 #include <glm/gtc/matrix_transform.hpp>
 

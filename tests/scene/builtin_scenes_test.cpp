@@ -2,7 +2,7 @@
 // byte, and every scene loads, animates and has what its seed situation needs.
 #include "test_support.h"
 
-#include "temporal/scene.h"
+#include "temporal/scene/scene.h"
 
 #include <glm/trigonometric.hpp>
 

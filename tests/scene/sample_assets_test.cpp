@@ -3,7 +3,7 @@
 // independently of the library, straight from the file's data with tinygltf (skinning, morphing).
 #include "test_support.h"
 
-#include "temporal/scene.h"
+#include "temporal/scene/scene.h"
 
 #include <glm/gtc/quaternion.hpp>
 #include <glm/gtc/type_ptr.hpp>

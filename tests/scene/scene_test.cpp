@@ -4,7 +4,7 @@
 #include "gltf_writer.h"
 #include "test_support.h"
 
-#include "temporal/scene.h"
+#include "temporal/scene/scene.h"
 
 #include <glm/gtc/matrix_transform.hpp>
 

@@ -1,6 +1,6 @@
 #include "test_support.h"
 
-#include "temporal/exr.h"
+#include "temporal/core/exr.h"
 
 #include <sys/wait.h>
 

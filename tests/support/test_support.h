@@ -2,7 +2,7 @@
 // write a difference EXR when they fail.
 #pragma once
 
-#include "temporal/image.h"
+#include "temporal/core/image.h"
 
 #include <gtest/gtest.h>
 

@@ -2,7 +2,7 @@
 // camera motion, NaN input, camera cuts, input errors. Tolerances are stated next to each assertion.
 #include "synthetic.h"
 
-#include "temporal/upsample.h"
+#include "temporal/upsample/upsample.h"
 
 #include <gtest/gtest.h>
 #include <test_support.h>

@@ -2,7 +2,7 @@
 // exit codes for bad input.
 #include "synthetic.h"
 
-#include "temporal/exr.h"
+#include "temporal/core/exr.h"
 
 #include <gtest/gtest.h>
 #include <test_support.h>

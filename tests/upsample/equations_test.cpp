@@ -1,8 +1,8 @@
 // Each closed-form equation of seeds 000 and 002 against values computed by hand.
-#include "temporal/drobot.h"
-#include "temporal/history.h"
-#include "temporal/joint_bilateral.h"
-#include "temporal/reprojection.h"
+#include "temporal/upsample/drobot.h"
+#include "temporal/upsample/history.h"
+#include "temporal/upsample/joint_bilateral.h"
+#include "temporal/upsample/reprojection.h"
 
 #include <gtest/gtest.h>
 

@@ -3,7 +3,7 @@
 // frames with the regular jitter pattern and the metadata of docs/conventions.md.
 #pragma once
 
-#include "temporal/image.h"
+#include "temporal/core/image.h"
 
 #include <glm/vec2.hpp>
 

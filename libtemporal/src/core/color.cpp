@@ -1,8 +1,8 @@
 // Colour management through OpenColorIO 2.1 (no built-in config before 2.2: one is built here in code).
-#include "temporal/color.h"
+#include "temporal/core/color.h"
 
-#include "temporal/image.h"
-#include "temporal/parallel.h"
+#include "temporal/core/image.h"
+#include "temporal/core/parallel.h"
 
 #include <OpenColorIO/OpenColorIO.h>
 

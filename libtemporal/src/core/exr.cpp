@@ -1,5 +1,5 @@
 // OpenEXR I/O through OpenImageIO: multi-part files (one part per layer), planar images, atomic writes.
-#include "temporal/exr.h"
+#include "temporal/core/exr.h"
 
 #include <OpenImageIO/imageio.h>
 

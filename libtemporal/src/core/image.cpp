@@ -1,4 +1,4 @@
-#include "temporal/image.h"
+#include "temporal/core/image.h"
 
 #include <cmath>
 #include <cstdlib>

@@ -1,4 +1,4 @@
-#include "temporal/parallel.h"
+#include "temporal/core/parallel.h"
 
 #include <tbb/global_control.h>
 #include <tbb/info.h>

@@ -1,4 +1,4 @@
-#include "temporal/sequence.h"
+#include "temporal/core/sequence.h"
 
 #include <algorithm>
 #include <charconv>

@@ -1,15 +1,15 @@
-// Frame-by-frame comparison of test sequences against a reference (temporal/comparison.h).
+// Frame-by-frame comparison of test sequences against a reference (temporal/metrics/comparison.h).
 //
 // Streaming: each frame's reference, G-buffer and test files are read, measured and dropped; what survives a
 // frame is the luminance of the reference and of each test (for flicker) and the metric rows. Only the layers
 // that are compared (plus `motion` and the mask) are read from the multi-part files.
-#include "temporal/comparison.h"
+#include "temporal/metrics/comparison.h"
 
-#include "temporal/exr.h"
-#include "temporal/flicker.h"
-#include "temporal/image.h"
-#include "temporal/metrics.h"
-#include "temporal/warp.h"
+#include "temporal/core/exr.h"
+#include "temporal/metrics/flicker.h"
+#include "temporal/core/image.h"
+#include "temporal/metrics/metrics.h"
+#include "temporal/metrics/warp.h"
 
 #include <algorithm>
 #include <chrono>

@@ -1,7 +1,7 @@
-// Temporal instability against the reference (temporal/flicker.h; definition and choices in docs/compare.md).
-#include "temporal/flicker.h"
+// Temporal instability against the reference (temporal/metrics/flicker.h; definition and choices in docs/compare.md).
+#include "temporal/metrics/flicker.h"
 
-#include "temporal/parallel.h"
+#include "temporal/core/parallel.h"
 
 #include <algorithm>
 #include <cmath>

@@ -1,12 +1,12 @@
-// PSNR, SSIM and the per-pixel helpers of `compare` (temporal/metrics.h).
+// PSNR, SSIM and the per-pixel helpers of `compare` (temporal/metrics/metrics.h).
 //
 // Reductions keep one partial sum per image row (double) and add them in row order afterwards: the result is
 // the same whatever the number of threads, which keeps CSV files reproducible.
-#include "temporal/metrics.h"
+#include "temporal/metrics/metrics.h"
 
-#include "temporal/color.h"
-#include "temporal/image.h"
-#include "temporal/parallel.h"
+#include "temporal/core/color.h"
+#include "temporal/core/image.h"
+#include "temporal/core/parallel.h"
 
 #include <algorithm>
 #include <cmath>

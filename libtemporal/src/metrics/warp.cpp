@@ -1,7 +1,7 @@
-// Motion-compensated bilinear fetch (temporal/warp.h), following docs/conventions.md: p_prev = p + motion.
-#include "temporal/warp.h"
+// Motion-compensated bilinear fetch (temporal/metrics/warp.h), following docs/conventions.md: p_prev = p + motion.
+#include "temporal/metrics/warp.h"
 
-#include "temporal/parallel.h"
+#include "temporal/core/parallel.h"
 
 #include <algorithm>
 #include <cmath>

@@ -2,9 +2,9 @@
 // higher level using tri-cubic reconstruction". The paper blurs 8-bit tone-mapped RGB on the GPU; here the
 // planes are float and the reconstruction is separable (a vertical 4-tap pass into one row of the level,
 // then a horizontal 4-tap pass), so the cost per output pixel does not depend on the level.
-#include "temporal/blur_pyramid.h"
+#include "temporal/morph/blur_pyramid.h"
 
-#include "temporal/parallel.h"
+#include "temporal/core/parallel.h"
 
 #include <algorithm>
 #include <array>

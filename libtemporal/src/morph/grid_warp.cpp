@@ -2,9 +2,9 @@
 // OpenGL; this is the same operation on the CPU: a closed, connected grid of triangles, fold-overs allowed,
 // depth test on the original frame's depth, pixel centres sampled with a top-left rule so that every pixel is
 // covered by exactly one of two triangles sharing an edge.
-#include "temporal/grid_warp.h"
+#include "temporal/morph/grid_warp.h"
 
-#include "temporal/parallel.h"
+#include "temporal/core/parallel.h"
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>

@@ -1,8 +1,8 @@
 // Hold-type blur under smooth pursuit (seed 004 section 3, Figure 1): the eye moves continuously while each
 // frame is held, so a point of the retina integrates the held frame along the motion path.
-#include "temporal/hold_blur.h"
+#include "temporal/morph/hold_blur.h"
 
-#include "temporal/parallel.h"
+#include "temporal/core/parallel.h"
 
 #include <algorithm>
 #include <cmath>

@@ -1,9 +1,9 @@
 // Max-MIP pyramid with argmax (seed 004 section 6, Figure 6). The paper packs the relative position of the
 // maximum into 2 x 5 bits and the gradient into 6 bits of a 16-bit texel; on the CPU we keep the full float
 // value and the absolute pixel index, which needs no quantisation and costs the same loop.
-#include "temporal/max_pyramid.h"
+#include "temporal/morph/max_pyramid.h"
 
-#include "temporal/parallel.h"
+#include "temporal/core/parallel.h"
 
 #include <algorithm>
 #include <limits>

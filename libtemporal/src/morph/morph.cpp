@@ -14,11 +14,11 @@
 // The low-pass is computed on the rendered frame and warped with the same grid (rather than blurring each
 // warped frame): for a piecewise-affine warp the two agree up to the local scale change, and this way the
 // energy balance of the compensation holds exactly along each motion trajectory, the one the eye follows.
-#include "temporal/morph.h"
+#include "temporal/morph/morph.h"
 
 #include "fast_pow.h"
-#include "temporal/color.h"
-#include "temporal/parallel.h"
+#include "temporal/core/color.h"
+#include "temporal/core/parallel.h"
 
 #include <algorithm>
 #include <atomic>

@@ -1,9 +1,9 @@
 // Exponential history buffer, seed 003 eq. 1, with reprojection and depth / id rejection.
-#include "temporal/ema.h"
+#include "temporal/phlm/ema.h"
 
 #include "filter_common.h"
-#include "temporal/parallel.h"
-#include "temporal/resample.h"
+#include "temporal/core/parallel.h"
+#include "temporal/phlm/resample.h"
 
 #include <algorithm>
 #include <atomic>

@@ -1,7 +1,7 @@
 #include "filter_common.h"
 
-#include "temporal/color.h"
-#include "temporal/parallel.h"
+#include "temporal/core/color.h"
+#include "temporal/core/parallel.h"
 
 #include <algorithm>
 #include <atomic>

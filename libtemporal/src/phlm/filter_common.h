@@ -1,7 +1,7 @@
 // Helpers shared by the filters of src/phlm (not part of the public headers).
 #pragma once
 
-#include "temporal/frame_filter.h"
+#include "temporal/phlm/frame_filter.h"
 
 #include <cstdint>
 #include <string>
@@ -10,7 +10,7 @@
 namespace temporal::detail {
 
 // Marks the finite pixels of the input (valid = 1 when every filtered channel is finite) and, when
-// `want_ycgco`, converts the three channels to YCgCo planes (temporal/color.h). Buffers are resized only
+// `want_ycgco`, converts the three channels to YCgCo planes (temporal/core/color.h). Buffers are resized only
 // when the frame size changes. Returns the number of non-finite pixels.
 std::size_t prepare_frame(const FilterInput& in, bool want_ycgco, std::vector<float> ycgco[3],
                           std::vector<std::uint8_t>& valid);

@@ -1,11 +1,11 @@
 // FXAA 3.11 "PC quality" (Lottes 2011), written from the white paper's description and its published
 // constants (quality preset 12: 12 search steps). Pixel coordinates: the centre of pixel (x, y) is (x, y).
-#include "temporal/fxaa.h"
+#include "temporal/phlm/fxaa.h"
 
 #include "filter_common.h"
-#include "temporal/color.h"
-#include "temporal/parallel.h"
-#include "temporal/resample.h"
+#include "temporal/core/color.h"
+#include "temporal/core/parallel.h"
+#include "temporal/phlm/resample.h"
 
 #include <algorithm>
 #include <atomic>

@@ -1,12 +1,12 @@
 // Pixel History Linear Models, seed 003 sections 4-6 and Algorithm 1. The terms the paper leaves loose and
 // how they are read here are listed in docs/filter-phlm.md ("Reading the paper").
-#include "temporal/phlm.h"
+#include "temporal/phlm/phlm.h"
 
 #include "filter_common.h"
-#include "temporal/color.h"
-#include "temporal/parallel.h"
-#include "temporal/resample.h"
-#include "temporal/rls.h"
+#include "temporal/core/color.h"
+#include "temporal/core/parallel.h"
+#include "temporal/phlm/resample.h"
+#include "temporal/phlm/rls.h"
 
 #include <algorithm>
 #include <array>

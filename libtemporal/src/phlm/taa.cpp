@@ -1,11 +1,11 @@
 // TAA after Karis 2014 (the UE4-TAA baseline of seed 003 Table 2). Choices beyond the talk are listed in
 // docs/filter-phlm.md ("TAA").
-#include "temporal/taa.h"
+#include "temporal/phlm/taa.h"
 
 #include "filter_common.h"
-#include "temporal/color.h"
-#include "temporal/parallel.h"
-#include "temporal/resample.h"
+#include "temporal/core/color.h"
+#include "temporal/core/parallel.h"
+#include "temporal/phlm/resample.h"
 
 #include <algorithm>
 #include <atomic>

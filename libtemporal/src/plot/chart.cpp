@@ -1,6 +1,6 @@
-// VTK charts written to PNG (temporal/plot.h): vtkChartXY in an off-screen vtkContextView, read back with
+// VTK charts written to PNG (temporal/plot/plot.h): vtkChartXY in an off-screen vtkContextView, read back with
 // vtkWindowToImageFilter and written with vtkPNGWriter.
-#include "temporal/plot.h"
+#include "temporal/plot/plot.h"
 
 #include <vtkAxis.h>
 #include <vtkBrush.h>

@@ -1,5 +1,5 @@
-// An X display for VTK (temporal/plot.h): Debian's VTK 9.1 is built for X11 only and aborts without a display.
-#include "temporal/plot.h"
+// An X display for VTK (temporal/plot/plot.h): Debian's VTK 9.1 is built for X11 only and aborts without a display.
+#include "temporal/plot/plot.h"
 
 #include <X11/Xlib.h>
 #undef Status  // Xlib defines Status as a macro; temporal::Status must stay usable

@@ -6,7 +6,7 @@
 // Loading each entry point from OSMesa by name keeps the renderer correct whatever else is linked.
 #pragma once
 
-#include "temporal/error.h"
+#include "temporal/core/error.h"
 
 #include <GL/glcorearb.h>
 

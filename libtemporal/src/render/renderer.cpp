@@ -1,12 +1,12 @@
 // render-gbuffer's frame loop on the GPU (OSMesa llvmpipe): light maps, G-buffers, deferred payload
 // shading, read-back into planar images. docs/render-gbuffer.md explains every choice made here.
-#include "temporal/render.h"
+#include "temporal/render/render.h"
 
 #include "gl_api.h"
 #include "scene_gpu.h"
 #include "shaders.h"
 
-#include "temporal/parallel.h"
+#include "temporal/core/parallel.h"
 
 #include <glm/gtc/matrix_transform.hpp>
 #include <glm/gtc/type_ptr.hpp>

@@ -4,7 +4,7 @@
 
 #include "gl_api.h"
 
-#include "temporal/render.h"
+#include "temporal/render/render.h"
 
 #include <glm/mat3x3.hpp>
 #include <glm/mat4x4.hpp>

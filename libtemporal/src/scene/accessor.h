@@ -3,7 +3,7 @@
 // so a corrupt file gives an Input error instead of a read past the end.
 #pragma once
 
-#include "temporal/error.h"
+#include "temporal/core/error.h"
 
 #include <tiny_gltf.h>
 

@@ -2,7 +2,7 @@
 // Scene::evaluate() replays. Not a public header (src/scene only).
 #pragma once
 
-#include "temporal/scene.h"
+#include "temporal/scene/scene.h"
 
 #include <glm/gtc/quaternion.hpp>
 #include <glm/mat4x4.hpp>

@@ -18,8 +18,8 @@
 // jittered grid blurs it (measured: 7 px of blur at k = 4, docs/upsample-st.md).
 #include "upsample_internal.h"
 
-#include "temporal/drobot.h"
-#include "temporal/parallel.h"
+#include "temporal/upsample/drobot.h"
+#include "temporal/core/parallel.h"
 
 #include <atomic>
 

@@ -19,8 +19,8 @@
 // (0 where there is no history: a flat kernel, i.e. spatial upsampling), and use this frame's w_f in eq. 7.
 #include "upsample_internal.h"
 
-#include "temporal/history.h"
-#include "temporal/parallel.h"
+#include "temporal/upsample/history.h"
+#include "temporal/core/parallel.h"
 
 #include <atomic>
 #include <cmath>

@@ -5,7 +5,7 @@
 // same weights in the same order, so their results are bit-identical.
 #include "upsample_internal.h"
 
-#include "temporal/parallel.h"
+#include "temporal/core/parallel.h"
 
 namespace temporal::upsample {
 namespace {

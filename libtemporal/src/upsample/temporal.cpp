@@ -5,7 +5,7 @@
 // (FrameStats::hole_pixels, `temporal:holePixels`) and fill them with the joint-bilateral result (eq. 1-3).
 #include "upsample_internal.h"
 
-#include "temporal/parallel.h"
+#include "temporal/core/parallel.h"
 
 #include <atomic>
 

@@ -1,10 +1,10 @@
 // Internal state and per-frame context shared by the upsampling methods (not installed).
 #pragma once
 
-#include "temporal/image.h"
-#include "temporal/joint_bilateral.h"
-#include "temporal/reprojection.h"
-#include "temporal/upsample.h"
+#include "temporal/core/image.h"
+#include "temporal/upsample/joint_bilateral.h"
+#include "temporal/upsample/reprojection.h"
+#include "temporal/upsample/upsample.h"
 
 #include <bit>
 #include <cmath>

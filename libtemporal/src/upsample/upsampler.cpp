@@ -2,7 +2,7 @@
 // antialiasing downsample (seed 000 section 4) and the shared joint-bilateral row kernel.
 #include "upsample_internal.h"
 
-#include "temporal/parallel.h"
+#include "temporal/core/parallel.h"
 
 #include <algorithm>
 #include <chrono>

@@ -4,12 +4,12 @@
 //  * `compare`'s time per 1080p frame (the tool as a process, one frame and ten frames; the library with I/O;
 //    the metric kernels alone), next to `idiff` on the same pair.
 // External tools that are not in PATH are skipped with a message. Numbers are reported in docs/compare.md.
-#include "temporal/comparison.h"
-#include "temporal/exr.h"
-#include "temporal/image.h"
-#include "temporal/metrics.h"
-#include "temporal/flicker.h"
-#include "temporal/warp.h"
+#include "temporal/metrics/comparison.h"
+#include "temporal/core/exr.h"
+#include "temporal/core/image.h"
+#include "temporal/metrics/metrics.h"
+#include "temporal/metrics/flicker.h"
+#include "temporal/metrics/warp.h"
 
 #include <benchmark/benchmark.h>
 

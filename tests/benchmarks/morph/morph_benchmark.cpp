@@ -1,9 +1,9 @@
 // Seed 004 Table 1 on the CPU: the two in-between frames of a 40 -> 120 Hz upsampling at 1024x1024, split into
 // motion flow (snapped grid), morph (warped grid rasterisation) and blur (pyramid, reconstruction,
 // compensation). Counters flow_ms, morph_ms, blur_ms are per rendered frame (= per two in-between frames).
-#include "temporal/hold_blur.h"
-#include "temporal/morph.h"
-#include "temporal/parallel.h"
+#include "temporal/morph/hold_blur.h"
+#include "temporal/morph/morph.h"
+#include "temporal/core/parallel.h"
 
 #include "synthetic.h"
 

@@ -2,11 +2,11 @@
 // interpolate), next to the streaming bound of PHLM's state traffic: a memcpy of the bytes the filter must
 // read and write per frame (26 floats of models read at p + motion and 26 written, per pixel).
 // Run: build/<dir>/tests/benchmarks/phlm/phlm_bench [--benchmark_filter=...]
-#include "temporal/ema.h"
-#include "temporal/fxaa.h"
-#include "temporal/parallel.h"
-#include "temporal/phlm.h"
-#include "temporal/taa.h"
+#include "temporal/phlm/ema.h"
+#include "temporal/phlm/fxaa.h"
+#include "temporal/core/parallel.h"
+#include "temporal/phlm/phlm.h"
+#include "temporal/phlm/taa.h"
 
 #include <benchmark/benchmark.h>
 

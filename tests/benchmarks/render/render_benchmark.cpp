@@ -7,8 +7,8 @@
 // The time of each iteration is the pass's own timing from the renderer (manual time). Environment:
 //   TEMPORAL_BENCH_SIZE=WxH (default 1280x1024), TEMPORAL_BENCH_SPP (reference samples, default 16),
 //   TEMPORAL_BENCH_SCENES=walkers,tower (default: every built-in scene).
-#include "temporal/render.h"
-#include "temporal/scene.h"
+#include "temporal/render/render.h"
+#include "temporal/scene/scene.h"
 
 #include <benchmark/benchmark.h>
 

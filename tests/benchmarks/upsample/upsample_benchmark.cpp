@@ -6,8 +6,8 @@
 #include "synthetic.h"
 #include "upsample_variants.h"
 
-#include "temporal/parallel.h"
-#include "temporal/upsample.h"
+#include "temporal/core/parallel.h"
+#include "temporal/upsample/upsample.h"
 
 #include <benchmark/benchmark.h>
 

@@ -5,7 +5,7 @@
 #include "synthetic.h"
 #include "upsample_variants.h"
 
-#include "temporal/upsample.h"
+#include "temporal/upsample/upsample.h"
 
 #include <algorithm>
 #include <cmath>

@@ -2,7 +2,7 @@
 // argument): each method once, plus drobot --mode refresh and herzog --lagged-wf.
 #pragma once
 
-#include "temporal/upsample.h"
+#include "temporal/upsample/upsample.h"
 
 namespace temporal::test {
 

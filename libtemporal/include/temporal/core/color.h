@@ -6,7 +6,7 @@
 // built-in config, and a test checks that the two agree.
 #pragma once
 
-#include "temporal/error.h"
+#include "temporal/core/error.h"
 
 #include <memory>
 #include <span>

@@ -6,8 +6,8 @@
 // written by other programs are read too.
 #pragma once
 
-#include "temporal/error.h"
-#include "temporal/image.h"
+#include "temporal/core/error.h"
+#include "temporal/core/image.h"
 
 #include <span>
 #include <string>

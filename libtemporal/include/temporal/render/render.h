@@ -30,10 +30,10 @@
 // read-back excluded.
 #pragma once
 
-#include "temporal/error.h"
-#include "temporal/image.h"
-#include "temporal/render_jitter.h"
-#include "temporal/scene.h"
+#include "temporal/core/error.h"
+#include "temporal/core/image.h"
+#include "temporal/core/jitter.h"
+#include "temporal/scene/scene.h"
 
 #include <glm/vec3.hpp>
 

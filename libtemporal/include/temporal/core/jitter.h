@@ -5,7 +5,7 @@
 // matrix (jitter_projection), so rasterisation, interpolation and depth all follow it exactly.
 #pragma once
 
-#include "temporal/error.h"
+#include "temporal/core/error.h"
 
 #include <glm/mat4x4.hpp>
 #include <glm/vec2.hpp>

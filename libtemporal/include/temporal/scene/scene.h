@@ -8,7 +8,7 @@
 // glTF 2.0 section 3.7.3, and morph targets, section 3.7.2.2).
 #pragma once
 
-#include "temporal/error.h"
+#include "temporal/core/error.h"
 
 #include <glm/mat4x4.hpp>
 #include <glm/vec2.hpp>

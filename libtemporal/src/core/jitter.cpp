@@ -1,4 +1,4 @@
-#include "temporal/render_jitter.h"
+#include "temporal/core/jitter.h"
 
 #include <glm/gtc/matrix_transform.hpp>
 

@@ -10,9 +10,9 @@
 // NaN/Inf pixels are counted and passed through unchanged.
 #pragma once
 
-#include "temporal/error.h"
-#include "temporal/frame_filter.h"
-#include "temporal/image.h"
+#include "temporal/core/error.h"
+#include "temporal/phlm/frame_filter.h"
+#include "temporal/core/image.h"
 
 namespace temporal {
 

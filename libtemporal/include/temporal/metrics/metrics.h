@@ -10,7 +10,7 @@
 // a peak value `peak` in the same units; SSIM is unitless in [-1, 1].
 #pragma once
 
-#include "temporal/error.h"
+#include "temporal/core/error.h"
 
 #include <cstddef>
 #include <cstdint>

@@ -15,8 +15,8 @@
 // native 120 Hz rendering (same motion field) puts seed 004's user study on a reproducible number.
 #pragma once
 
-#include "temporal/error.h"
-#include "temporal/image.h"
+#include "temporal/core/error.h"
+#include "temporal/core/image.h"
 
 #include <span>
 #include <string>

@@ -1,9 +1,9 @@
 // What the temporal filters of `filter-phlm` (PHLM, TAA, EMA, FXAA) receive for one frame, and what they
-// report back. Shared by temporal/phlm.h, taa.h, ema.h and fxaa.h.
+// report back. Shared by temporal/phlm/phlm.h, taa.h, ema.h and fxaa.h.
 #pragma once
 
-#include "temporal/error.h"
-#include "temporal/image.h"
+#include "temporal/core/error.h"
+#include "temporal/core/image.h"
 
 #include <glm/vec2.hpp>
 

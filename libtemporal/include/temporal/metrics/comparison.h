@@ -1,13 +1,12 @@
 // Sequence comparison, the engine of the `compare` tool: streams a reference and any number of test
 // sequences frame by frame (only the current frame and the previous frame's luminance are in memory), computes
-// PSNR, SSIM and flicker (temporal/metrics.h, temporal/flicker.h) per frame and per test, optionally inside and
+// PSNR, SSIM and flicker (temporal/metrics/metrics.h, temporal/metrics/flicker.h) per frame and per test, optionally inside and
 // outside a mask layer, writes error maps, and turns the results into CSV, JSON, charts and threshold checks.
 // docs/compare.md defines every number.
 #pragma once
 
-#include "temporal/error.h"
-#include "temporal/plot.h"
-#include "temporal/sequence.h"
+#include "temporal/core/error.h"
+#include "temporal/core/sequence.h"
 
 #include <functional>
 #include <map>
@@ -21,7 +20,7 @@ struct ComparisonSetup {
   std::string reference;               // reference sequence pattern (REF.####.exr)
   std::vector<std::string> tests;      // test sequence patterns
   std::vector<std::string> names;      // one per test; empty: derived from the file names
-  std::string layer = "rgb";           // compared layer of the tests (temporal/metrics.h compared_channels)
+  std::string layer = "rgb";           // compared layer of the tests (temporal/metrics/metrics.h compared_channels)
   std::string reference_layer;         // compared layer of the reference; empty: same as `layer`
   std::string gbuffer;                 // G-buffer pattern with `motion`; empty: flicker without compensation
   std::string mask;                    // mask layer or channel; empty: none. Looked up in each test, then the
@@ -42,7 +41,7 @@ struct FrameMetrics {
   double psnr_rgb = 0.0;   // dB, over every compared channel
   double psnr_y = 0.0;     // dB, on luminance
   double ssim = 0.0;       // MSSIM on luminance
-  std::optional<double> flicker;  // RMS of d_t (temporal/flicker.h); absent at the first frame and camera cuts
+  std::optional<double> flicker;  // RMS of d_t (temporal/metrics/flicker.h); absent at the first frame and camera cuts
   std::size_t flicker_pixels = 0;
   std::size_t nonfinite_test = 0;       // pixels with a NaN/Inf in the test (excluded)
   std::size_t nonfinite_reference = 0;  // pixels with a NaN/Inf in the reference (excluded)
@@ -147,11 +146,5 @@ Status write_comparison_csv(const ComparisonReport& report, const std::string& p
 Status write_comparison_json(const ComparisonReport& report, const Thresholds& thresholds,
                              const std::vector<ThresholdFailure>& failures, const std::string& tool,
                              const std::string& parameters, const std::string& path);
-
-// The charts of `--plot F.png`: the file name and the chart. F.png: per-frame PSNR (RGB); F-psnr-y.png,
-// F-ssim.png, F-flicker.png: the other per-frame metrics (flicker only when there are two frames or more);
-// F-speed.png: mean PSNR against mean compute time, when any test header has timings.
-std::vector<std::pair<std::string, Chart>> comparison_charts(const ComparisonReport& report,
-                                                             const std::string& plot_path);
 
 }  // namespace temporal

@@ -21,8 +21,8 @@
 // allocates nothing per pixel. Non-finite payload values are counted and never enter a history.
 #pragma once
 
-#include "temporal/error.h"
-#include "temporal/image.h"
+#include "temporal/core/error.h"
+#include "temporal/core/image.h"
 
 #include <cstddef>
 #include <memory>

@@ -6,16 +6,16 @@
 // the model of the previous frame is fetched at p + motion (reset to the input when that is off-screen),
 // its prediction is tested against the 3x3 neighbourhood colour box and, outside it, clipped along the ray
 // towards the input and the model reset to the clipped colour (Algorithm 1 lines 13-19); the model is then
-// updated by recursive least squares (eq. 5-7, temporal/rls.h) and predicts the output (eq. 8).
+// updated by recursive least squares (eq. 5-7, temporal/phlm/rls.h) and predicts the output (eq. 8).
 //
 // Model size follows the data: C = 3 channels (RGB) give N = 4 predictors (beta 3x4, P 4x4); one channel
 // (ambient occlusion `ssao.Y`, `shadow.Y`) gives N = 2 (beta 1x2, P 2x2). docs/filter-phlm.md lists how
 // every loose term of the paper is read.
 #pragma once
 
-#include "temporal/error.h"
-#include "temporal/frame_filter.h"
-#include "temporal/image.h"
+#include "temporal/core/error.h"
+#include "temporal/phlm/frame_filter.h"
+#include "temporal/core/image.h"
 
 #include <cstddef>
 #include <cstdint>
@@ -29,7 +29,7 @@ struct PhlmParams {
   float p_init = 1000.0f;  // P = p_init * I at reset (section 6)
   float feature_a = 0.125f;  // phi(v, l) = a l^2 + b v l^3 (section 5.1)
   float feature_b = 0.25f;
-  // trace(P) never exceeds trace_factor * N * p_init (temporal/rls.h, wind-up guard).
+  // trace(P) never exceeds trace_factor * N * p_init (temporal/phlm/rls.h, wind-up guard).
   float trace_factor = 4.0f;
 };
 
@@ -56,7 +56,7 @@ class PhlmFilter {
 
   // The models after the last frame, as an image of named planes (written by --state-out):
   //   beta.<c><k>  (c = channel suffix R, G, B or Y; k = 0..N-1: intercept then slopes)
-  //   P.D<k>, P.U<ij>  (UD factors of P, temporal/rls.h), feature.<c>, scale.s
+  //   P.D<k>, P.U<ij>  (UD factors of P, temporal/phlm/rls.h), feature.<c>, scale.s
   // Empty before the first frame. `state_with_covariance` adds the packed symmetric P (Pmat.P<ij>, i <= j)
   // for inspection; set_state ignores it.
   Image state() const;

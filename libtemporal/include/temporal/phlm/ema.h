@@ -7,9 +7,9 @@
 // pixel keeps (outputs) its reprojected history.
 #pragma once
 
-#include "temporal/error.h"
-#include "temporal/frame_filter.h"
-#include "temporal/image.h"
+#include "temporal/core/error.h"
+#include "temporal/phlm/frame_filter.h"
+#include "temporal/core/image.h"
 
 #include <cstdint>
 #include <string>

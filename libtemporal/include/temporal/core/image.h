@@ -9,8 +9,8 @@
 // colour layer; docs/conventions.md lists every name the tools use.
 #pragma once
 
-#include "temporal/error.h"
-#include "temporal/metadata.h"
+#include "temporal/core/error.h"
+#include "temporal/core/metadata.h"
 
 #include <cstddef>
 #include <cstdint>

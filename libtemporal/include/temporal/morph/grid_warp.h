@@ -7,7 +7,7 @@
 // the offset in pixels from p to where the surface seen at p was in the previous frame (p_prev = p + motion).
 #pragma once
 
-#include "temporal/max_pyramid.h"
+#include "temporal/morph/max_pyramid.h"
 
 #include <cstdint>
 #include <span>

@@ -1,7 +1,7 @@
 // Temporal instability ("flicker") of a test sequence relative to its reference.
 //
 // For frame t, with T the test's and R the reference's luminance and W the motion-compensated fetch of the
-// previous frame (temporal/warp.h; the identity without motion vectors):
+// previous frame (temporal/metrics/warp.h; the identity without motion vectors):
 //
 //   d_t(p) = (T_t(p) - W(T_{t-1})(p)) - (R_t(p) - W(R_{t-1})(p))
 //   flicker_t = sqrt( mean over compared pixels p of d_t(p)^2 )        (RMS, in the units of the pixel values)

@@ -5,7 +5,7 @@
 //  1. Current colour: the 3x3 jittered input samples filtered with Karis' Blackman-Harris approximation
 //     w = exp(-2.29 d^2), d the distance from the pixel centre to each sample (the input's `temporal:jitter`
 //     says where the samples were taken), which removes the jitter from the current colour.
-//  2. History: the previous output fetched at p + motion with a 4x4 Catmull-Rom filter (temporal/resample.h);
+//  2. History: the previous output fetched at p + motion with a 4x4 Catmull-Rom filter (temporal/phlm/resample.h);
 //     off-screen: no history.
 //  3. Neighbourhood clipping in YCoCg: the history is clipped to the min/max box of the 3x3 input samples,
 //     along the segment towards the filtered current colour (which always lies inside the box).
@@ -15,9 +15,9 @@
 // history.
 #pragma once
 
-#include "temporal/error.h"
-#include "temporal/frame_filter.h"
-#include "temporal/image.h"
+#include "temporal/core/error.h"
+#include "temporal/phlm/frame_filter.h"
+#include "temporal/core/image.h"
 
 #include <cstdint>
 #include <string>

@@ -5,7 +5,8 @@
 // `Xvfb -displayfd N -nolisten tcp` on a free display number and points $DISPLAY at it for this process.
 #pragma once
 
-#include "temporal/error.h"
+#include "temporal/core/error.h"
+#include "temporal/metrics/comparison.h"
 
 #include <optional>
 #include <string>
@@ -73,5 +74,11 @@ class VirtualDisplay {
   std::string previous_display_;
   bool had_previous_ = false;
 };
+
+// The charts of `--plot F.png`: the file name and the chart. F.png: per-frame PSNR (RGB); F-psnr-y.png,
+// F-ssim.png, F-flicker.png: the other per-frame metrics (flicker only when there are two frames or more);
+// F-speed.png: mean PSNR against mean compute time, when any test header has timings.
+std::vector<std::pair<std::string, Chart>> comparison_charts(const ComparisonReport& report,
+                                                             const std::string& plot_path);
 
 }  // namespace temporal

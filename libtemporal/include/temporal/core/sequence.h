@@ -1,7 +1,7 @@
 // Frame sequences on disk: `name.####.exr` or `name.%04d.exr` patterns and `--frames A-B` ranges.
 #pragma once
 
-#include "temporal/error.h"
+#include "temporal/core/error.h"
 
 #include <optional>
 #include <string>

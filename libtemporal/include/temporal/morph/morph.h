@@ -15,10 +15,10 @@
 //  - Warp:   per-pixel forward warp of frame n with a depth test, holes left black (no hole filling).
 #pragma once
 
-#include "temporal/error.h"
-#include "temporal/grid_warp.h"
-#include "temporal/image.h"
-#include "temporal/blur_pyramid.h"
+#include "temporal/core/error.h"
+#include "temporal/morph/grid_warp.h"
+#include "temporal/core/image.h"
+#include "temporal/morph/blur_pyramid.h"
 
 #include <cstdint>
 #include <optional>

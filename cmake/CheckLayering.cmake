@@ -1,0 +1,30 @@
+# The layering rule of libtemporal (cmake/TemporalLibrary.cmake): a file of stage S (libtemporal/src/S/ or
+# libtemporal/include/temporal/S/) may include "temporal/T/..." only when T is S or one of S's dependencies.
+# Run as a script: cmake -DROOT=<libtemporal> -DSTAGES=a,b,... -DDEPS_a=x,y ... -P CheckLayering.cmake
+# Fails (non-zero exit) with one line per offending include: file:line: what it includes and what is allowed.
+cmake_minimum_required(VERSION 3.25)
+string(REPLACE "," ";" _stages "${STAGES}")
+set(_violations "")
+foreach(stage IN LISTS _stages)
+  string(REPLACE "," ";" _allowed "${DEPS_${stage}}")
+  list(APPEND _allowed ${stage})
+  file(GLOB_RECURSE _files ${ROOT}/src/${stage}/*.cpp ${ROOT}/src/${stage}/*.h ${ROOT}/include/temporal/${stage}/*.h)
+  foreach(f IN LISTS _files)
+    file(STRINGS ${f} _lines REGEX "^[ \t]*#[ \t]*include[ \t]*[\"<]temporal/")
+    foreach(line IN LISTS _lines)
+      string(REGEX MATCH "temporal/([A-Za-z0-9_]+)/" _m "${line}")
+      set(_target "${CMAKE_MATCH_1}")
+      if(_target STREQUAL "")
+        list(APPEND _violations "${f}: '${line}' is not under temporal/<stage>/")
+      elseif(NOT _target IN_LIST _allowed)
+        list(JOIN _allowed ", " _allowed_text)
+        list(APPEND _violations
+          "${f}: stage '${stage}' includes temporal/${_target}/ (allowed: ${_allowed_text}); move the code or add the dependency in cmake/TemporalLibrary.cmake")
+      endif()
+    endforeach()
+  endforeach()
+endforeach()
+if(_violations)
+  list(JOIN _violations "\n" _text)
+  message(FATAL_ERROR "libtemporal layering violated:\n${_text}")
+endif()
