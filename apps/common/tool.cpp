@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <iostream>
 #include <optional>
+#include <type_traits>
 
 #ifndef TEMPORAL_VERSION
 #define TEMPORAL_VERSION "0.0.0"
@@ -36,6 +37,56 @@ Tool::Tool(std::string name, std::string description) : name_(std::move(name)), 
 
 std::string Tool::signature() const { return name_ + " " TEMPORAL_VERSION; }
 
+void Tool::add_params(const ParamList& params) {
+  for (const auto& p : params) {
+    const std::string range = param_range_text(p);
+    const std::string help = p.help + (range.empty() ? "" : " (" + range + ")");
+    std::visit(
+        [&](auto* v) {
+          using T = std::remove_pointer_t<decltype(v)>;
+          if constexpr (std::is_same_v<T, bool>)
+            app_.add_flag(p.flag, *v, help);
+          else
+            app_.add_option(p.flag, *v, help);
+        },
+        p.value);
+    params_.push_back(p);
+  }
+}
+
+void Tool::add_sequence_options(SequenceOptions& o, const SequenceFlags& f) {
+  app_.add_option("--input", o.input, f.input_help)->required();
+  if (!f.gbuffer_help.empty()) {
+    auto* g = app_.add_option("--gbuffer", o.gbuffer, f.gbuffer_help);
+    if (f.gbuffer_required) g->required();
+  }
+  app_.add_option("--out", o.out, f.out_help)->required();
+  app_.add_option("--frames", o.frames, "Frames A-B (default: every input frame on disk)");
+  if (f.reset_frames)
+    app_.add_option("--reset-frames", o.reset_frames,
+                    "Frames where every history is discarded, e.g. 10,20-22 (also done where a header has "
+                    "temporal:cameraCut = 1)");
+  app_.add_option("--compression", o.compression, "EXR compression of the outputs: none | zip | piz");
+  if (f.state) {
+    app_.add_option("--state-in", o.state_in, "Resume from a state file written by --state-out (same method and options)");
+    app_.add_option("--state-out", o.state_out,
+                    "Write the state (everything the next frame needs) each frame (pattern with ####) or after the "
+                    "last frame only (plain path)");
+  }
+}
+
+RunHooks Tool::hooks() {
+  RunHooks h;
+  h.frame_done = [this](int frame, int done, int total) {
+    if (!progress_) progress_ = std::make_shared<Progress>(name_, total);
+    progress_->step(frame);
+    if (done == total) progress_.reset();  // erase the line before any summary
+  };
+  h.warning = [this](const std::string& file, const std::string& text) { print_warning(file, text); };
+  h.log = [this](const std::string& text) { log(text); };
+  return h;
+}
+
 int Tool::run(int argc, char** argv, const std::function<Status()>& body) {
   for (int i = 1; i < argc; ++i) {
     if (i > 1) command_line_ += ' ';
@@ -47,6 +98,11 @@ int Tool::run(int argc, char** argv, const std::function<Status()>& body) {
     return app_.exit(e);
   } catch (const CLI::ParseError& e) {
     std::cerr << name_ << ": " << e.what() << "\n" << name_ << ": run `" << name_ << " --help` for the options\n";
+    return kExitUsage;
+  }
+  if (Status s = check_params(params_); !s) {
+    print_error(s.error());
+    std::cerr << name_ << ": run `" << name_ << " --help` for the options\n";
     return kExitUsage;
   }
   std::optional<ThreadLimit> limit;

@@ -4,11 +4,14 @@
 #pragma once
 
 #include "temporal/core/error.h"
+#include "temporal/core/params.h"
+#include "temporal/core/runner.h"
 
 #include <CLI/CLI.hpp>
 
 #include <chrono>
 #include <functional>
+#include <memory>
 #include <string>
 
 namespace temporal::tool {
@@ -38,6 +41,28 @@ class Tool {
   // "name version", for the `temporal:tool` header attribute.
   std::string signature() const;
 
+  // Adds every parameter of a method (temporal/core/params.h) as an option: the help shows the default (from
+  // the library's option struct) and the valid range; after parsing, out-of-range and non-finite values are
+  // usage errors (exit 1) with the range in the message.
+  void add_params(const ParamList& params);
+
+  // The standard options of a sequence tool (docs/cli.md), bound to `options`. `gbuffer_help` empty: no
+  // --gbuffer; `state` adds --state-in / --state-out.
+  struct SequenceFlags {
+    std::string input_help;
+    std::string gbuffer_help;
+    std::string out_help;
+    bool gbuffer_required = false;
+    bool reset_frames = true;
+    bool state = false;
+  };
+  void add_sequence_options(SequenceOptions& options, const SequenceFlags& flags);
+
+  // Hooks that draw the progress line, print warnings and --verbose lines (temporal/core/runner.h).
+  RunHooks hooks();
+  // `temporal:tool` / `temporal:parameters` of the outputs.
+  RunIdentity identity() const { return {signature(), command_line_}; }
+
   // Parses argv, applies --threads, runs `body` and turns its result into an exit code. Usage errors
   // print the message and a pointer to --help.
   int run(int argc, char** argv, const std::function<Status()>& body);
@@ -54,6 +79,8 @@ class Tool {
   CLI::App app_;
   int threads_ = 0;
   bool verbose_ = false;
+  ParamList params_;
+  std::shared_ptr<class Progress> progress_;
 };
 
 // A single progress line on stderr (`tool: frame 12/40 (8.1 frames/s)`), drawn only when stderr is a

@@ -2,7 +2,6 @@
 #include "temporal/upsample/drobot.h"
 #include "temporal/upsample/history.h"
 #include "temporal/upsample/joint_bilateral.h"
-#include "temporal/upsample/reprojection.h"
 
 #include <gtest/gtest.h>
 
@@ -81,20 +80,6 @@ TEST(UpsampleEquations, RelativeGradientAndEq8) {
   EXPECT_FLOAT_EQ(up::temporal_weight(1.5f), 0.0f);  // clamped at |g| = 1
   EXPECT_FLOAT_EQ(up::kernel_gamma(4.0f, 0.64f), 2.56f);
   EXPECT_FLOAT_EQ(up::kernel_gamma(10.0f, 1.0f), 4.0f);  // gamma * w_f at most 4
-}
-
-TEST(UpsampleEquations, ReprojectionTapsAndSurfaceTest) {
-  const auto t = up::bilinear_taps(10, 20, 1.25f, -0.5f);  // sample point (11.25, 19.5)
-  EXPECT_EQ(t.x0, 11);
-  EXPECT_EQ(t.y0, 19);
-  EXPECT_FLOAT_EQ(t.w[0], 0.75f * 0.5f);
-  EXPECT_FLOAT_EQ(t.w[1], 0.25f * 0.5f);
-  EXPECT_FLOAT_EQ(t.w[2], 0.75f * 0.5f);
-  EXPECT_FLOAT_EQ(t.w[3], 0.25f * 0.5f);
-  EXPECT_TRUE(up::same_surface(10.0f, 3, 10.4f, 3, 0.05f, true));    // 0.4 / 10.4 = 3.8% <= 5%
-  EXPECT_FALSE(up::same_surface(10.0f, 3, 10.6f, 3, 0.05f, true));   // 5.7%
-  EXPECT_FALSE(up::same_surface(10.0f, 3, 10.0f, 4, 0.05f, true));   // contact point: other material
-  EXPECT_TRUE(up::same_surface(10.0f, 3, 10.0f, 4, 0.05f, false));
 }
 
 TEST(DrobotEquations, Listing71Weights) {

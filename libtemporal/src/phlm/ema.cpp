@@ -3,7 +3,7 @@
 
 #include "filter_common.h"
 #include "temporal/core/parallel.h"
-#include "temporal/phlm/resample.h"
+#include "temporal/core/reproject.h"
 
 #include <algorithm>
 #include <atomic>
@@ -61,15 +61,15 @@ Status EmaFilter::process(const FilterInput& in, Image& output, FilterStats* sta
         const float mvx = in.motion_x ? in.motion_x[i] : 0.0f;
         const float mvy = in.motion_y ? in.motion_y[i] : 0.0f;
         const float fx = float(xx) + mvx, fy = float(yy) + mvy;
-        bool reject = in.reset || !same || !resample::on_screen(fx, fy, w, h);
+        bool reject = in.reset || !same || !reproject::on_screen(fx, fy, w, h);
         if (!reject && (use_depth || use_id)) {
-          const std::size_t q = resample::nearest(fx, fy, w, h);
+          const std::size_t q = reproject::nearest(fx, fy, w, h);
           if (use_id && prev_id[q] != in.id[i]) reject = true;
           if (use_depth && std::fabs(prev_depth[q] - in.depth[i]) > tol * std::fabs(in.depth[i])) reject = true;
         }
         float hv[3] = {};
         if (!reject) {
-          const resample::Bilinear b = resample::bilinear(fx, fy, w, h);
+          const reproject::Bilinear b = reproject::bilinear(fx, fy, w, h);
           for (int c = 0; c < channels; ++c) hv[c] = b(hist[c]);
         }
         local += reject ? 1 : 0;

@@ -5,7 +5,7 @@
 #include "filter_common.h"
 #include "temporal/core/color.h"
 #include "temporal/core/parallel.h"
-#include "temporal/phlm/resample.h"
+#include "temporal/core/reproject.h"
 
 #include <algorithm>
 #include <atomic>
@@ -41,7 +41,7 @@ Status fxaa(const FilterInput& in, Image& output, const FxaaParams& params, Filt
   auto at = [&](int x, int yy) {
     return L[std::size_t(std::clamp(yy, 0, h - 1)) * std::size_t(w) + std::size_t(std::clamp(x, 0, w - 1))];
   };
-  auto sample_luma = [&](float fx, float fy) { return resample::bilinear(fx, fy, w, h)(L); };
+  auto sample_luma = [&](float fx, float fy) { return reproject::bilinear(fx, fy, w, h)(L); };
   std::atomic<std::size_t> edges{0};
 
   parallel_rows(h, [&](int y0, int y1) {
@@ -151,7 +151,7 @@ Status fxaa(const FilterInput& in, Image& output, const FxaaParams& params, Filt
         if (!horzSpan) fx += pixelOffsetSubpix * lengthSign;
         if (horzSpan) fy += pixelOffsetSubpix * lengthSign;
         // Final bilinear fetch; non-finite neighbours would poison it, so fall back to the pixel itself.
-        const resample::Bilinear b = resample::bilinear(fx, fy, w, h);
+        const reproject::Bilinear b = reproject::bilinear(fx, fy, w, h);
         const bool taps_ok = valid[b.i00] && valid[b.i10] && valid[b.i01] && valid[b.i11];
         for (int c = 0; c < channels; ++c) out[c][i] = taps_ok ? b(y[c]) : y[c][i];
         if (dbg) dbg[i] = 1.0f;

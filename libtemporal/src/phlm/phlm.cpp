@@ -5,7 +5,7 @@
 #include "filter_common.h"
 #include "temporal/core/color.h"
 #include "temporal/core/parallel.h"
-#include "temporal/phlm/resample.h"
+#include "temporal/core/reproject.h"
 #include "temporal/phlm/rls.h"
 
 #include <algorithm>
@@ -200,9 +200,9 @@ void run_phlm(const FilterInput& in, const PhlmParams& params, bool have_prev, c
         const float mvx = in.motion_x ? in.motion_x[i] : 0.0f;
         const float mvy = in.motion_y ? in.motion_y[i] : 0.0f;
         const float fx = float(xx) + mvx, fy = float(yy) + mvy;
-        const bool reset = in.reset || !have_prev || !resample::on_screen(fx, fy, w, h);  // lines 7-9
-        resample::Bilinear bl{};
-        if (!reset) bl = resample::bilinear(fx, fy, w, h);
+        const bool reset = in.reset || !have_prev || !reproject::on_screen(fx, fy, w, h);  // lines 7-9
+        reproject::Bilinear bl{};
+        if (!reset) bl = reproject::bilinear(fx, fy, w, h);
         // The previous model record at q, bilinearly (line 11). Integer motion (a static scene, a static
         // camera's still objects) reads the one record directly instead of four with weights (1, 0, 0, 0).
         using L = Layout<C>;

@@ -5,7 +5,7 @@
 #include "filter_common.h"
 #include "temporal/core/color.h"
 #include "temporal/core/parallel.h"
-#include "temporal/phlm/resample.h"
+#include "temporal/core/reproject.h"
 
 #include <algorithm>
 #include <atomic>
@@ -83,14 +83,14 @@ void run_taa(const FilterInput& in, const TaaParams& params, bool have_history, 
         const float mvx = in.motion_x ? in.motion_x[i] : 0.0f;
         const float mvy = in.motion_y ? in.motion_y[i] : 0.0f;
         const float fx = float(xx) + mvx, fy = float(yy) + mvy;
-        const bool no_history = in.reset || !have_history || !resample::on_screen(fx, fy, w, h);
+        const bool no_history = in.reset || !have_history || !reproject::on_screen(fx, fy, w, h);
         float result[C];
         float clipped = 0.0f;
         if (no_history) {
           for (int c = 0; c < C; ++c) result[c] = cur[c];
           ++local_resets;
         } else {
-          const resample::CatmullRom cr = resample::catmull_rom(fx, fy, w, h);
+          const reproject::CatmullRom cr = reproject::catmull_rom(fx, fy, w, h);
           float hv[C];
           for (int c = 0; c < C; ++c) hv[c] = cr(hist[c]);
           if (!any_valid) {

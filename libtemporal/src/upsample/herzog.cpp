@@ -3,7 +3,7 @@
 // Per frame, three passes (run row by row in one sweep, see "schedule" in run_herzog):
 //  A (full resolution): spatial estimate h~ and its weight w~ (eq. 6) with the
 //    image kernel k = g(|x(i) - x(j)|, r, min(gamma w_f, 4)) (section 3.3/3.5); motion-compensated fetch
-//    of the history h_r, h_w (reprojection.h); relative temporal gradient of the payload's luminance
+//    of the history h_r, h_w (temporal/core/reproject.h); relative temporal gradient of the payload's luminance
 //    (section 3.5.1), set to its maximum where the history is disoccluded (Figure 6), averaged into the
 //    intermediate-resolution gradient buffer (section 4: "compute it at an intermediate resolution").
 //  B (intermediate resolution): temporal filter |(0.4, 0.3, 0.2, 0.1) . (g_t .. g_t-3)| with the three
@@ -132,7 +132,7 @@ struct RowScratch {
       index(gx, cx, mxr[cx], myr[cx]);
     }
   }
-  build_segments(seg, GW);
+  reproject::build_segments(seg, GW);
   for (const auto& sg : seg.segments) {
     if (sg.base >= 0) {  // every cell of the run is inside: q = base + gx
       const float* __restrict a0 = p0 + sg.base;
@@ -502,7 +502,7 @@ void run_herzog(Upsampler::State& s, const FrameContext& f, const Options& o, Fr
           src[n] = prev_planes[c];
           dst[n++] = rs.hr[c];
           if (n == 4 || c == C - 1) {
-            gather_history_planes(hist, src, dst, n, W);
+            reproject::gather_row(hist, src, dst, n, W);
             n = 0;
           }
         }

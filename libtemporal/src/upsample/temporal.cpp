@@ -62,7 +62,7 @@ void run_temporal(Upsampler::State& s, const FrameContext& f, const Options& o, 
             src[i] = prev_planes[c0 + i];
             dst[i] = planes[c0 + i] + row;
           }
-          gather_history_planes(hist, src, dst, n, f.W);
+          reproject::gather_row(hist, src, dst, n, f.W);
         }
       }
       for (int c = 0; c < C; ++c) {

@@ -3,7 +3,7 @@
 
 #include "temporal/core/image.h"
 #include "temporal/upsample/joint_bilateral.h"
-#include "temporal/upsample/reprojection.h"
+#include "temporal/core/reproject.h"
 #include "temporal/upsample/upsample.h"
 
 #include <bit>
@@ -12,13 +12,6 @@
 #include <vector>
 
 namespace temporal::upsample {
-
-// floor() for |x| < 2^31, written so that loops using it vectorise: GCC does not vectorise std::floor without
-// -fno-trapping-math (the truncating conversion does vectorise). Same value as std::floor (up to the sign of 0).
-inline float floor_vec(float x) {
-  const float t = float(int(x));
-  return t > x ? t - 1.0f : t;
-}
 
 // Vectorisable exp2 / log2 for the per-tap kernel powers (std::pow does not vectorise without
 // -ffast-math). log2: relative error < 1e-6 on normal positive floats; exp2: relative error < 2e-6 for
@@ -41,7 +34,7 @@ inline float fast_exp2(float x) {
   u &= std::uint32_t(std::int32_t(u) >> 31);
   u = u < 0xC2FC0000u ? u : 0xC2FC0000u;  // bits of -126.0f
   x = std::bit_cast<float>(u);
-  const float xi = floor_vec(x);
+  const float xi = reproject::floor_vec(x);
   const float f = (x - xi) * 0.69314718056f;  // 2^f = e^(f ln 2)
   const float p =
       1.0f + f * (1.0f + f * (0.5f + f * (1.0f / 6 + f * (1.0f / 24 + f * (1.0f / 120 + f * (1.0f / 720 + f * (1.0f / 5040)))))));
@@ -110,248 +103,21 @@ struct Upsampler::State {
   std::vector<float> cz, cnx, cny, cnz, cache_table;
 };
 
-// Motion-compensated history taps of one full-resolution row (reprojection.h), written branch-free so the
-// loop vectorises (gathers of the previous depth and id): for pixel X, indices q[j][X] into the previous
-// frame's full-resolution buffers and bilinear weights w[j][X] of the four taps, renormalised over the taps
-// that pass the disocclusion test; all weights 0 (and hit[X] = 0) on a miss.
-struct HistoryRow {
-  std::vector<int> q[4];
-  std::vector<float> w[4];
-  std::vector<float> hit;
-  // Runs of the row, in order, covering [0, W): {X0, X1, base}; base >= 0: the taps are the image-aligned
-  // 2x2 block at a constant offset (q0 = base + X, q1 = q0 + 1, q2 = q0 + W, q3 = q2 + 1), read with
-  // contiguous loads; base = -1: gathered through q.
-  struct Segment {
-    int x0, x1, base;
-  };
-  std::vector<Segment> segments;
-  std::vector<int> offset, aligned;  // scratch: q0 - X, and 1 where the taps form the aligned block
-  void resize(int W) {
-    for (auto& v : q) v.resize(W);
-    for (auto& v : w) v.resize(W);
-    hit.resize(W);
-    offset.resize(W);
-    aligned.resize(W);
-  }
-};
-
-// Splits a row whose q are set into HistoryRow::segments: runs of at least 16 pixels with aligned taps at one
-// offset (camera pans, static regions) are contiguous segments; everything between them is one gather
-// segment. `offset` and `aligned` must be filled.
-inline void build_segments(HistoryRow& h, int W) {
-  h.segments.clear();
-  const int* __restrict off = h.offset.data();
-  const int* __restrict al = h.aligned.data();
-  int gather_start = -1, X = 0;
-  while (X < W) {
-    const int base = off[X];
-    int E = X;
-    if (al[X]) {
-      while (E + 16 <= W) {  // whole blocks first (a reduction the compiler vectorises)
-        int all = 1;
-        for (int i = 0; i < 16; ++i) all &= int(off[E + i] == base) & al[E + i];
-        if (!all) break;
-        E += 16;
-      }
-      while (E < W && off[E] == base && al[E]) ++E;
-    }
-    if (E - X >= 16) {
-      if (gather_start >= 0) h.segments.push_back({gather_start, X, -1});
-      gather_start = -1;
-      h.segments.push_back({X, E, base});
-      X = E;
-    } else {
-      if (gather_start < 0) gather_start = X;
-      X = std::max(E, X + 1);
-    }
-  }
-  if (gather_start >= 0) h.segments.push_back({gather_start, W, -1});
-}
-
-// Depth / id test of the four taps, the renormalised weights and hit flag for pixels [X0, X1) (second step of
-// history_row_impl). e0..e3 hold the bilinear weights already zeroed for taps outside the image; kAligned:
-// the taps are base + X (+1, +W, +W+1), loaded contiguously; otherwise gathered through q.
-template <bool kIds, bool kAligned>
-inline void history_test(const float* __restrict zr, const std::uint32_t* __restrict idr, const float* __restrict pz,
-                         const std::uint32_t* __restrict pid, float tol, int W, int X0, int X1, int base,
-                         HistoryRow& h) {
-  const int* __restrict q0 = h.q[0].data();
-  const int* __restrict q1 = h.q[1].data();
-  const int* __restrict q2 = h.q[2].data();
-  const int* __restrict q3 = h.q[3].data();
-  float* __restrict w0 = h.w[0].data();
-  float* __restrict w1 = h.w[1].data();
-  float* __restrict w2 = h.w[2].data();
-  float* __restrict w3 = h.w[3].data();
-  float* __restrict hit = h.hit.data();
-  auto same = [=](float z, float zp) { return std::abs(z - zp) <= tol * (z > zp ? z : zp); };
-#pragma GCC ivdep
-  for (int X = X0; X < X1; ++X) {
-    const int a = kAligned ? base + X : q0[X], b = kAligned ? base + X + 1 : q1[X];
-    const int c = kAligned ? base + X + W : q2[X], d = kAligned ? base + X + W + 1 : q3[X];
-    const float z = zr[X];
-    bool ok0 = same(z, pz[a]);
-    bool ok1 = same(z, pz[b]);
-    bool ok2 = same(z, pz[c]);
-    bool ok3 = same(z, pz[d]);
-    if constexpr (kIds) {
-      const std::uint32_t id = idr[X];
-      ok0 = ok0 & (pid[a] == id);
-      ok1 = ok1 & (pid[b] == id);
-      ok2 = ok2 & (pid[c] == id);
-      ok3 = ok3 & (pid[d] == id);
-    }
-    const float e0 = ok0 ? w0[X] : 0.0f, e1 = ok1 ? w1[X] : 0.0f;
-    const float e2 = ok2 ? w2[X] : 0.0f, e3 = ok3 ? w3[X] : 0.0f;
-    const float sum = e0 + e1 + e2 + e3;
-    const float inv = sum >= 1e-3f ? 1.0f / sum : 0.0f;
-    w0[X] = e0 * inv;
-    w1[X] = e1 * inv;
-    w2[X] = e2 * inv;
-    w3[X] = e3 * inv;
-    hit[X] = inv > 0.0f ? 1.0f : 0.0f;
-  }
-}
-
-// Two steps: (1) per pixel, the tap indices, the bilinear weights of the taps inside the image and the run
-// structure, without touching the previous frame (vectorises, no gathers); (2) per segment, the depth / id
-// tests against the previous frame, with contiguous loads where the taps are aligned (most of a typical
-// frame) and gathers elsewhere. Same values as testing everything in one gathered loop.
-template <bool kIds>
-inline void history_row_impl(const Upsampler::State& s, const FrameContext& f, const Options& o, int Y,
-                             HistoryRow& h) {
-  const int W = f.W, H = f.H;
-  const std::size_t row = std::size_t(Y) * W;
-  const float* __restrict mxr = f.mx + row;
-  const float* __restrict myr = f.my + row;
-  int* __restrict q0 = h.q[0].data();
-  int* __restrict q1 = h.q[1].data();
-  int* __restrict q2 = h.q[2].data();
-  int* __restrict q3 = h.q[3].data();
-  float* __restrict w0 = h.w[0].data();
-  float* __restrict w1 = h.w[1].data();
-  float* __restrict w2 = h.w[2].data();
-  float* __restrict w3 = h.w[3].data();
-  int* __restrict off = h.offset.data();
-  int* __restrict al = h.aligned.data();
-  const float fY = float(Y);
-  // Bitwise & instead of && keeps the loop free of branches (it vectorises).
-#pragma GCC ivdep
-  for (int X = 0; X < W; ++X) {
-    float mx = mxr[X], my = myr[X];
-    const bool finite = (std::abs(mx) < 1e6f) & (std::abs(my) < 1e6f);  // NaN/Inf/absurd motion: no history
-    mx = finite ? mx : 0.0f;
-    my = finite ? my : 0.0f;
-    const float u = float(X) + mx, v = fY + my;
-    const float fu = floor_vec(u), fv = floor_vec(v);  // |u|, |v| < 1e6 + size
-    const float ax = u - fu, ay = v - fv;
-    const int x0 = int(fu), y0 = int(fv);
-    const bool ix0 = (x0 >= 0) & (x0 < W), ix1 = (x0 + 1 >= 0) & (x0 + 1 < W);
-    const bool iy0 = (y0 >= 0) & (y0 < H), iy1 = (y0 + 1 >= 0) & (y0 + 1 < H);
-    const int cx0 = std::clamp(x0, 0, W - 1), cx1 = std::clamp(x0 + 1, 0, W - 1);
-    const int cy0 = std::clamp(y0, 0, H - 1), cy1 = std::clamp(y0 + 1, 0, H - 1);
-    const int a = cy0 * W + cx0, b = cy0 * W + cx1, c = cy1 * W + cx0, d = cy1 * W + cx1;
-    q0[X] = a;
-    q1[X] = b;
-    q2[X] = c;
-    q3[X] = d;
-    w0[X] = (finite & ix0 & iy0) ? (1 - ax) * (1 - ay) : 0.0f;
-    w1[X] = (finite & ix1 & iy0) ? ax * (1 - ay) : 0.0f;
-    w2[X] = (finite & ix0 & iy1) ? (1 - ax) * ay : 0.0f;
-    w3[X] = (finite & ix1 & iy1) ? ax * ay : 0.0f;
-    off[X] = a - X;
-    al[X] = int(b == a + 1) & int(c == a + W) & int(d == c + 1);
-  }
-  build_segments(h, W);
-  const float* zr = f.z + row;
-  const float* pz = s.prev_z.data();
-  const std::uint32_t* idr = kIds ? f.id + row : nullptr;
-  const std::uint32_t* pid = kIds ? s.prev_id.data() : nullptr;
-  for (const auto& sg : h.segments) {
-    if (sg.base >= 0)
-      history_test<kIds, true>(zr, idr, pz, pid, o.depth_tolerance, W, sg.x0, sg.x1, sg.base, h);
-    else
-      history_test<kIds, false>(zr, idr, pz, pid, o.depth_tolerance, W, sg.x0, sg.x1, 0, h);
-  }
-}
-
+// The history taps of full-resolution row Y (temporal/core/reproject.h): the previous frame's depth and ids kept
+// by the state, this frame's G-buffer, the method's disocclusion settings.
+using reproject::HistoryRow;
 inline void history_row(const Upsampler::State& s, const FrameContext& f, const Options& o, int Y, HistoryRow& h) {
-  h.resize(f.W);
-  if (o.use_ids && f.id && !s.prev_id.empty())
-    history_row_impl<true>(s, f, o, Y, h);
-  else
-    history_row_impl<false>(s, f, o, Y, h);
-}
-
-// The segments of a HistoryRow (see HistoryRow::segments): f(X0, X1, contiguous, base).
-template <typename F>
-inline void for_each_segment(const HistoryRow& h, int /*W*/, F&& f) {
-  for (const auto& sg : h.segments) f(sg.x0, sg.x1, sg.base >= 0, sg.base >= 0 ? sg.base : 0);
-}
-
-// The image-aligned four-tap gather (taps base + X, + 1, + W, + W + 1) of N = 3 or 4 planes in one loop: the
-// weights are loaded once for all planes. Same expression per plane as the loop of gather_history_planes.
-template <int N>
-inline void gather_aligned(const float* const* prev, float* const* out, const float* __restrict w0,
-                           const float* __restrict w1, const float* __restrict w2, const float* __restrict w3, int X0,
-                           int X1, int base, int W) {
-  static_assert(N == 3 || N == 4);
-  const float* __restrict pa = prev[0];
-  const float* __restrict pb = prev[1];
-  const float* __restrict pc = prev[2];
-  const float* __restrict pd = prev[N - 1];
-  float* __restrict oa = out[0];
-  float* __restrict ob = out[1];
-  float* __restrict oc = out[2];
-  float* __restrict od = out[N - 1];
-#pragma GCC ivdep
-  for (int X = X0; X < X1; ++X) {
-    const int a = base + X;
-    const float a0 = w0[X], a1 = w1[X], a2 = w2[X], a3 = w3[X];
-    oa[X] = a0 * pa[a] + a1 * pa[a + 1] + a2 * pa[a + W] + a3 * pa[a + W + 1];
-    ob[X] = a0 * pb[a] + a1 * pb[a + 1] + a2 * pb[a + W] + a3 * pb[a + W + 1];
-    oc[X] = a0 * pc[a] + a1 * pc[a + 1] + a2 * pc[a + W] + a3 * pc[a + W + 1];
-    if constexpr (N == 4) od[X] = a0 * pd[a] + a1 * pd[a + 1] + a2 * pd[a + W] + a3 * pd[a + W + 1];
-  }
-}
-
-// The four-tap gather of up to 4 previous-frame planes with the weights of a HistoryRow, in one pass (the
-// indices and weights are loaded once for all planes).
-inline void gather_history_planes(const HistoryRow& h, const float* const* prev, float* const* out, int n, int W) {
-  const int* __restrict q0 = h.q[0].data();
-  const int* __restrict q1 = h.q[1].data();
-  const int* __restrict q2 = h.q[2].data();
-  const int* __restrict q3 = h.q[3].data();
-  const float* __restrict w0 = h.w[0].data();
-  const float* __restrict w1 = h.w[1].data();
-  const float* __restrict w2 = h.w[2].data();
-  const float* __restrict w3 = h.w[3].data();
-  for_each_segment(h, W, [&](int X0, int X1, bool contiguous, int base) {
-    if (contiguous && n == 4) {  // h_w and R, G, B (herzog)
-      gather_aligned<4>(prev, out, w0, w1, w2, w3, X0, X1, base, W);
-      return;
-    }
-    if (contiguous && n == 3) {  // R, G, B (temporal)
-      gather_aligned<3>(prev, out, w0, w1, w2, w3, X0, X1, base, W);
-      return;
-    }
-    for (int i = 0; i < n; ++i) {
-      const float* __restrict p = prev[i];
-      float* __restrict o = out[i];
-      if (contiguous) {
-        // Taps 0/1 are p[base + X], p[base + X + 1]; taps 2/3 the same one row below.
-#pragma GCC ivdep
-        for (int X = X0; X < X1; ++X) {
-          const int a = base + X;
-          o[X] = w0[X] * p[a] + w1[X] * p[a + 1] + w2[X] * p[a + W] + w3[X] * p[a + W + 1];
-        }
-      } else {
-#pragma GCC ivdep
-        for (int X = X0; X < X1; ++X)
-          o[X] = w0[X] * p[q0[X]] + w1[X] * p[q1[X]] + w2[X] * p[q2[X]] + w3[X] * p[q3[X]];
-      }
-    }
-  });
+  reproject::Frames fr;
+  fr.width = f.W;
+  fr.height = f.H;
+  fr.motion_x = f.mx;
+  fr.motion_y = f.my;
+  fr.z = f.z;
+  fr.prev_z = s.prev_z.data();
+  fr.id = f.id;
+  fr.prev_id = s.prev_id.empty() ? nullptr : s.prev_id.data();
+  fr.test = {o.depth_tolerance, o.use_ids};
+  reproject::reproject_row(fr, Y, h);
 }
 
 // The geometry (z, N, validity) and payload of one low-resolution row, expanded to full-resolution columns:

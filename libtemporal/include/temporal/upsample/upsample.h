@@ -4,7 +4,7 @@
 //   spatial   joint-bilateral upsampling, seed 000 eq. 1-3 (hat image kernel)            [joint_bilateral.h]
 //   temporal  temporally-amortised upsampling, seed 000 eq. 4: pixels shaded this frame are kept, the
 //             others are fetched from the previous output at p + motion; disocclusions (depth + id,
-//             Figure 3) have no history and are filled spatially and counted ("hole pixels")  [reprojection.h]
+//             Figure 3) have no history and are filled spatially and counted ("hole pixels")  [temporal/core/reproject.h]
 //   herzog    spatio-temporal upsampling, seed 000 sections 3.3-3.5: exponential history (eq. 6-7),
 //             image kernel with fall-off gamma * w_f, w_f from the filtered relative gradient (eq. 8)  [history.h]
 //   drobot    seed 002: reprojection cache at low resolution + exponential history with convergence,

@@ -1,0 +1,50 @@
+// Parameters of a method, described once: the library's option structs hold the defaults, and each method lists
+// its parameters as Param entries that point at those fields. Tools bind the list to their command line (flag,
+// help, default printed from the field, valid range); the benchmark, the golden tests and the pipelines read the
+// same list. So a default is written in exactly one place, and a range check cannot be forgotten.
+#pragma once
+
+#include "temporal/core/error.h"
+
+#include <limits>
+#include <string>
+#include <variant>
+#include <vector>
+
+namespace temporal {
+
+// One parameter: the command-line flag, a help line (what it is, the paper's name and equation), the field it
+// sets, and its valid range. Floating-point values must be finite and inside [min, max]; integers inside
+// [min, max]; strings one of `choices` (when given).
+struct Param {
+  std::string flag;  // "--sigma-normal"
+  std::string help;  // "sigma_n of the normal weight (seed 000 eq. 2)"
+  std::variant<float*, double*, int*, bool*, std::string*> value;
+  double min = -std::numeric_limits<double>::infinity();
+  double max = std::numeric_limits<double>::infinity();
+  std::vector<std::string> choices;
+
+  // Shorthands for the common ranges.
+  static Param real(std::string flag, std::string help, float* v, double lo, double hi) {
+    return {std::move(flag), std::move(help), v, lo, hi, {}};
+  }
+  static Param integer(std::string flag, std::string help, int* v, int lo, int hi) {
+    return {std::move(flag), std::move(help), v, double(lo), double(hi), {}};
+  }
+  static Param flag_on(std::string flag, std::string help, bool* v) { return {std::move(flag), std::move(help), v, 0, 1, {}}; }
+  static Param choice(std::string flag, std::string help, std::string* v, std::vector<std::string> options) {
+    return {std::move(flag), std::move(help), v, 0, 0, std::move(options)};
+  }
+};
+using ParamList = std::vector<Param>;
+
+// The current value as text (the default, before parsing): "0.2", "4", "on", "herzog".
+std::string param_value_text(const Param& param);
+// The valid range as text: "[0, 1]", "> 0", "one of: cache, refresh"; empty when unbounded.
+std::string param_range_text(const Param& param);
+// Usage error unless the current value is valid: finite, inside the range, one of the choices.
+Status check_param(const Param& param);
+// check_param for every entry (the first failure).
+Status check_params(const ParamList& params);
+
+}  // namespace temporal

@@ -1,0 +1,89 @@
+// Method parameters (temporal/core/params.h): text forms and range checks.
+#include "temporal/core/params.h"
+
+#include <cmath>
+#include <cstdio>
+
+namespace temporal {
+namespace {
+
+// Numbers for messages: integers without a fraction, others with up to 6 significant digits.
+std::string number(double v) {
+  if (std::isinf(v)) return v > 0 ? "inf" : "-inf";
+  char text[64];
+  if (v == std::floor(v) && std::abs(v) < 1e15)
+    std::snprintf(text, sizeof text, "%.0f", v);
+  else
+    std::snprintf(text, sizeof text, "%.6g", v);
+  return text;
+}
+
+std::string join(const std::vector<std::string>& items) {
+  std::string s;
+  for (const auto& x : items) {
+    if (!s.empty()) s += ", ";
+    s += x;
+  }
+  return s;
+}
+
+}  // namespace
+
+std::string param_value_text(const Param& p) {
+  return std::visit(
+      [](auto* v) -> std::string {
+        using T = std::remove_pointer_t<decltype(v)>;
+        if constexpr (std::is_same_v<T, bool>)
+          return *v ? "on" : "off";
+        else if constexpr (std::is_same_v<T, std::string>)
+          return *v;
+        else
+          return number(double(*v));
+      },
+      p.value);
+}
+
+std::string param_range_text(const Param& p) {
+  if (!p.choices.empty()) return "one of: " + join(p.choices);
+  if (std::holds_alternative<bool*>(p.value)) return {};
+  const bool lo = std::isfinite(p.min), hi = std::isfinite(p.max);
+  // Appended piece by piece: `"[" + std::string` trips a false -Wrestrict in GCC 12.
+  std::string text;
+  if (lo && hi) {
+    text.append("[").append(number(p.min)).append(", ").append(number(p.max)).append("]");
+  } else if (lo) {
+    text.append(">= ").append(number(p.min));
+  } else if (hi) {
+    text.append("<= ").append(number(p.max));
+  }
+  return text;
+}
+
+Status check_param(const Param& p) {
+  if (const auto* s = std::get_if<std::string*>(&p.value)) {
+    if (p.choices.empty()) return Status::ok();
+    for (const auto& c : p.choices)
+      if (**s == c) return Status::ok();
+    return Error::usage(p.flag + " '" + **s + "' is not " + param_range_text(p));
+  }
+  if (std::holds_alternative<bool*>(p.value)) return Status::ok();
+  const double v = std::visit(
+      [](auto* x) -> double {
+        using T = std::remove_pointer_t<decltype(x)>;
+        if constexpr (std::is_arithmetic_v<T>) return double(*x);
+        return 0.0;
+      },
+      p.value);
+  if (!std::isfinite(v)) return Error::usage(p.flag + " must be a finite number (got " + number(v) + ")");
+  if (v < p.min || v > p.max)
+    return Error::usage(p.flag + " " + number(v) + " is out of range: it must be " + param_range_text(p));
+  return Status::ok();
+}
+
+Status check_params(const ParamList& params) {
+  for (const auto& p : params)
+    if (Status s = check_param(p); !s) return s;
+  return Status::ok();
+}
+
+}  // namespace temporal

@@ -1,0 +1,282 @@
+// The sequence runner (temporal/core/runner.h).
+#include "temporal/core/runner.h"
+
+#include <algorithm>
+#include <deque>
+#include <filesystem>
+
+namespace temporal {
+namespace {
+
+std::string join(const std::vector<std::string>& v) {
+  std::string s;
+  for (const auto& x : v) {
+    if (!s.empty()) s += ", ";
+    s += x;
+  }
+  return s.empty() ? std::string("(none)") : s;
+}
+
+std::string dims(int w, int h) { return std::to_string(w) + "x" + std::to_string(h); }
+
+// The channels a layer name stands for in a G-buffer.
+std::vector<std::string> layer_channel_names(const std::string& layer) {
+  if (layer == "depth") return {"depth.Z"};
+  if (layer == "N") return {"N.X", "N.Y", "N.Z"};
+  if (layer == "motion") return {"motion.X", "motion.Y"};
+  if (layer == "albedo") return {"albedo.R", "albedo.G", "albedo.B"};
+  if (layer == "id") return {"id"};
+  return {};
+}
+
+// Everything the loop needs, resolved from the options once.
+struct Plan {
+  SequencePattern input, out;
+  std::optional<SequencePattern> gbuffer, state_out;
+  std::vector<int> frames;
+  std::set<int> resets;
+  ExrWriteOptions write;
+};
+
+Expected<Plan> make_plan(const SequenceOptions& o, const StageInputs& needs) {
+  auto input = SequencePattern::parse(o.input);
+  if (!input) return input.error();
+  auto out = SequencePattern::parse(o.out);
+  if (!out) return out.error();
+  if (input->has_placeholder() && !out->has_placeholder())
+    return Error::usage("--out '" + o.out + "' needs a frame placeholder (#### or %04d) for a sequence");
+  std::optional<FrameRange> range;
+  if (!o.frames.empty()) {
+    auto r = FrameRange::parse(o.frames);
+    if (!r) return r.error();
+    range = *r;
+  }
+  auto frames = resolve_frames(*input, range);
+  if (!frames) return frames.error();
+  auto compression = parse_data_compression(o.compression);
+  if (!compression) return compression.error();
+  Plan plan{*input, *out, std::nullopt, std::nullopt, *frames, {}, {}};
+  plan.write.compression = *compression;
+  if (!o.reset_frames.empty()) {
+    auto list = parse_frame_list(o.reset_frames);
+    if (!list) return list.error();
+    plan.resets.insert(list->begin(), list->end());
+  }
+  if (o.gbuffer.empty()) {
+    if (needs.gbuffer_required)
+      return Error::usage("this method needs --gbuffer G.####.exr (" + needs.gbuffer_purpose + ")");
+  } else if (!needs.gbuffer_layers.empty()) {
+    auto g = SequencePattern::parse(o.gbuffer);
+    if (!g) return g.error();
+    // Every G-buffer file of the range must exist before any work is done.
+    if (auto f = resolve_frames(*g, FrameRange{plan.frames.front(), plan.frames.back()}); !f) return f.error();
+    plan.gbuffer = *g;
+  }
+  if (!o.state_out.empty()) {
+    auto s = SequencePattern::parse(o.state_out);
+    if (!s) return s.error();
+    plan.state_out = *s;
+  }
+  return plan;
+}
+
+// The G-buffer layers to read (selection for read_exr).
+std::vector<std::string> gbuffer_selection(const StageInputs& needs) {
+  std::vector<std::string> layers;
+  for (const auto& n : needs.gbuffer_layers) layers.push_back(n.layer);
+  return layers;
+}
+
+// Reads frames in order, keeping the lookahead frames in memory (each file is read once).
+class InputWindow {
+ public:
+  InputWindow(const Plan& plan, const StageInputs& needs) : plan_(plan), needs_(needs) {}
+  // The current frame followed by up to `lookahead` next frames that exist on disk.
+  Status advance(int frame) {
+    while (!cache_.empty() && cache_.front().first < frame) cache_.pop_front();
+    int next = cache_.empty() ? frame : cache_.back().first + 1;
+    for (; next <= frame + needs_.lookahead; ++next) {
+      const std::string path = plan_.input.path(next);
+      if (next != frame && !std::filesystem::exists(path)) break;
+      auto img = read_exr(path, ExrSelection{needs_.input_layers});
+      if (!img) {
+        Error e = img.error();
+        if (e.file.empty()) e.file = path;
+        return e;
+      }
+      cache_.emplace_back(next, std::move(*img));
+    }
+    return Status::ok();
+  }
+  const Image& current() const { return cache_.front().second; }
+  std::vector<const Image*> next() const {
+    std::vector<const Image*> v;
+    for (std::size_t i = 1; i < cache_.size(); ++i) v.push_back(&cache_[i].second);
+    return v;
+  }
+
+ private:
+  const Plan& plan_;
+  const StageInputs& needs_;
+  std::deque<std::pair<int, Image>> cache_;
+};
+
+// The size the G-buffer must have for this input frame.
+Status check_gbuffer_size(const Image& g, const Image& input, const StageInputs& needs, const std::string& gpath,
+                          const std::string& ipath) {
+  int k = needs.gbuffer_scale;
+  if (k == 0) k = input.metadata().jitter_factor.value_or(1);
+  if (g.width() == k * input.width() && g.height() == k * input.height()) return Status::ok();
+  if (k == 1)
+    return Error::input(gpath, "G-buffer is " + dims(g.width(), g.height()) + " but " + ipath + " is " +
+                                   dims(input.width(), input.height()) + "; render both at the same --size");
+  return Error::input(ipath, "size mismatch: G-buffer " + dims(g.width(), g.height()) + " (" + gpath + ") must be k = " +
+                                 std::to_string(k) + " times the input " + dims(input.width(), input.height()) +
+                                 " per axis (full = k * low)");
+}
+
+Status write_state(const Plan& plan, const FrameStage& stage, const RunIdentity& id, int frame) {
+  auto state = stage.save_state();
+  if (!state) return state.error();
+  FrameMetadata& md = state->metadata();
+  md.frame = frame;
+  md.tool = id.tool;
+  md.parameters = id.parameters;
+  return write_exr(plan.state_out->path(frame), *state, plan.write);
+}
+
+}  // namespace
+
+Expected<ExrCompression> parse_data_compression(const std::string& name) {
+  auto c = parse_compression(name);
+  if (!c) return c.error();
+  if (*c == ExrCompression::Dwaa)
+    return Error::usage("--compression dwaa is lossy (it compresses `*.Y` data as luminance): use none, zip or piz");
+  return *c;
+}
+
+Status check_gbuffer_layers(const Image& g, const std::vector<LayerNeed>& needs, const std::string& path) {
+  for (const auto& need : needs) {
+    if (!need.required) continue;
+    bool ok = true;
+    for (const auto& c : layer_channel_names(need.layer))
+      ok = ok && (c == "id" ? g.uint_plane(c) != nullptr : g.plane(c) != nullptr);
+    if (layer_channel_names(need.layer).empty()) ok = !g.layer_channels(need.layer).empty();
+    if (!ok) {
+      std::string how = "; render the G-buffer with render-gbuffer --outputs gbuffer";
+      if (need.layer == "id" && g.has_channel("id")) how = "; `id` must be stored as uint32 (render-gbuffer writes it so)";
+      return Error::input(path, "no layer '" + need.layer + "' (have: " + join(g.channel_names()) + ")" + how);
+    }
+  }
+  return Status::ok();
+}
+
+std::size_t count_non_finite_layers(const Image& image, const std::vector<std::string>& layers) {
+  std::size_t n = 0;
+  for (const auto& name : image.channel_names()) {
+    bool selected = layers.empty();
+    for (const auto& l : layers) {
+      const auto channels = layer_channel_names(l);
+      selected = selected || name == l || std::find(channels.begin(), channels.end(), name) != channels.end() ||
+                 name.rfind(l + ".", 0) == 0 || (l == "rgb" && (name == "R" || name == "G" || name == "B"));
+    }
+    if (const float* p = selected ? image.plane(name) : nullptr) n += count_non_finite({p, image.pixel_count()});
+  }
+  return n;
+}
+
+Expected<RunSummary> run_sequence(const SequenceOptions& options, FrameStage& stage, const RunIdentity& identity,
+                                  const RunHooks& hooks) {
+  const StageInputs& needs = stage.inputs();
+  auto plan = make_plan(options, needs);
+  if (!plan) return plan.error();
+  if ((!options.state_in.empty() || !options.state_out.empty()) && !stage.has_state())
+    return Error::usage("this method has no state: drop --state-in / --state-out");
+  auto warn = [&](const std::string& file, const std::string& text) {
+    if (hooks.warning) hooks.warning(file, text);
+  };
+  auto log = [&](const std::string& text) {
+    if (hooks.log) hooks.log(text);
+  };
+  bool resumed = false;
+  if (!options.state_in.empty()) {
+    auto state = read_exr(options.state_in);
+    if (!state) return state.error();
+    if (Status s = stage.load_state(*state); !s) {
+      Error e = s.error();
+      if (e.file.empty()) e.file = options.state_in;
+      return e;
+    }
+    resumed = true;
+  }
+
+  RunSummary summary;
+  InputWindow window(*plan, needs);
+  const std::vector<std::string> gsel = gbuffer_selection(needs);
+  std::vector<StageOutput> outputs;
+  int prev = -1;
+  const std::size_t n = plan->frames.size();
+  for (std::size_t i = 0; i < n; ++i) {
+    const int frame = plan->frames[i];
+    StageFrame sf;
+    sf.frame = frame;
+    sf.index = i;
+    sf.count = n;
+    sf.input_path = plan->input.path(frame);
+    if (Status s = window.advance(frame); !s) return s.error();
+    sf.input = &window.current();
+    sf.next = window.next();
+    if (const std::size_t bad = count_non_finite_layers(*sf.input, needs.input_layers); bad > 0) {
+      warn(sf.input_path, std::to_string(bad) +
+                              " non-finite values (NaN/Inf): treated as missing samples and kept out of every history");
+      summary.non_finite_input += bad;
+    }
+    Image gbuffer;
+    if (plan->gbuffer) {
+      sf.gbuffer_path = plan->gbuffer->path(frame);
+      auto g = read_exr(sf.gbuffer_path, ExrSelection{gsel});
+      if (!g) return g.error();
+      if (Status s = check_gbuffer_layers(*g, needs.gbuffer_layers, sf.gbuffer_path); !s) return s.error();
+      if (Status s = check_gbuffer_size(*g, *sf.input, needs, sf.gbuffer_path, sf.input_path); !s) return s.error();
+      if (const std::size_t bad = count_non_finite_layers(*g, gsel); bad > 0) {
+        warn(sf.gbuffer_path, std::to_string(bad) + " non-finite G-buffer values (NaN/Inf): those pixels get no "
+                                                     "history and no spatial weight");
+        summary.non_finite_gbuffer += bad;
+      }
+      gbuffer = std::move(*g);
+      sf.gbuffer = &gbuffer;
+    }
+    sf.cut = (i == 0 && !resumed) || plan->resets.count(frame) > 0 || (prev >= 0 && frame != prev + 1) ||
+             sf.input->metadata().camera_cut.value_or(false) ||
+             (sf.gbuffer && i > 0 && sf.gbuffer->metadata().camera_cut.value_or(false));
+    outputs.clear();
+    if (Status s = stage.process(sf, outputs); !s) {
+      Error e = s.error();
+      if (e.file.empty()) e.file = sf.input_path;
+      return e;
+    }
+    for (auto& o : outputs) {
+      FrameMetadata md = o.keep_input_metadata ? sf.input->metadata() : o.image->metadata();
+      md.frame = o.frame;
+      md.tool = identity.tool;
+      md.parameters = identity.parameters;
+      md.compute_ms = o.compute_ms;
+      md.timings_ms = o.timings_ms;  // the input's pass timings describe another stage
+      for (const auto& [k, v] : o.extra) md.extra[k] = v;
+      o.image->metadata() = std::move(md);
+      if (Status s = write_exr(plan->out.path(o.frame), *o.image, plan->write); !s) return s.error();
+      summary.compute_ms += o.compute_ms;
+      ++summary.outputs;
+    }
+    if (plan->state_out && (plan->state_out->has_placeholder() || i + 1 == n))
+      if (Status s = write_state(*plan, stage, identity, frame); !s) return s.error();
+    if (const std::string line = stage.frame_summary(); !line.empty())
+      log("frame " + std::to_string(frame) + ": " + line + (sf.cut ? " (history reset)" : ""));
+    if (hooks.frame_done) hooks.frame_done(frame, int(i + 1), int(n));
+    prev = frame;
+    ++summary.frames;
+  }
+  return summary;
+}
+
+}  // namespace temporal
