@@ -50,9 +50,9 @@ std::string param_range_text(const Param& p) {
   // Appended piece by piece: `"[" + std::string` trips a false -Wrestrict in GCC 12.
   std::string text;
   if (lo && hi) {
-    text.append("[").append(number(p.min)).append(", ").append(number(p.max)).append("]");
+    text.append(p.above_min ? "(" : "[").append(number(p.min)).append(", ").append(number(p.max)).append("]");
   } else if (lo) {
-    text.append(">= ").append(number(p.min));
+    text.append(p.above_min ? "> " : ">= ").append(number(p.min));
   } else if (hi) {
     text.append("<= ").append(number(p.max));
   }
@@ -75,7 +75,7 @@ Status check_param(const Param& p) {
       },
       p.value);
   if (!std::isfinite(v)) return Error::usage(p.flag + " must be a finite number (got " + number(v) + ")");
-  if (v < p.min || v > p.max)
+  if (v < p.min || v > p.max || (p.above_min && v == p.min))
     return Error::usage(p.flag + " " + number(v) + " is out of range: it must be " + param_range_text(p));
   return Status::ok();
 }

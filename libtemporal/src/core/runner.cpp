@@ -2,6 +2,7 @@
 #include "temporal/core/runner.h"
 
 #include <algorithm>
+#include <cmath>
 #include <deque>
 #include <filesystem>
 
@@ -172,7 +173,7 @@ Status check_gbuffer_layers(const Image& g, const std::vector<LayerNeed>& needs,
 }
 
 std::size_t count_non_finite_layers(const Image& image, const std::vector<std::string>& layers) {
-  std::size_t n = 0;
+  std::vector<const float*> planes;
   for (const auto& name : image.channel_names()) {
     bool selected = layers.empty();
     for (const auto& l : layers) {
@@ -180,7 +181,13 @@ std::size_t count_non_finite_layers(const Image& image, const std::vector<std::s
       selected = selected || name == l || std::find(channels.begin(), channels.end(), name) != channels.end() ||
                  name.rfind(l + ".", 0) == 0 || (l == "rgb" && (name == "R" || name == "G" || name == "B"));
     }
-    if (const float* p = selected ? image.plane(name) : nullptr) n += count_non_finite({p, image.pixel_count()});
+    if (const float* p = selected ? image.plane(name) : nullptr) planes.push_back(p);
+  }
+  std::size_t n = 0;
+  for (std::size_t i = 0; i < image.pixel_count(); ++i) {
+    bool finite = true;
+    for (const float* p : planes) finite = finite && std::isfinite(p[i]);
+    n += finite ? 0 : 1;
   }
   return n;
 }
@@ -228,7 +235,7 @@ Expected<RunSummary> run_sequence(const SequenceOptions& options, FrameStage& st
     sf.next = window.next();
     if (const std::size_t bad = count_non_finite_layers(*sf.input, needs.input_layers); bad > 0) {
       warn(sf.input_path, std::to_string(bad) +
-                              " non-finite values (NaN/Inf): treated as missing samples and kept out of every history");
+                              " pixels hold NaN or Inf: treated as missing samples and kept out of every history");
       summary.non_finite_input += bad;
     }
     Image gbuffer;
@@ -239,8 +246,8 @@ Expected<RunSummary> run_sequence(const SequenceOptions& options, FrameStage& st
       if (Status s = check_gbuffer_layers(*g, needs.gbuffer_layers, sf.gbuffer_path); !s) return s.error();
       if (Status s = check_gbuffer_size(*g, *sf.input, needs, sf.gbuffer_path, sf.input_path); !s) return s.error();
       if (const std::size_t bad = count_non_finite_layers(*g, gsel); bad > 0) {
-        warn(sf.gbuffer_path, std::to_string(bad) + " non-finite G-buffer values (NaN/Inf): those pixels get no "
-                                                     "history and no spatial weight");
+        warn(sf.gbuffer_path, std::to_string(bad) + " pixels hold NaN or Inf in the G-buffer: they get no history "
+                                                     "and no spatial weight");
         summary.non_finite_gbuffer += bad;
       }
       gbuffer = std::move(*g);

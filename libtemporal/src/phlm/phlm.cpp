@@ -493,4 +493,8 @@ Status PhlmFilter::set_state(const Image& state, int channels) {
   return Status::ok();
 }
 
+std::string PhlmFilter::stats_text(const FilterStats& stats) const {
+  return ", max trace(P) " + std::to_string(stats.max_trace_p);
+}
+
 }  // namespace temporal

@@ -23,10 +23,18 @@ struct Param {
   double min = -std::numeric_limits<double>::infinity();
   double max = std::numeric_limits<double>::infinity();
   std::vector<std::string> choices;
+  bool above_min = false;  // the value must be strictly greater than min ("> 0")
 
   // Shorthands for the common ranges.
   static Param real(std::string flag, std::string help, float* v, double lo, double hi) {
     return {std::move(flag), std::move(help), v, lo, hi, {}};
+  }
+  // A value strictly above `lo` (e.g. a positive scale: > 0).
+  static Param positive(std::string flag, std::string help, float* v, double lo = 0.0,
+                        double hi = std::numeric_limits<double>::infinity()) {
+    Param p{std::move(flag), std::move(help), v, lo, hi, {}};
+    p.above_min = true;
+    return p;
   }
   static Param integer(std::string flag, std::string help, int* v, int lo, int hi) {
     return {std::move(flag), std::move(help), v, double(lo), double(hi), {}};

@@ -136,7 +136,8 @@ Expected<ExrCompression> parse_data_compression(const std::string& name);
 // produce it. `path` names the file in the error.
 Status check_gbuffer_layers(const Image& gbuffer, const std::vector<LayerNeed>& needs, const std::string& path);
 
-// Non-finite values in the float planes of the named layers of `image` (every float plane when empty).
+// Pixels of `image` with a NaN or Inf in any float plane of the named layers (every float plane when empty; "rgb"
+// stands for R, G, B).
 std::size_t count_non_finite_layers(const Image& image, const std::vector<std::string>& layers);
 
 }  // namespace temporal

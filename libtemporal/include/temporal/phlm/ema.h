@@ -22,16 +22,17 @@ struct EmaParams {
   float depth_tolerance = 0.05f; // |d_prev - d| / d above this rejects the history
 };
 
-class EmaFilter {
+class EmaFilter final : public FrameFilter {
  public:
   explicit EmaFilter(EmaParams params = {});
 
   // Filters one frame; `debug.reject` (1 where the history was rejected) is added when in.debug.
-  Status process(const FilterInput& in, Image& output, FilterStats* stats = nullptr);
+  Status process(const FilterInput& in, Image& output, FilterStats* stats = nullptr) override;
 
   // History `history.<c>` plus the previous frame's `history.depth` and `history.id` (when given).
   const Image& state() const { return history_; }
-  Status set_state(const Image& state, int channels);
+  Status set_state(const Image& state, int channels) override;
+  Image saved_state() const override { return history_; }
   static std::vector<std::string> state_channel_names(int channels);
 
  private:

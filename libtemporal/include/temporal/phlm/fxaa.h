@@ -26,4 +26,21 @@ struct FxaaParams {
 // in.debug.
 Status fxaa(const FilterInput& in, Image& output, const FxaaParams& params = {}, FilterStats* stats = nullptr);
 
+// fxaa() as a FrameFilter: spatial, no state.
+class FxaaFilter final : public FrameFilter {
+ public:
+  explicit FxaaFilter(FxaaParams params = {}) : params_(params) {}
+  Status process(const FilterInput& in, Image& output, FilterStats* stats = nullptr) override {
+    return fxaa(in, output, params_, stats);
+  }
+  bool has_state() const override { return false; }
+  Image saved_state() const override { return {}; }
+  Status set_state(const Image&, int) override {
+    return Error::usage("--method fxaa is spatial and has no state: drop --state-in / --state-out");
+  }
+
+ private:
+  FxaaParams params_;
+};
+
 }  // namespace temporal
