@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Whole-tool regression check for refactors (not run by CTest: it takes a few minutes). Renders two built-in
 # scenes at 128x96, runs every method of every tool on them, and writes every output under DIR (`record`),
-# or runs the same commands again and requires the pixels of every EXR (all parts, idiff -a, tolerance 0) and
+# or runs the same commands again (into a temporary folder) and requires the pixels of every EXR (all parts, idiff -a, tolerance 0) and
 # every metric of compare's CSV (timing columns dropped) to equal the recorded ones (`check`).
 #
 # Usage: tests/golden/tool_outputs.sh record|check DIR [BUILD_DIR]     (BUILD_DIR default: build/ci)
@@ -14,9 +14,14 @@ case "$build" in /*) ;; *) build="$PWD/$build" ;; esac
 case "$dir" in /*) ;; *) dir="$PWD/$dir" ;; esac
 bin="$build/apps"
 out="$dir"
-[[ "$mode" == check ]] && out="$dir.check"
-rm -rf "$out"
-mkdir -p "$out"
+if [[ "$mode" == check ]]; then
+  # A fresh folder per run: several checks may run at once on one machine.
+  out="$(mktemp -d "${TMPDIR:-/tmp}/tool_outputs.XXXXXX")"
+  trap 'rm -rf "$out"' EXIT
+else
+  rm -rf "$out"
+  mkdir -p "$out"
+fi
 
 render() { "$bin/render-gbuffer/render-gbuffer" "$@" >/dev/null; }
 up() { "$bin/upsample-st/upsample-st" "$@"; }
