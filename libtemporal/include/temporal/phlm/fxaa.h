@@ -7,7 +7,7 @@
 //
 // Luma: FXAA works on perceptual luma; for scene-linear input it is sqrt of the Rec. 709 luminance of values
 // clamped to [0, 1] (Lottes suggests luma in gamma space, and sqrt is the usual gamma-2 estimate).
-// NaN/Inf pixels are counted and passed through unchanged.
+// NaN/Inf pixels are counted and replaced by the mean of their finite 4-neighbours (0 when none is finite).
 #pragma once
 
 #include "temporal/core/error.h"
