@@ -16,6 +16,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <numbers>
 #include <string>
@@ -51,7 +52,10 @@ inline float clamp01(float v) { return std::min(std::max(v, 0.0f), 1.0f); }
 // CIELab from XYZ with a given cube root: the scalar API uses std::pow, the pixel loops fast_math::pow.
 template <typename Pow>
 inline Color lab_from_xyz(float x, float y, float z, Pow pow) {
-  auto f = [&](float t) { return t > kLabDeltaCube ? pow(t, 1.0f / 3.0f) : kLabFactor * t + kLabTerm; };
+  auto f = [&](float t) {  // both branches evaluated, then selected: the pixel loops stay branch-free
+    const float root = pow(t, 1.0f / 3.0f), linear = kLabFactor * t + kLabTerm;
+    return t > kLabDeltaCube ? root : linear;
+  };
   const float fx = f(x * kInvWhite[0]), fy = f(y * kInvWhite[1]), fz = f(z * kInvWhite[2]);
   return {116.0f * fy - 16.0f, 500.0f * (fx - fy), 200.0f * (fy - fz)};
 }
@@ -246,59 +250,141 @@ constexpr int kStrip = 64;  // pixels per filter strip: 4 AVX-512 (8 AVX2) regis
 // How the input images become linear RGB in [0, 1] before YyCxCz.
 enum class Prepare { Srgb, Linear, ToneRational, ToneReinhard };
 
-// Plane storage with kStrip floats of zeroed slack, so strip loops may read (not use) past the last pixel.
+// Plane storage: `margin` replicated rows above and below the image (so vertical filters need no clamping),
+// and kStrip floats of zeroed slack at the end, so strip loops may read (not use) past the last pixel.
 struct Plane {
   std::vector<float> v;
-  void resize(std::size_t n) { v.assign(n + kStrip, 0.0f); }
-  float* data() { return v.data(); }
-  const float* data() const { return v.data(); }
+  std::size_t width = 0;
+  int margin = 0;
+  void resize(std::size_t w, int h, int m = 0) {
+    width = w;
+    margin = m;
+    v.assign(w * std::size_t(h + 2 * m) + kStrip, 0.0f);
+  }
+  float* data() { return v.data() + std::size_t(margin) * width; }  // row 0
+  const float* data() const { return v.data() + std::size_t(margin) * width; }
+  // Copies row 0 into the margin rows above and row h - 1 into those below.
+  void fill_margins(int h) {
+    for (int r = 1; r <= margin; ++r) {
+      std::memcpy(data() - std::size_t(r) * width, data(), width * sizeof(float));
+      std::memcpy(data() + std::size_t(h - 1 + r) * width, data() + std::size_t(h - 1) * width, width * sizeof(float));
+    }
+  }
 };
 
-// Step (1): linear RGB in [0, 1] (decoded, or exposed by `scale` and tone-mapped, then clamped) -> YyCxCz.
-// Invalid pixels are black in both images.
-template <Prepare P>
-void prepare_rows(const FlipImage& in, std::size_t n, const std::uint8_t* valid, float scale, const float* k,
-                  float* Y, float* Cx, float* Cz) {
-  parallel_chunks(n, [&](std::size_t b, std::size_t e) {
-    const float* m = flip::kRgbToXyz;
-    for (std::size_t i = b; i < e; ++i) {
-      const bool ok = !valid || valid[i];
-      float c[3] = {ok ? in.r[i] : 0.0f, ok ? in.g[i] : 0.0f, ok ? in.b[i] : 0.0f};
-      if constexpr (P == Prepare::Srgb) {
-        for (float& v : c) v = v <= 0.04045f ? v / 12.92f : fast_math::pow((v + 0.055f) / 1.055f, 2.4f);
-      } else if constexpr (P == Prepare::ToneRational) {
-        for (float& v : c) {
-          v *= scale;
-          v = (v * v * k[0] + v * k[1] + k[2]) / (v * v * k[3] + v * k[4] + k[5]);
-        }
-      } else if constexpr (P == Prepare::ToneReinhard) {
-        for (float& v : c) v *= scale;
-        const float s = 1.0f / (1.0f + 0.2126f * c[0] + 0.7152f * c[1] + 0.0722f * c[2]);
-        for (float& v : c) v *= s;
+// GCC vector types for the filters: with plain loops GCC vectorised the vertical filter across its taps, with
+// gathers, at a tenth of the speed. A strip of kStrip floats is four Vec16 (four AVX-512 registers, or eight
+// AVX2 ones once lowered).
+using Vec16 = float __attribute__((vector_size(64)));
+static_assert(kStrip == 64, "a strip is four Vec16");
+inline Vec16 load16(const float* p) {
+  Vec16 v;
+  std::memcpy(&v, p, sizeof v);
+  return v;
+}
+inline void store16(float* p, const Vec16& v) { std::memcpy(p, &v, sizeof v); }
+
+// Step (1) on pixels [begin, end): linear RGB in [0, 1] (decoded, or exposed by `scale` and tone-mapped, then
+// clamped) -> YyCxCz. Invalid pixels are black. The pixel loops are free functions with restrict parameters:
+// inside the parallel lambdas GCC could not prove that the output planes do not alias the captured pointers,
+// and `valid` is a template choice because a load under a null test keeps a loop from vectorising.
+template <Prepare P, bool Valid>
+[[gnu::noinline]] void prepare_span(const float* __restrict R, const float* __restrict G, const float* __restrict Bl,
+                  const std::uint8_t* __restrict valid, float scale, const float* __restrict k, float* __restrict Y,
+                  float* __restrict Cx, float* __restrict Cz, float* __restrict Yf, std::size_t begin,
+                  std::size_t end) {
+  const float* m = flip::kRgbToXyz;
+  const float k0 = k[0], k1 = k[1], k2 = k[2], k3 = k[3], k4 = k[4], k5 = k[5];
+  for (std::size_t i = begin; i < end; ++i) {
+    bool ok = true;
+    if constexpr (Valid) ok = valid[i] != 0;
+    float c[3] = {ok ? R[i] : 0.0f, ok ? G[i] : 0.0f, ok ? Bl[i] : 0.0f};
+    if constexpr (P == Prepare::Srgb) {
+      for (float& v : c) {
+        const float curve = fast_math::pow((v + 0.055f) / 1.055f, 2.4f), linear = v / 12.92f;
+        v = v <= 0.04045f ? linear : curve;
       }
-      for (float& v : c) v = std::min(std::max(v, 0.0f), 1.0f);
-      const float x = (m[0] * c[0] + m[1] * c[1] + m[2] * c[2]) * flip::kInvWhite[0];
-      const float y = (m[3] * c[0] + m[4] * c[1] + m[5] * c[2]) * flip::kInvWhite[1];
-      const float z = (m[6] * c[0] + m[7] * c[1] + m[8] * c[2]) * flip::kInvWhite[2];
-      Y[i] = 116.0f * y - 16.0f;
-      Cx[i] = 500.0f * (x - y);
-      Cz[i] = 200.0f * (y - z);
+    } else if constexpr (P == Prepare::ToneRational) {
+      for (float& v : c) {
+        v *= scale;
+        v = (v * v * k0 + v * k1 + k2) / (v * v * k3 + v * k4 + k5);
+      }
+    } else if constexpr (P == Prepare::ToneReinhard) {
+      for (float& v : c) v *= scale;
+      const float s = 1.0f / (1.0f + 0.2126f * c[0] + 0.7152f * c[1] + 0.0722f * c[2]);
+      for (float& v : c) v *= s;
     }
+    for (float& v : c) v = std::min(std::max(v, 0.0f), 1.0f);
+    const float x = (m[0] * c[0] + m[1] * c[1] + m[2] * c[2]) * flip::kInvWhite[0];
+    const float y = (m[3] * c[0] + m[4] * c[1] + m[5] * c[2]) * flip::kInvWhite[1];
+    const float z = (m[6] * c[0] + m[7] * c[1] + m[8] * c[2]) * flip::kInvWhite[2];
+    const float luma = 116.0f * y - 16.0f;
+    Y[i] = luma;
+    Cx[i] = 500.0f * (x - y);
+    Cz[i] = 200.0f * (y - z);
+    Yf[i] = luma * (1.0f / 116.0f) + 16.0f / 116.0f;  // the feature filters' input, Y normalised to [0, 1]
+  }
+}
+
+template <Prepare P, bool Valid>
+void prepare_rows(const FlipImage& in, std::size_t n, const std::uint8_t* valid, float scale, const float* k,
+                  float* Y, float* Cx, float* Cz, float* Yf) {
+  parallel_chunks(n, [&](std::size_t b, std::size_t e) {
+    prepare_span<P, Valid>(in.r, in.g, in.b, valid, scale, k, Y, Cx, Cz, Yf, b, e);
   });
 }
 
-// acc[k][i] += w_k[t] * src_t[i] over the taps, for K outputs of one strip; sources are per output and per tap.
+// Step (3) per pixel of a strip: filtered YyCxCz -> XYZ -> linear RGB clamped to [0, 1] (the reference's order)
+// -> XYZ -> CIELab -> Hunt. Not inlined: in the caller's tile loop GCC loses the restrict guarantees and does
+// not vectorise it.
+[[gnu::noinline]] void lab_span(const float* __restrict fy, const float* __restrict fcx, const float* __restrict fcz1,
+                                const float* __restrict fcz2, float* __restrict L, float* __restrict A,
+                                float* __restrict B, int count) {
+  const float* mi = flip::kXyzToRgb;
+  const float* mf = flip::kRgbToXyz;
+  const auto fast_pow = [](float x, float p) { return fast_math::pow(x, p); };
+  for (int i = 0; i < count; ++i) {
+    const float yy = (fy[i] + 16.0f) * (1.0f / 116.0f);
+    const float X = (yy + fcx[i] * (1.0f / 500.0f)) * flip::kWhite[0];
+    const float Yv = yy * flip::kWhite[1];
+    const float Z = (yy - (fcz1[i] + fcz2[i]) * (1.0f / 200.0f)) * flip::kWhite[2];
+    const float r = flip::clamp01(mi[0] * X + mi[1] * Yv + mi[2] * Z);
+    const float g = flip::clamp01(mi[3] * X + mi[4] * Yv + mi[5] * Z);
+    const float b = flip::clamp01(mi[6] * X + mi[7] * Yv + mi[8] * Z);
+    const Color lab = flip::lab_from_xyz(mf[0] * r + mf[1] * g + mf[2] * b, mf[3] * r + mf[4] * g + mf[5] * b,
+                                         mf[6] * r + mf[7] * g + mf[8] * b, fast_pow);
+    L[i] = lab[0];
+    A[i] = 0.01f * lab[0] * lab[1];
+    B[i] = 0.01f * lab[0] * lab[2];
+  }
+}
+
+// Edge and point magnitudes from the filtered first and second derivatives.
+[[gnu::noinline]] void feature_span(const float* __restrict dx, const float* __restrict ddx,
+                                    const float* __restrict dy, const float* __restrict ddy, float* __restrict E,
+                                    float* __restrict P, int count) {
+  for (int i = 0; i < count; ++i) {
+    E[i] = std::sqrt(dx[i] * dx[i] + dy[i] * dy[i]);
+    P[i] = std::sqrt(ddx[i] * ddx[i] + ddy[i] * ddy[i]);
+  }
+}
+
+// out_k[i] = sum_t w_k[t] src[t * step + i] for the kStrip pixels of a strip, K outputs from one input (each
+// input vector loaded once for all K): along a row (step 1) or down a column (step = plane width).
 template <int K>
-inline void strip_fir(float (&acc)[K][kStrip], const float* const (&src)[K], std::ptrdiff_t step, int taps,
-                      const float* const (&w)[K]) {
-  for (int k = 0; k < K; ++k)
-    for (int i = 0; i < kStrip; ++i) acc[k][i] = 0.0f;
-  for (int t = 0; t < taps; ++t)
+inline void strip_fir(const float* src, std::ptrdiff_t step, int taps, const float* const (&w)[K],
+                      float* const (&out)[K]) {
+  Vec16 acc[K][4] = {};
+  for (int t = 0; t < taps; ++t) {
+    const float* s = src + std::ptrdiff_t(t) * step;
+    const Vec16 v[4] = {load16(s), load16(s + 16), load16(s + 32), load16(s + 48)};
     for (int k = 0; k < K; ++k) {
       const float wt = w[k][t];
-      const float* s = src[k] + std::ptrdiff_t(t) * step;
-      for (int i = 0; i < kStrip; ++i) acc[k][i] += wt * s[i];
+      for (int j = 0; j < 4; ++j) acc[k][j] += wt * v[j];
     }
+  }
+  for (int k = 0; k < K; ++k)
+    for (int j = 0; j < 4; ++j) store16(out[k] + 16 * j, acc[k][j]);
 }
 
 struct Filters {
@@ -312,142 +398,137 @@ struct Filters {
 enum { kHY, kHCx, kHCz1, kHCz2, kHG, kHDG, kHDDG, kHorizontal };
 enum { kL, kA, kB, kEdge, kPoint, kProducts };
 
-// Step (2): every 1-D horizontal filter of a row, borders clamped (each row is copied into a padded buffer).
-void horizontal_pass(const float* Y, const float* Cx, const float* Cz, int w, int h, const Filters& f,
-                     Plane (&out)[kHorizontal]) {
+// The input window of a strip starting at x0 for a filter of radius r: the row itself where the window lies
+// inside it, else a copy in `buffer` with coordinates clamped to the row (the reference's border rule).
+inline const float* strip_window(const float* row, int x0, int r, int w, float* buffer) {
+  if (x0 - r >= 0 && x0 + kStrip + r <= w) return row + (x0 - r);
+  for (int j = 0; j < kStrip + 2 * r; ++j) buffer[j] = row[std::clamp(x0 - r + j, 0, w - 1)];
+  return buffer;
+}
+
+// Step (2): every 1-D horizontal filter of a row; the feature filters read Y normalised to [0, 1] (Yf). The
+// outputs' margin rows are filled afterwards, for the vertical filters.
+void horizontal_pass(const float* Y, const float* Cx, const float* Cz, const float* Yf, int w, int h,
+                     const Filters& f, Plane (&out)[kHorizontal]) {
   parallel_rows(h, [&](int y0, int y1) {
-    const int rs = f.rs, rf = f.rf;
-    std::vector<float> pad_y(std::size_t(w + 2 * rs + kStrip)), pad_cx(pad_y.size()), pad_cz(pad_y.size());
-    std::vector<float> pad_f(std::size_t(w + 2 * rf + kStrip));
-    auto pad = [&](const float* row, int r, std::vector<float>& dst, bool feature) {
-      for (int x = -r; x < w + r; ++x) {
-        const float v = row[std::clamp(x, 0, w - 1)];
-        dst[std::size_t(x + r)] = feature ? v * (1.0f / 116.0f) + 16.0f / 116.0f : v;  // Y to [0, 1]
-      }
-    };
+    const int rs = f.rs, rf = f.rf, ts = 2 * rs + 1, tf = 2 * rf + 1;
+    std::vector<float> buffer(4 * std::size_t(kStrip + 2 * std::max(rs, rf)));
+    float* const buf[4] = {buffer.data(), buffer.data() + buffer.size() / 4, buffer.data() + buffer.size() / 2,
+                           buffer.data() + 3 * buffer.size() / 4};
+    alignas(64) float sink[kHorizontal][kStrip];  // the last strip's overhang
     for (int y = y0; y < y1; ++y) {
       const std::size_t o = std::size_t(y) * std::size_t(w);
-      pad(Y + o, rs, pad_y, false);
-      pad(Cx + o, rs, pad_cx, false);
-      pad(Cz + o, rs, pad_cz, false);
-      pad(Y + o, rf, pad_f, true);
-      const int ts = 2 * rs + 1, tf = 2 * rf + 1;
       for (int x0 = 0; x0 < w; x0 += kStrip) {
-        const int m = std::min(kStrip, w - x0);
-        float a[2][kStrip], c[2][kStrip], g[3][kStrip];
-        const std::size_t xs = std::size_t(x0);
-        strip_fir<2>(a, {pad_y.data() + xs, pad_cx.data() + xs}, 1, ts, {f.spatial.y.data(), f.spatial.cx.data()});
-        strip_fir<2>(c, {pad_cz.data() + xs, pad_cz.data() + xs}, 1, ts, {f.spatial.cz1.data(), f.spatial.cz2.data()});
-        strip_fir<3>(g, {pad_f.data() + xs, pad_f.data() + xs, pad_f.data() + xs}, 1, tf,
-                     {f.feature.g.data(), f.feature.dg.data(), f.feature.ddg.data()});
-        const float* res[kHorizontal] = {a[0], a[1], c[0], c[1], g[0], g[1], g[2]};
-        for (int p = 0; p < kHorizontal; ++p) std::copy(res[p], res[p] + m, out[p].data() + o + xs);
+        // Full strips write in place; the last one through `sink` so nothing past the row is overwritten.
+        const bool full = x0 + kStrip <= w;
+        float* dst[kHorizontal];
+        for (int p = 0; p < kHorizontal; ++p) dst[p] = full ? out[p].data() + o + std::size_t(x0) : sink[p];
+        strip_fir<1>(strip_window(Y + o, x0, rs, w, buf[0]), 1, ts, {f.spatial.y.data()}, {dst[kHY]});
+        strip_fir<1>(strip_window(Cx + o, x0, rs, w, buf[1]), 1, ts, {f.spatial.cx.data()}, {dst[kHCx]});
+        strip_fir<2>(strip_window(Cz + o, x0, rs, w, buf[2]), 1, ts, {f.spatial.cz1.data(), f.spatial.cz2.data()},
+                     {dst[kHCz1], dst[kHCz2]});
+        strip_fir<3>(strip_window(Yf + o, x0, rf, w, buf[3]), 1, tf,
+                     {f.feature.g.data(), f.feature.dg.data(), f.feature.ddg.data()}, {dst[kHG], dst[kHDG], dst[kHDDG]});
+        if (!full)
+          for (int p = 0; p < kHorizontal; ++p) std::copy(sink[p], sink[p] + (w - x0), out[p].data() + o + std::size_t(x0));
       }
     }
   });
+  for (auto& p : out) p.fill_margins(h);
 }
 
-// Step (3): the vertical 1-D filters, and per pixel the Hunt-adjusted CIELab of the filtered colour and the
-// edge and point magnitudes.
-void vertical_pass(const Plane (&in)[kHorizontal], int w, int h, const Filters& f, Plane (&out)[kProducts]) {
-  const auto fast_pow = [](float x, float p) { return fast_math::pow(x, p); };
-  parallel_rows(h, [&](int y0, int y1) {
-    const int rs = f.rs, rf = f.rf;
+// Tiles of kStrip columns by kBand rows, each walked down its rows: the tap rows a tile needs (kBand + 2 r rows,
+// kStrip wide, about 21 kB for the four colour planes at 67 ppd) stay in the 32 kB L1 cache.
+template <typename Body>
+void for_tiles(int w, int h, Body&& body) {
+  constexpr int kBand = 32;
+  const int strips = (w + kStrip - 1) / kStrip, bands = (h + kBand - 1) / kBand;
+  parallel_chunks(
+      std::size_t(strips) * std::size_t(bands),
+      [&](std::size_t t0, std::size_t t1) {
+        for (std::size_t tile = t0; tile < t1; ++tile) {
+          const int x0 = int(tile % std::size_t(strips)) * kStrip, y0 = int(tile / std::size_t(strips)) * kBand;
+          body(x0, std::min(kStrip, w - x0), y0, std::min(y0 + kBand, h));
+        }
+      },
+      4);
+}
+
+// Step (3a): the vertical CSF filters and, per pixel, the Hunt-adjusted CIELab of the filtered colour.
+void vertical_color_pass(const Plane (&in)[kHorizontal], int w, int h, const Filters& f, Plane (&out)[kProducts]) {
+  for_tiles(w, h, [&](int x0, int m, int y0, int y1) {
+    const int r = f.rs, taps = 2 * r + 1;
+    alignas(64) float acc[4][kStrip];
     for (int y = y0; y < y1; ++y) {
-      for (int x0 = 0; x0 < w; x0 += kStrip) {
-        const int m = std::min(kStrip, w - x0);
-        const std::size_t xs = std::size_t(x0);
-        // Tap rows are clamped at the borders, so each tap gets its own row pointer.
-        float acc_s[4][kStrip] = {}, acc_f[4][kStrip] = {};
-        for (int t = 0; t <= 2 * rs; ++t) {
-          const std::size_t row = std::size_t(std::clamp(y + t - rs, 0, h - 1)) * std::size_t(w) + xs;
-          const float* sy = in[kHY].data() + row;
-          const float* sx = in[kHCx].data() + row;
-          const float* s1 = in[kHCz1].data() + row;
-          const float* s2 = in[kHCz2].data() + row;
-          const std::size_t k = std::size_t(t);
-          const float wy = f.spatial.y[k], wx = f.spatial.cx[k], w1 = f.spatial.cz1[k], w2 = f.spatial.cz2[k];
-          for (int i = 0; i < kStrip; ++i) {
-            acc_s[0][i] += wy * sy[i];
-            acc_s[1][i] += wx * sx[i];
-            acc_s[2][i] += w1 * s1[i];
-            acc_s[3][i] += w2 * s2[i];
-          }
-        }
-        for (int t = 0; t <= 2 * rf; ++t) {
-          const std::size_t row = std::size_t(std::clamp(y + t - rf, 0, h - 1)) * std::size_t(w) + xs;
-          const float* sdg = in[kHDG].data() + row;
-          const float* sddg = in[kHDDG].data() + row;
-          const float* sg = in[kHG].data() + row;
-          const std::size_t k = std::size_t(t);
-          const float g = f.feature.g[k], dg = f.feature.dg[k], ddg = f.feature.ddg[k];
-          for (int i = 0; i < kStrip; ++i) {
-            acc_f[0][i] += g * sdg[i];   // d/dx
-            acc_f[1][i] += g * sddg[i];  // d2/dx2
-            acc_f[2][i] += dg * sg[i];   // d/dy
-            acc_f[3][i] += ddg * sg[i];  // d2/dy2
-          }
-        }
-        const std::size_t o = std::size_t(y) * std::size_t(w) + xs;
-        float* L = out[kL].data() + o;
-        float* A = out[kA].data() + o;
-        float* B = out[kB].data() + o;
-        float* E = out[kEdge].data() + o;
-        float* P = out[kPoint].data() + o;
-        const float* mi = flip::kXyzToRgb;
-        const float* mf = flip::kRgbToXyz;
-        for (int i = 0; i < m; ++i) {
-          // YyCxCz -> XYZ -> linear RGB clamped to [0, 1] (the reference's order) -> XYZ -> CIELab -> Hunt.
-          const float yy = (acc_s[0][i] + 16.0f) / 116.0f;
-          const float X = (yy + acc_s[1][i] / 500.0f) * flip::kWhite[0];
-          const float Yv = yy * flip::kWhite[1];
-          const float Z = (yy - (acc_s[2][i] + acc_s[3][i]) / 200.0f) * flip::kWhite[2];
-          const float r = flip::clamp01(mi[0] * X + mi[1] * Yv + mi[2] * Z);
-          const float g = flip::clamp01(mi[3] * X + mi[4] * Yv + mi[5] * Z);
-          const float b = flip::clamp01(mi[6] * X + mi[7] * Yv + mi[8] * Z);
-          const Color lab = flip::lab_from_xyz(mf[0] * r + mf[1] * g + mf[2] * b, mf[3] * r + mf[4] * g + mf[5] * b,
-                                               mf[6] * r + mf[7] * g + mf[8] * b, fast_pow);
-          L[i] = lab[0];
-          A[i] = 0.01f * lab[0] * lab[1];
-          B[i] = 0.01f * lab[0] * lab[2];
-          E[i] = std::sqrt(acc_f[0][i] * acc_f[0][i] + acc_f[2][i] * acc_f[2][i]);
-          P[i] = std::sqrt(acc_f[1][i] * acc_f[1][i] + acc_f[3][i] * acc_f[3][i]);
-        }
-      }
+      const std::ptrdiff_t top = std::ptrdiff_t(y - r) * w + x0, step = w;
+      strip_fir<1>(in[kHY].data() + top, step, taps, {f.spatial.y.data()}, {acc[0]});
+      strip_fir<1>(in[kHCx].data() + top, step, taps, {f.spatial.cx.data()}, {acc[1]});
+      strip_fir<1>(in[kHCz1].data() + top, step, taps, {f.spatial.cz1.data()}, {acc[2]});
+      strip_fir<1>(in[kHCz2].data() + top, step, taps, {f.spatial.cz2.data()}, {acc[3]});
+      const std::size_t o = std::size_t(y) * std::size_t(w) + std::size_t(x0);
+      lab_span(acc[0], acc[1], acc[2], acc[3], out[kL].data() + o, out[kA].data() + o, out[kB].data() + o, m);
     }
   });
 }
 
-// Step (4): FLIP per pixel from the two images' quantities. Max: HDR-FLIP's running maximum over exposures
-// (strictly greater replaces, as the reference), recording `exposure` in exposure_map when it is not null.
-template <bool Max>
+// Step (3b): the vertical feature filters (Gaussian down the x-derivatives, derivatives down the x-Gaussian)
+// and, per pixel, the edge and point magnitudes.
+void vertical_feature_pass(const Plane (&in)[kHorizontal], int w, int h, const Filters& f, Plane (&out)[kProducts]) {
+  for_tiles(w, h, [&](int x0, int m, int y0, int y1) {
+    const int r = f.rf, taps = 2 * r + 1;
+    alignas(64) float acc[4][kStrip];
+    for (int y = y0; y < y1; ++y) {
+      const std::ptrdiff_t top = std::ptrdiff_t(y - r) * w + x0, step = w;
+      strip_fir<1>(in[kHDG].data() + top, step, taps, {f.feature.g.data()}, {acc[0]});   // d/dx
+      strip_fir<1>(in[kHDDG].data() + top, step, taps, {f.feature.g.data()}, {acc[1]});  // d2/dx2
+      strip_fir<2>(in[kHG].data() + top, step, taps, {f.feature.dg.data(), f.feature.ddg.data()},
+                   {acc[2], acc[3]});  // d/dy, d2/dy2
+      const std::size_t o = std::size_t(y) * std::size_t(w) + std::size_t(x0);
+      feature_span(acc[0], acc[1], acc[2], acc[3], out[kEdge].data() + o, out[kPoint].data() + o, m);
+    }
+  });
+}
+
+// Step (4): FLIP per pixel from the two images' quantities, on pixels [begin, end). Max: HDR-FLIP's running
+// maximum over exposures (strictly greater replaces, as the reference), recording `exposure` in `which`.
+struct CombineConstants {
+  float knee, below, above;
+};
+
+template <bool Max, bool Valid>
+[[gnu::noinline]] void combine_span(const float* __restrict L1, const float* __restrict A1, const float* __restrict B1,
+                  const float* __restrict E1, const float* __restrict P1, const float* __restrict L2,
+                  const float* __restrict A2, const float* __restrict B2, const float* __restrict E2,
+                  const float* __restrict P2, const std::uint8_t* __restrict valid, float* __restrict out,
+                  float* __restrict which, float exposure, CombineConstants k, std::size_t begin, std::size_t end) {
+  const float half = float(1.0 / std::numbers::sqrt2);
+  for (std::size_t i = begin; i < end; ++i) {
+    const float da = A1[i] - A2[i], db = B1[i] - B2[i];
+    const float distance = std::fabs(L1[i] - L2[i]) + std::sqrt(da * da + db * db);  // HyAB
+    const float c = fast_math::pow(distance, flip::kQc);
+    const float color = c < k.knee ? c * k.below : flip::kPt + (c - k.knee) * k.above;
+    const float feature = std::sqrt(std::max(std::fabs(E1[i] - E2[i]), std::fabs(P1[i] - P2[i])) * half);  // ^q_f
+    float v = fast_math::pow(color, 1.0f - feature);
+    if constexpr (Valid) v = valid[i] ? v : 0.0f;
+    if constexpr (Max) {
+      const bool larger = v > out[i];
+      out[i] = larger ? v : out[i];
+      which[i] = larger ? exposure : which[i];
+    } else {
+      out[i] = v;
+    }
+  }
+}
+
+template <bool Max, bool Valid>
 void combine_pass(const Plane (&ref)[kProducts], const Plane (&test)[kProducts], std::size_t n,
                   const std::uint8_t* valid, float* map, float* exposure_map, float exposure) {
   const float cmax = flip::max_color_difference(), knee = flip::kPc * cmax;
-  const float below = flip::kPt / knee, above = (1.0f - flip::kPt) / (cmax - knee);
-  const float inv_sqrt2 = float(1.0 / std::numbers::sqrt2);
+  const CombineConstants k{knee, flip::kPt / knee, (1.0f - flip::kPt) / (cmax - knee)};
   parallel_chunks(n, [&](std::size_t b, std::size_t e) {
-    const float *L1 = ref[kL].data(), *A1 = ref[kA].data(), *B1 = ref[kB].data();
-    const float *E1 = ref[kEdge].data(), *P1 = ref[kPoint].data();
-    const float *L2 = test[kL].data(), *A2 = test[kA].data(), *B2 = test[kB].data();
-    const float *E2 = test[kEdge].data(), *P2 = test[kPoint].data();
-    for (std::size_t i = b; i < e; ++i) {
-      const float da = A1[i] - A2[i], db = B1[i] - B2[i];
-      const float distance = std::fabs(L1[i] - L2[i]) + std::sqrt(da * da + db * db);  // HyAB
-      const float c = fast_math::pow(distance, flip::kQc);
-      const float color = c < knee ? c * below : flip::kPt + (c - knee) * above;
-      const float feature =
-          std::sqrt(std::max(std::fabs(E1[i] - E2[i]), std::fabs(P1[i] - P2[i])) * inv_sqrt2);  // ^q_f = 0.5
-      float v = fast_math::pow(color, 1.0f - feature);
-      v = (!valid || valid[i]) ? v : 0.0f;
-      if constexpr (Max) {
-        const bool larger = v > map[i];
-        map[i] = larger ? v : map[i];
-        if (exposure_map) exposure_map[i] = larger ? exposure : exposure_map[i];
-      } else {
-        map[i] = v;
-      }
-    }
+    combine_span<Max, Valid>(ref[kL].data(), ref[kA].data(), ref[kB].data(), ref[kEdge].data(), ref[kPoint].data(),
+                             test[kL].data(), test[kA].data(), test[kB].data(), test[kEdge].data(),
+                             test[kPoint].data(), valid, map, exposure_map, exposure, k, b, e);
   });
 }
 
@@ -469,26 +550,30 @@ Status check_inputs(const FlipImage& test, const FlipImage& ref, int width, int 
 // The evaluator
 
 struct FlipEvaluator::Workspace {
-  std::size_t pixels = 0;
-  Plane ycxcz[3];
+  int width = 0, height = 0;
+  Plane ycxcz[4];  // Y, Cx, Cz, and Y normalised for the feature filters
   Plane horizontal[kHorizontal];
   Plane products[2][kProducts];  // [0]: reference, [1]: test
+  Plane exposure_scratch;
   Filters filters;
 
-  void ensure(std::size_t n, double ppd) {
-    if (n != pixels) {
-      for (auto& p : ycxcz) p.resize(n);
-      for (auto& p : horizontal) p.resize(n);
-      for (auto& image : products)
-        for (auto& p : image) p.resize(n);
-      pixels = n;
-    }
+  void ensure(int w, int h, double ppd) {
     if (filters.ppd != ppd) {
       filters.ppd = ppd;
       filters.rs = flip::spatial_filter_radius(ppd);
       filters.rf = flip::feature_filter_radius(ppd);
       filters.spatial = flip::spatial_filters(ppd);
       filters.feature = flip::feature_filters(ppd);
+    }
+    const int margin = std::max(filters.rs, filters.rf);
+    if (w != width || h != height || margin != horizontal[0].margin) {
+      for (auto& p : ycxcz) p.resize(std::size_t(w), h);
+      for (auto& p : horizontal) p.resize(std::size_t(w), h, margin);
+      for (auto& image : products)
+        for (auto& p : image) p.resize(std::size_t(w), h);
+      exposure_scratch.resize(std::size_t(w), h);
+      width = w;
+      height = h;
     }
   }
 
@@ -500,14 +585,20 @@ struct FlipEvaluator::Workspace {
     float* Cx = ycxcz[1].data();
     float* Cz = ycxcz[2].data();
     const float* k = flip::rational_coefficients(tone);
+    float* Yf = ycxcz[3].data();
+    auto run = [&]<Prepare P>() {
+      if (valid) prepare_rows<P, true>(in, n, valid, scale, k, Y, Cx, Cz, Yf);
+      else prepare_rows<P, false>(in, n, valid, scale, k, Y, Cx, Cz, Yf);
+    };
     switch (how) {
-      case Prepare::Srgb: prepare_rows<Prepare::Srgb>(in, n, valid, scale, k, Y, Cx, Cz); break;
-      case Prepare::Linear: prepare_rows<Prepare::Linear>(in, n, valid, scale, k, Y, Cx, Cz); break;
-      case Prepare::ToneRational: prepare_rows<Prepare::ToneRational>(in, n, valid, scale, k, Y, Cx, Cz); break;
-      case Prepare::ToneReinhard: prepare_rows<Prepare::ToneReinhard>(in, n, valid, scale, k, Y, Cx, Cz); break;
+      case Prepare::Srgb: run.template operator()<Prepare::Srgb>(); break;
+      case Prepare::Linear: run.template operator()<Prepare::Linear>(); break;
+      case Prepare::ToneRational: run.template operator()<Prepare::ToneRational>(); break;
+      case Prepare::ToneReinhard: run.template operator()<Prepare::ToneReinhard>(); break;
     }
-    horizontal_pass(Y, Cx, Cz, w, h, filters, horizontal);
-    vertical_pass(horizontal, w, h, filters, products[slot]);
+    horizontal_pass(Y, Cx, Cz, Yf, w, h, filters, horizontal);
+    vertical_color_pass(horizontal, w, h, filters, products[slot]);
+    vertical_feature_pass(horizontal, w, h, filters, products[slot]);
   }
 };
 
@@ -520,11 +611,12 @@ Status FlipEvaluator::ldr(const FlipImage& test, const FlipImage& reference, int
                           const std::uint8_t* valid, float* map) {
   if (auto st = check_inputs(test, reference, width, height, map, options_); !st) return st;
   const std::size_t n = std::size_t(width) * std::size_t(height);
-  work_->ensure(n, options_.pixels_per_degree);
+  work_->ensure(width, height, options_.pixels_per_degree);
   const Prepare how = options_.ldr_input == FlipLdrInput::Srgb ? Prepare::Srgb : Prepare::Linear;
   work_->image(reference, width, height, valid, how, 1.0f, options_.tone_mapper, 0);
   work_->image(test, width, height, valid, how, 1.0f, options_.tone_mapper, 1);
-  combine_pass<false>(work_->products[0], work_->products[1], n, valid, map, nullptr, 0.0f);
+  if (valid) combine_pass<false, true>(work_->products[0], work_->products[1], n, valid, map, nullptr, 0.0f);
+  else combine_pass<false, false>(work_->products[0], work_->products[1], n, valid, map, nullptr, 0.0f);
   return {};
 }
 
@@ -544,17 +636,21 @@ Expected<FlipExposures> FlipEvaluator::hdr(const FlipImage& test, const FlipImag
     return Error::usage("HDR-FLIP needs at least 2 exposures (got " + std::to_string(options_.exposures) +
                         "); 0 chooses max(2, ceil(stop - start))");
   e.count = options_.exposures > 0 ? options_.exposures : int(std::max(2.0f, std::ceil(e.stop - e.start)));
-  work_->ensure(n, options_.pixels_per_degree);
+  work_->ensure(width, height, options_.pixels_per_degree);
   std::fill(map, map + n, 0.0f);
-  if (exposure_map) std::fill(exposure_map, exposure_map + n, 0.0f);
+  // Without a caller's exposure map the running one goes to scratch (a store under a null test would keep the
+  // combine loop from vectorising).
+  float* exposures = exposure_map ? exposure_map : work_->exposure_scratch.data();
+  std::fill(exposures, exposures + n, 0.0f);
   const Prepare how = options_.tone_mapper == FlipToneMapper::Reinhard ? Prepare::ToneReinhard : Prepare::ToneRational;
   const float step = (e.stop - e.start) / float(e.count - 1);
   for (int i = 0; i < e.count; ++i) {
     const float scale = std::pow(2.0f, e.start + float(i) * step);
     work_->image(reference, width, height, valid, how, scale, options_.tone_mapper, 0);
     work_->image(test, width, height, valid, how, scale, options_.tone_mapper, 1);
-    combine_pass<true>(work_->products[0], work_->products[1], n, valid, map, exposure_map,
-                       float(i) / float(e.count - 1));
+    const float which = float(i) / float(e.count - 1);
+    if (valid) combine_pass<true, true>(work_->products[0], work_->products[1], n, valid, map, exposures, which);
+    else combine_pass<true, false>(work_->products[0], work_->products[1], n, valid, map, exposures, which);
   }
   return e;
 }
@@ -563,32 +659,40 @@ Expected<FlipExposures> FlipEvaluator::hdr(const FlipImage& test, const FlipImag
 // Pooling
 
 FlipStats flip_statistics(std::span<const float> map, const std::uint8_t* valid) {
-  // Fixed chunks, each with its own histogram of value sums, merged in chunk order: the result does not depend
-  // on the thread count. A value's bucket grows with the value, so a percentile's bucket is found from the
-  // cumulative bucket sums and only that bucket's values need sorting.
-  constexpr int kBuckets = 4096;
+  // Two parallel passes over fixed chunks (merged in chunk order, so the result does not depend on the thread
+  // count). A value's bucket grows with the value, so the bucket holding each weighted percentile follows from
+  // the cumulative bucket sums of pass 1, and pass 2 collects only those buckets' values, which are sorted.
+  constexpr int kBuckets = 1024;
   constexpr std::size_t kChunks = 32;
+  constexpr std::size_t kLanes = 4;  // FLIP values crowd into few buckets: four interleaved histograms keep the
+                                     // additions to one bucket from waiting on each other
   const std::size_t n = map.size();
+  auto bucket_of = [](float v) { return std::clamp(int(v * float(kBuckets)), 0, kBuckets - 1); };
+  auto valid_at = [&](std::size_t i) { return !valid || valid[i] != 0; };
   struct Chunk {
-    std::vector<double> sum = std::vector<double>(kBuckets, 0.0);
+    std::vector<double> sum;
     std::size_t count = 0;
     float min = std::numeric_limits<float>::infinity(), max = -std::numeric_limits<float>::infinity();
+    std::vector<float> picked[3];
   };
   std::vector<Chunk> chunks(kChunks);
-  auto bucket_of = [](float v) { return std::clamp(int(v * float(kBuckets)), 0, kBuckets - 1); };
   parallel_chunks(
       kChunks,
       [&](std::size_t c0, std::size_t c1) {
         for (std::size_t c = c0; c < c1; ++c) {
           Chunk& ch = chunks[c];
+          std::vector<double> lanes(kLanes * kBuckets, 0.0);
           for (std::size_t i = n * c / kChunks; i < n * (c + 1) / kChunks; ++i) {
-            if (valid && !valid[i]) continue;
+            if (!valid_at(i)) continue;
             const float v = map[i];
-            ch.sum[std::size_t(bucket_of(v))] += v;
+            lanes[(i % kLanes) * kBuckets + std::size_t(bucket_of(v))] += v;
             ++ch.count;
             ch.min = std::min(ch.min, v);
             ch.max = std::max(ch.max, v);
           }
+          ch.sum.assign(kBuckets, 0.0);
+          for (std::size_t l = 0; l < kLanes; ++l)
+            for (std::size_t b = 0; b < kBuckets; ++b) ch.sum[b] += lanes[l * kBuckets + b];
         }
       },
       1);
@@ -608,26 +712,47 @@ FlipStats flip_statistics(std::span<const float> map, const std::uint8_t* valid)
   s.mean = total / double(s.pixels);
   s.min = mn;
   s.max = mx;
-  auto percentile = [&](double p) {
-    const double target = p * total;
-    double before = 0.0;
+  // The bucket where the running sum first exceeds p * total, and the sum of the buckets below it.
+  const double fractions[3] = {0.25, 0.5, 0.75};
+  int target[3];
+  double before[3];
+  for (int q = 0; q < 3; ++q) {
+    double sum = 0.0;
     int b = 0;
-    while (b < kBuckets && !(before + bucket[std::size_t(b)] > target)) before += bucket[std::size_t(b++)];
-    if (b == kBuckets) return 0.0;  // every value 0: nothing exceeds 0 (the reference returns 0 too)
+    while (b < kBuckets && !(sum + bucket[std::size_t(b)] > fractions[q] * total)) sum += bucket[std::size_t(b++)];
+    target[q] = b;  // kBuckets: every value is 0, nothing exceeds 0 (the reference answers 0 too)
+    before[q] = sum;
+  }
+  parallel_chunks(
+      kChunks,
+      [&](std::size_t c0, std::size_t c1) {
+        for (std::size_t c = c0; c < c1; ++c)
+          for (std::size_t i = n * c / kChunks; i < n * (c + 1) / kChunks; ++i) {
+            const int b = bucket_of(map[i]);
+            // Rarely true: one predictable test per value, the three buckets sorted out only on a hit.
+            if ((b == target[0]) | (b == target[1]) | (b == target[2]) && valid_at(i))
+              for (int q = 0; q < 3; ++q)
+                if (b == target[q]) chunks[c].picked[q].push_back(map[i]);
+          }
+      },
+      1);
+  double result[3];
+  for (int q = 0; q < 3; ++q) {
     std::vector<float> values;
-    for (std::size_t i = 0; i < n; ++i)
-      if ((!valid || valid[i]) && bucket_of(map[i]) == b) values.push_back(map[i]);
+    for (const Chunk& ch : chunks) values.insert(values.end(), ch.picked[q].begin(), ch.picked[q].end());
     std::sort(values.begin(), values.end());
-    double running = before;
-    for (float v : values) {
-      running += v;
-      if (running > target) return double(v);
-    }
-    return values.empty() ? 0.0 : double(values.back());  // rounding of the bucket sums: the bucket's largest
-  };
-  s.weighted_quartile_1 = percentile(0.25);
-  s.weighted_median = percentile(0.5);
-  s.weighted_quartile_3 = percentile(0.75);
+    result[q] = target[q] == kBuckets || values.empty() ? 0.0 : double(values.back());  // fallback: see below
+    double running = before[q];
+    for (float v : values)
+      if ((running += v) > fractions[q] * total) {
+        result[q] = v;
+        break;
+      }
+    // Without a break, the bucket sums' rounding differs from this running sum: the bucket's largest value.
+  }
+  s.weighted_quartile_1 = result[0];
+  s.weighted_median = result[1];
+  s.weighted_quartile_3 = result[2];
   return s;
 }
 
