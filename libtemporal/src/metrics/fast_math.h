@@ -50,4 +50,15 @@ inline float pow(float x, float p) {
   return positive ? r : (p == 0.0f ? 1.0f : 0.0f);
 }
 
+// t^(1/3) for t > 0 and normal, without a division: Newton's iteration on the inverse cube root,
+// r <- r (4 - t r^3) / 3, whose relative error e becomes about -2 e^2 per step, from an estimate taken from the
+// bits (the exponent divided by 3; error below 4%), then t^(1/3) = t r^2. Three steps: within 4e-7 relative
+// (measured over [0.008, 1.3], CIELab's range). Inputs <= 0 give garbage, for callers that select it away.
+inline float cbrt(float t) {
+  float r = std::bit_cast<float>(0x54a21d2au - std::bit_cast<std::uint32_t>(t) / 3u);
+  const float third = t * (1.0f / 3.0f);
+  for (int i = 0; i < 3; ++i) r = r * ((4.0f / 3.0f) - third * (r * r * r));
+  return t * r * r;
+}
+
 }  // namespace temporal::fast_math

@@ -49,18 +49,19 @@ const float* rational_coefficients(FlipToneMapper t) { return t == FlipToneMappe
 
 inline float clamp01(float v) { return std::min(std::max(v, 0.0f), 1.0f); }
 
-// CIELab from XYZ with a given cube root: the scalar API uses std::pow, the pixel loops fast_math::pow.
-template <typename Pow>
-inline Color lab_from_xyz(float x, float y, float z, Pow pow) {
+// CIELab from XYZ with a given cube root: the scalar API uses std::pow(t, 1/3) as the reference, the pixel
+// loops fast_math::cbrt.
+template <typename Cbrt>
+inline Color lab_from_xyz(float x, float y, float z, Cbrt cbrt) {
   auto f = [&](float t) {  // both branches evaluated, then selected: the pixel loops stay branch-free
-    const float root = pow(t, 1.0f / 3.0f), linear = kLabFactor * t + kLabTerm;
+    const float root = cbrt(t), linear = kLabFactor * t + kLabTerm;
     return t > kLabDeltaCube ? root : linear;
   };
   const float fx = f(x * kInvWhite[0]), fy = f(y * kInvWhite[1]), fz = f(z * kInvWhite[2]);
   return {116.0f * fy - 16.0f, 500.0f * (fx - fy), 200.0f * (fy - fz)};
 }
 
-inline float std_pow(float x, float p) { return std::pow(x, p); }
+inline float std_cbrt(float t) { return std::pow(t, 1.0f / 3.0f); }
 
 float color_max_distance() {
   const Color green = hunt_adjust(xyz_to_lab(linear_rgb_to_xyz({0.0f, 1.0f, 0.0f})));
@@ -94,7 +95,7 @@ Color ycxcz_to_xyz(const Color& c) {
   return {(y + c[1] / 500.0f) * kWhite[0], y * kWhite[1], (y - c[2] / 200.0f) * kWhite[2]};
 }
 
-Color xyz_to_lab(const Color& c) { return lab_from_xyz(c[0], c[1], c[2], std_pow); }
+Color xyz_to_lab(const Color& c) { return lab_from_xyz(c[0], c[1], c[2], std_cbrt); }
 
 Color hunt_adjust(const Color& lab) { return {lab[0], 0.01f * lab[0] * lab[1], 0.01f * lab[0] * lab[2]}; }
 
@@ -290,12 +291,12 @@ inline void store16(float* p, const Vec16& v) { std::memcpy(p, &v, sizeof v); }
 // and `valid` is a template choice because a load under a null test keeps a loop from vectorising.
 template <Prepare P, bool Valid>
 [[gnu::noinline]] void prepare_span(const float* __restrict R, const float* __restrict G, const float* __restrict Bl,
-                  const std::uint8_t* __restrict valid, float scale, const float* __restrict k, float* __restrict Y,
-                  float* __restrict Cx, float* __restrict Cz, float* __restrict Yf, std::size_t begin,
-                  std::size_t end) {
+                                    const std::uint8_t* __restrict valid, float scale, const float* __restrict k,
+                                    float* __restrict Y, float* __restrict Cx, float* __restrict Cz,
+                                    float* __restrict Yf, std::size_t count) {
   const float* m = flip::kRgbToXyz;
   const float k0 = k[0], k1 = k[1], k2 = k[2], k3 = k[3], k4 = k[4], k5 = k[5];
-  for (std::size_t i = begin; i < end; ++i) {
+  for (std::size_t i = 0; i < count; ++i) {
     bool ok = true;
     if constexpr (Valid) ok = valid[i] != 0;
     float c[3] = {ok ? R[i] : 0.0f, ok ? G[i] : 0.0f, ok ? Bl[i] : 0.0f};
@@ -326,12 +327,20 @@ template <Prepare P, bool Valid>
   }
 }
 
-template <Prepare P, bool Valid>
-void prepare_rows(const FlipImage& in, std::size_t n, const std::uint8_t* valid, float scale, const float* k,
-                  float* Y, float* Cx, float* Cz, float* Yf) {
-  parallel_chunks(n, [&](std::size_t b, std::size_t e) {
-    prepare_span<P, Valid>(in.r, in.g, in.b, valid, scale, k, Y, Cx, Cz, Yf, b, e);
-  });
+// Step (1) for one row: the input pointers at the row's first pixel, the outputs where the row goes.
+using PrepareRow = void (*)(const float*, const float*, const float*, const std::uint8_t*, float, const float*,
+                            float*, float*, float*, float*, std::size_t);
+
+PrepareRow prepare_row(Prepare how, bool valid) {
+  switch (how) {
+    case Prepare::Srgb: return valid ? prepare_span<Prepare::Srgb, true> : prepare_span<Prepare::Srgb, false>;
+    case Prepare::Linear: return valid ? prepare_span<Prepare::Linear, true> : prepare_span<Prepare::Linear, false>;
+    case Prepare::ToneRational:
+      return valid ? prepare_span<Prepare::ToneRational, true> : prepare_span<Prepare::ToneRational, false>;
+    case Prepare::ToneReinhard:
+      return valid ? prepare_span<Prepare::ToneReinhard, true> : prepare_span<Prepare::ToneReinhard, false>;
+  }
+  return nullptr;
 }
 
 // Step (3) per pixel of a strip: filtered YyCxCz -> XYZ -> linear RGB clamped to [0, 1] (the reference's order)
@@ -342,7 +351,7 @@ void prepare_rows(const FlipImage& in, std::size_t n, const std::uint8_t* valid,
                                 float* __restrict B, int count) {
   const float* mi = flip::kXyzToRgb;
   const float* mf = flip::kRgbToXyz;
-  const auto fast_pow = [](float x, float p) { return fast_math::pow(x, p); };
+  const auto fast_cbrt = [](float t) { return fast_math::cbrt(t); };
   for (int i = 0; i < count; ++i) {
     const float yy = (fy[i] + 16.0f) * (1.0f / 116.0f);
     const float X = (yy + fcx[i] * (1.0f / 500.0f)) * flip::kWhite[0];
@@ -352,7 +361,7 @@ void prepare_rows(const FlipImage& in, std::size_t n, const std::uint8_t* valid,
     const float g = flip::clamp01(mi[3] * X + mi[4] * Yv + mi[5] * Z);
     const float b = flip::clamp01(mi[6] * X + mi[7] * Yv + mi[8] * Z);
     const Color lab = flip::lab_from_xyz(mf[0] * r + mf[1] * g + mf[2] * b, mf[3] * r + mf[4] * g + mf[5] * b,
-                                         mf[6] * r + mf[7] * g + mf[8] * b, fast_pow);
+                                         mf[6] * r + mf[7] * g + mf[8] * b, fast_cbrt);
     L[i] = lab[0];
     A[i] = 0.01f * lab[0] * lab[1];
     B[i] = 0.01f * lab[0] * lab[2];
@@ -390,45 +399,80 @@ inline void strip_fir(const float* src, std::ptrdiff_t step, int taps, const flo
 struct Filters {
   double ppd = 0.0;
   int rs = 0, rf = 0;  // radii: spatial (CSF), feature
+  int ry = 0, rcx = 0;  // radii of the Y and Cx kernels once their negligible outer taps are dropped
   flip::SpatialFilters spatial;
   flip::FeatureFilters feature;
+
+  void set(double pixels_per_degree) {
+    ppd = pixels_per_degree;
+    rs = flip::spatial_filter_radius(ppd);
+    rf = flip::feature_filter_radius(ppd);
+    spatial = flip::spatial_filters(ppd);
+    feature = flip::feature_filters(ppd);
+    ry = trim(spatial.y);
+    rcx = trim(spatial.cx);
+  }
+
+  // The narrow Y and Cx Gaussians (sigma about 1 pixel at 67 ppd) span the radius of the widest CSF Gaussian
+  // (Cz's, 10 pixels), as in the reference. Their outer taps below 2^-24 of the centre tap move a filtered value
+  // by less than its own float rounding, so they are dropped (after the normalisation over all taps): 11 and 13
+  // taps instead of 21 at 67 ppd.
+  static int trim(std::vector<float>& taps) {
+    int r = int(taps.size() / 2);
+    const float limit = taps[std::size_t(r)] * 0x1p-24f;
+    while (r > 0 && taps.front() < limit && taps.back() < limit) {
+      taps.erase(taps.begin());
+      taps.pop_back();
+      --r;
+    }
+    return r;
+  }
 };
 
 // The seven horizontal outputs and the five per-image quantities.
 enum { kHY, kHCx, kHCz1, kHCz2, kHG, kHDG, kHDDG, kHorizontal };
 enum { kL, kA, kB, kEdge, kPoint, kProducts };
 
-// The input window of a strip starting at x0 for a filter of radius r: the row itself where the window lies
-// inside it, else a copy in `buffer` with coordinates clamped to the row (the reference's border rule).
-inline const float* strip_window(const float* row, int x0, int r, int w, float* buffer) {
-  if (x0 - r >= 0 && x0 + kStrip + r <= w) return row + (x0 - r);
-  for (int j = 0; j < kStrip + 2 * r; ++j) buffer[j] = row[std::clamp(x0 - r + j, 0, w - 1)];
-  return buffer;
-}
+// Steps (1) and (2): each row goes to YyCxCz (and Yf, Y normalised to [0, 1] for the feature filters) in row
+// buffers extended by `margin` pixels on both sides with the edge values (the reference's clamped borders), and
+// every 1-D horizontal filter runs on those buffers. The outputs' margin rows are filled afterwards, for the
+// vertical filters. Preparing rows here rather than in a pass of its own saves writing and reading four planes.
+struct RowInput {
+  const FlipImage* image;
+  const std::uint8_t* valid;
+  PrepareRow prepare;
+  float scale;
+  const float* k;
+};
 
-// Step (2): every 1-D horizontal filter of a row; the feature filters read Y normalised to [0, 1] (Yf). The
-// outputs' margin rows are filled afterwards, for the vertical filters.
-void horizontal_pass(const float* Y, const float* Cx, const float* Cz, const float* Yf, int w, int h,
-                     const Filters& f, Plane (&out)[kHorizontal]) {
+void horizontal_pass(const RowInput& in, int w, int h, const Filters& f, Plane (&out)[kHorizontal]) {
   parallel_rows(h, [&](int y0, int y1) {
-    const int rs = f.rs, rf = f.rf, ts = 2 * rs + 1, tf = 2 * rf + 1;
-    std::vector<float> buffer(4 * std::size_t(kStrip + 2 * std::max(rs, rf)));
-    float* const buf[4] = {buffer.data(), buffer.data() + buffer.size() / 4, buffer.data() + buffer.size() / 2,
-                           buffer.data() + 3 * buffer.size() / 4};
+    const int margin = std::max(f.rs, f.rf);
+    const std::size_t len = std::size_t(w + 2 * margin + kStrip);
+    std::vector<float> rows(4 * len);
+    float* const buf[4] = {rows.data(), rows.data() + len, rows.data() + 2 * len, rows.data() + 3 * len};  // Y Cx Cz Yf
     alignas(64) float sink[kHorizontal][kStrip];  // the last strip's overhang
     for (int y = y0; y < y1; ++y) {
       const std::size_t o = std::size_t(y) * std::size_t(w);
+      const std::uint8_t* valid = in.valid ? in.valid + o : nullptr;
+      in.prepare(in.image->r + o, in.image->g + o, in.image->b + o, valid, in.scale, in.k, buf[0] + margin,
+                 buf[1] + margin, buf[2] + margin, buf[3] + margin, std::size_t(w));
+      for (float* b : buf) {
+        std::fill(b, b + margin, b[margin]);
+        std::fill(b + margin + w, b + 2 * margin + w, b[margin + w - 1]);
+      }
       for (int x0 = 0; x0 < w; x0 += kStrip) {
         // Full strips write in place; the last one through `sink` so nothing past the row is overwritten.
         const bool full = x0 + kStrip <= w;
         float* dst[kHorizontal];
         for (int p = 0; p < kHorizontal; ++p) dst[p] = full ? out[p].data() + o + std::size_t(x0) : sink[p];
-        strip_fir<1>(strip_window(Y + o, x0, rs, w, buf[0]), 1, ts, {f.spatial.y.data()}, {dst[kHY]});
-        strip_fir<1>(strip_window(Cx + o, x0, rs, w, buf[1]), 1, ts, {f.spatial.cx.data()}, {dst[kHCx]});
-        strip_fir<2>(strip_window(Cz + o, x0, rs, w, buf[2]), 1, ts, {f.spatial.cz1.data(), f.spatial.cz2.data()},
+        auto window = [&](int b, int r) { return buf[b] + margin + x0 - r; };
+        strip_fir<1>(window(0, f.ry), 1, 2 * f.ry + 1, {f.spatial.y.data()}, {dst[kHY]});
+        strip_fir<1>(window(1, f.rcx), 1, 2 * f.rcx + 1, {f.spatial.cx.data()}, {dst[kHCx]});
+        strip_fir<2>(window(2, f.rs), 1, 2 * f.rs + 1, {f.spatial.cz1.data(), f.spatial.cz2.data()},
                      {dst[kHCz1], dst[kHCz2]});
-        strip_fir<3>(strip_window(Yf + o, x0, rf, w, buf[3]), 1, tf,
-                     {f.feature.g.data(), f.feature.dg.data(), f.feature.ddg.data()}, {dst[kHG], dst[kHDG], dst[kHDDG]});
+        strip_fir<3>(window(3, f.rf), 1, 2 * f.rf + 1, {f.feature.g.data(), f.feature.dg.data(), f.feature.ddg.data()},
+                     {dst[kHG], dst[kHDG], dst[kHDDG]});
         if (!full)
           for (int p = 0; p < kHorizontal; ++p) std::copy(sink[p], sink[p] + (w - x0), out[p].data() + o + std::size_t(x0));
       }
@@ -437,11 +481,13 @@ void horizontal_pass(const float* Y, const float* Cx, const float* Cz, const flo
   for (auto& p : out) p.fill_margins(h);
 }
 
-// Tiles of kStrip columns by kBand rows, each walked down its rows: the tap rows a tile needs (kBand + 2 r rows,
-// kStrip wide, about 21 kB for the four colour planes at 67 ppd) stay in the 32 kB L1 cache.
+// Tiles of kStrip columns by kBand rows, each walked down its rows: the 2 r + 1 tap rows of one output row,
+// kStrip wide (about 21 kB for the four colour planes at 67 ppd), stay in the 32 kB L1 cache from one output
+// row to the next, which needs one new row per plane. Whole image rows instead (seven planes times 21 taps of
+// 1920 pixels, 1 MB) made the vertical pass wait on memory.
 template <typename Body>
 void for_tiles(int w, int h, Body&& body) {
-  constexpr int kBand = 32;
+  constexpr int kBand = 64;
   const int strips = (w + kStrip - 1) / kStrip, bands = (h + kBand - 1) / kBand;
   parallel_chunks(
       std::size_t(strips) * std::size_t(bands),
@@ -454,20 +500,70 @@ void for_tiles(int w, int h, Body&& body) {
       4);
 }
 
+// Two consecutive output rows of a vertical filter on a strip: out0 from input rows 0 .. taps - 1 of `src`,
+// out1 from rows 1 .. taps. Each input row is loaded once for both (taps + 1 loads for two outputs instead of
+// 2 taps), which halves the loads of the vertical passes; the multiply-adds stay.
+template <int K>
+inline void column_fir2(const float* src, std::ptrdiff_t step, int taps, const float* const (&w)[K],
+                        float* const (&out0)[K], float* const (&out1)[K]) {
+  Vec16 a[K][4] = {}, b[K][4] = {};
+  auto load = [&](int t, Vec16 (&v)[4]) {
+    const float* s = src + std::ptrdiff_t(t) * step;
+    for (int j = 0; j < 4; ++j) v[j] = load16(s + 16 * j);
+  };
+  Vec16 v[4];
+  load(0, v);
+  for (int k = 0; k < K; ++k)
+    for (int j = 0; j < 4; ++j) a[k][j] += w[k][0] * v[j];
+  for (int t = 1; t < taps; ++t) {
+    load(t, v);
+    for (int k = 0; k < K; ++k) {
+      const float wa = w[k][t], wb = w[k][t - 1];
+      for (int j = 0; j < 4; ++j) {
+        a[k][j] += wa * v[j];
+        b[k][j] += wb * v[j];
+      }
+    }
+  }
+  load(taps, v);
+  for (int k = 0; k < K; ++k)
+    for (int j = 0; j < 4; ++j) b[k][j] += w[k][taps - 1] * v[j];
+  for (int k = 0; k < K; ++k)
+    for (int j = 0; j < 4; ++j) {
+      store16(out0[k] + 16 * j, a[k][j]);
+      store16(out1[k] + 16 * j, b[k][j]);
+    }
+}
+
+// Runs `rows(y, pair)` down a tile: pairs of output rows where two remain, then a single one.
+template <typename Rows>
+void down_tile(int y0, int y1, Rows&& rows) {
+  int y = y0;
+  for (; y + 1 < y1; y += 2) rows(y, true);
+  if (y < y1) rows(y, false);
+}
+
 // Step (3a): the vertical CSF filters and, per pixel, the Hunt-adjusted CIELab of the filtered colour.
 void vertical_color_pass(const Plane (&in)[kHorizontal], int w, int h, const Filters& f, Plane (&out)[kProducts]) {
   for_tiles(w, h, [&](int x0, int m, int y0, int y1) {
-    const int r = f.rs, taps = 2 * r + 1;
-    alignas(64) float acc[4][kStrip];
-    for (int y = y0; y < y1; ++y) {
-      const std::ptrdiff_t top = std::ptrdiff_t(y - r) * w + x0, step = w;
-      strip_fir<1>(in[kHY].data() + top, step, taps, {f.spatial.y.data()}, {acc[0]});
-      strip_fir<1>(in[kHCx].data() + top, step, taps, {f.spatial.cx.data()}, {acc[1]});
-      strip_fir<1>(in[kHCz1].data() + top, step, taps, {f.spatial.cz1.data()}, {acc[2]});
-      strip_fir<1>(in[kHCz2].data() + top, step, taps, {f.spatial.cz2.data()}, {acc[3]});
-      const std::size_t o = std::size_t(y) * std::size_t(w) + std::size_t(x0);
-      lab_span(acc[0], acc[1], acc[2], acc[3], out[kL].data() + o, out[kA].data() + o, out[kB].data() + o, m);
-    }
+    alignas(64) float acc[2][4][kStrip];
+    down_tile(y0, y1, [&](int y, bool pair) {
+      const std::ptrdiff_t step = w;
+      auto filter = [&](int plane, int r, const std::vector<float>& taps, int slot) {
+        const float* top = in[plane].data() + std::ptrdiff_t(y - r) * w + x0;
+        if (pair) column_fir2<1>(top, step, 2 * r + 1, {taps.data()}, {acc[0][slot]}, {acc[1][slot]});
+        else strip_fir<1>(top, step, 2 * r + 1, {taps.data()}, {acc[0][slot]});
+      };
+      filter(kHY, f.ry, f.spatial.y, 0);
+      filter(kHCx, f.rcx, f.spatial.cx, 1);
+      filter(kHCz1, f.rs, f.spatial.cz1, 2);
+      filter(kHCz2, f.rs, f.spatial.cz2, 3);
+      for (int k = 0; k < (pair ? 2 : 1); ++k) {
+        const std::size_t o = std::size_t(y + k) * std::size_t(w) + std::size_t(x0);
+        lab_span(acc[k][0], acc[k][1], acc[k][2], acc[k][3], out[kL].data() + o, out[kA].data() + o,
+                 out[kB].data() + o, m);
+      }
+    });
   });
 }
 
@@ -476,16 +572,26 @@ void vertical_color_pass(const Plane (&in)[kHorizontal], int w, int h, const Fil
 void vertical_feature_pass(const Plane (&in)[kHorizontal], int w, int h, const Filters& f, Plane (&out)[kProducts]) {
   for_tiles(w, h, [&](int x0, int m, int y0, int y1) {
     const int r = f.rf, taps = 2 * r + 1;
-    alignas(64) float acc[4][kStrip];
-    for (int y = y0; y < y1; ++y) {
+    alignas(64) float acc[2][4][kStrip];
+    down_tile(y0, y1, [&](int y, bool pair) {
       const std::ptrdiff_t top = std::ptrdiff_t(y - r) * w + x0, step = w;
-      strip_fir<1>(in[kHDG].data() + top, step, taps, {f.feature.g.data()}, {acc[0]});   // d/dx
-      strip_fir<1>(in[kHDDG].data() + top, step, taps, {f.feature.g.data()}, {acc[1]});  // d2/dx2
-      strip_fir<2>(in[kHG].data() + top, step, taps, {f.feature.dg.data(), f.feature.ddg.data()},
-                   {acc[2], acc[3]});  // d/dy, d2/dy2
-      const std::size_t o = std::size_t(y) * std::size_t(w) + std::size_t(x0);
-      feature_span(acc[0], acc[1], acc[2], acc[3], out[kEdge].data() + o, out[kPoint].data() + o, m);
-    }
+      const float* g = f.feature.g.data();
+      if (pair) {
+        column_fir2<1>(in[kHDG].data() + top, step, taps, {g}, {acc[0][0]}, {acc[1][0]});   // d/dx
+        column_fir2<1>(in[kHDDG].data() + top, step, taps, {g}, {acc[0][1]}, {acc[1][1]});  // d2/dx2
+        column_fir2<2>(in[kHG].data() + top, step, taps, {f.feature.dg.data(), f.feature.ddg.data()},
+                       {acc[0][2], acc[0][3]}, {acc[1][2], acc[1][3]});  // d/dy, d2/dy2
+      } else {
+        strip_fir<1>(in[kHDG].data() + top, step, taps, {g}, {acc[0][0]});
+        strip_fir<1>(in[kHDDG].data() + top, step, taps, {g}, {acc[0][1]});
+        strip_fir<2>(in[kHG].data() + top, step, taps, {f.feature.dg.data(), f.feature.ddg.data()},
+                     {acc[0][2], acc[0][3]});
+      }
+      for (int k = 0; k < (pair ? 2 : 1); ++k) {
+        const std::size_t o = std::size_t(y + k) * std::size_t(w) + std::size_t(x0);
+        feature_span(acc[k][0], acc[k][1], acc[k][2], acc[k][3], out[kEdge].data() + o, out[kPoint].data() + o, m);
+      }
+    });
   });
 }
 
@@ -551,23 +657,15 @@ Status check_inputs(const FlipImage& test, const FlipImage& ref, int width, int 
 
 struct FlipEvaluator::Workspace {
   int width = 0, height = 0;
-  Plane ycxcz[4];  // Y, Cx, Cz, and Y normalised for the feature filters
   Plane horizontal[kHorizontal];
   Plane products[2][kProducts];  // [0]: reference, [1]: test
   Plane exposure_scratch;
   Filters filters;
 
   void ensure(int w, int h, double ppd) {
-    if (filters.ppd != ppd) {
-      filters.ppd = ppd;
-      filters.rs = flip::spatial_filter_radius(ppd);
-      filters.rf = flip::feature_filter_radius(ppd);
-      filters.spatial = flip::spatial_filters(ppd);
-      filters.feature = flip::feature_filters(ppd);
-    }
+    if (filters.ppd != ppd) filters.set(ppd);
     const int margin = std::max(filters.rs, filters.rf);
     if (w != width || h != height || margin != horizontal[0].margin) {
-      for (auto& p : ycxcz) p.resize(std::size_t(w), h);
       for (auto& p : horizontal) p.resize(std::size_t(w), h, margin);
       for (auto& image : products)
         for (auto& p : image) p.resize(std::size_t(w), h);
@@ -580,23 +678,8 @@ struct FlipEvaluator::Workspace {
   // Steps (1)-(3) for one image into products[slot].
   void image(const FlipImage& in, int w, int h, const std::uint8_t* valid, Prepare how, float scale,
              FlipToneMapper tone, int slot) {
-    const std::size_t n = std::size_t(w) * std::size_t(h);
-    float* Y = ycxcz[0].data();
-    float* Cx = ycxcz[1].data();
-    float* Cz = ycxcz[2].data();
-    const float* k = flip::rational_coefficients(tone);
-    float* Yf = ycxcz[3].data();
-    auto run = [&]<Prepare P>() {
-      if (valid) prepare_rows<P, true>(in, n, valid, scale, k, Y, Cx, Cz, Yf);
-      else prepare_rows<P, false>(in, n, valid, scale, k, Y, Cx, Cz, Yf);
-    };
-    switch (how) {
-      case Prepare::Srgb: run.template operator()<Prepare::Srgb>(); break;
-      case Prepare::Linear: run.template operator()<Prepare::Linear>(); break;
-      case Prepare::ToneRational: run.template operator()<Prepare::ToneRational>(); break;
-      case Prepare::ToneReinhard: run.template operator()<Prepare::ToneReinhard>(); break;
-    }
-    horizontal_pass(Y, Cx, Cz, Yf, w, h, filters, horizontal);
+    const RowInput rows{&in, valid, prepare_row(how, valid != nullptr), scale, flip::rational_coefficients(tone)};
+    horizontal_pass(rows, w, h, filters, horizontal);
     vertical_color_pass(horizontal, w, h, filters, products[slot]);
     vertical_feature_pass(horizontal, w, h, filters, products[slot]);
   }
@@ -726,14 +809,27 @@ FlipStats flip_statistics(std::span<const float> map, const std::uint8_t* valid)
   parallel_chunks(
       kChunks,
       [&](std::size_t c0, std::size_t c1) {
-        for (std::size_t c = c0; c < c1; ++c)
-          for (std::size_t i = n * c / kChunks; i < n * (c + 1) / kChunks; ++i) {
-            const int b = bucket_of(map[i]);
-            // Rarely true: one predictable test per value, the three buckets sorted out only on a hit.
-            if ((b == target[0]) | (b == target[1]) | (b == target[2]) && valid_at(i))
+        for (std::size_t c = c0; c < c1; ++c) {
+          const std::size_t i0 = n * c / kChunks, i1 = n * (c + 1) / kChunks;
+          const int t0 = target[0], t1 = target[1], t2 = target[2];
+          // Blocks of 64 values: a vectorised test whether any is in a target bucket (rarely), then a scalar
+          // look at the blocks that have one.
+          for (std::size_t b0 = i0; b0 < i1; b0 += 64) {
+            const std::size_t b1 = std::min(i1, b0 + 64);
+            int hit = 0;
+            for (std::size_t i = b0; i < b1; ++i) {
+              const int b = bucket_of(map[i]);
+              hit |= (b == t0) | (b == t1) | (b == t2);
+            }
+            if (!hit) continue;
+            for (std::size_t i = b0; i < b1; ++i) {
+              if (!valid_at(i)) continue;
+              const int b = bucket_of(map[i]);
               for (int q = 0; q < 3; ++q)
                 if (b == target[q]) chunks[c].picked[q].push_back(map[i]);
+            }
           }
+        }
       },
       1);
   double result[3];

@@ -6,8 +6,10 @@
 //   FlipHdr:  compare --flip hdr (HDR-FLIP, ACES, automatic exposures) and its pooling; the label gives the
 //             number of exposures, which HDR-FLIP's cost is proportional to.
 // The pair is synthetic but shaped like a rendered frame: smooth shading, textured regions, hard edges and a
-// few highlights (luminance up to ~10, median ~0.4: 4 exposures); the test adds noise, blurs a region and
-// shifts an edge. Numbers are reported in docs/compare.md ("FLIP").
+// few highlights (luminance up to ~10: 5 exposures); the test adds noise, smears a region and shifts an edge.
+// The argument is the thread count (0: every core; 1: one thread, the per-pixel cost without the scheduling).
+// Numbers are reported in docs/compare.md ("FLIP").
+#include "temporal/core/parallel.h"
 #include "temporal/metrics/flip.h"
 #include "temporal/metrics/metrics.h"
 
@@ -76,6 +78,7 @@ const Pair& pair_1080p() {
 }
 
 void BM_PsnrSsim_1080p(benchmark::State& state) {
+  const ThreadLimit threads(int(state.range(0)));
   const Pair& p = pair_1080p();
   const std::size_t n = std::size_t(kW) * std::size_t(kH);
   const std::vector<const float*> rp = {p.ref[0].data(), p.ref[1].data(), p.ref[2].data()};
@@ -98,9 +101,10 @@ void BM_PsnrSsim_1080p(benchmark::State& state) {
     benchmark::DoNotOptimize(s);
   }
 }
-BENCHMARK(BM_PsnrSsim_1080p)->MeasureProcessCPUTime()->UseRealTime()->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_PsnrSsim_1080p)->Arg(0)->Arg(1)->MeasureProcessCPUTime()->UseRealTime()->Unit(benchmark::kMillisecond);
 
 void flip_1080p(benchmark::State& state, FlipRange range) {
+  const ThreadLimit threads(int(state.range(0)));
   const Pair& p = pair_1080p();
   const std::size_t n = std::size_t(kW) * std::size_t(kH);
   FlipOptions o;
@@ -130,8 +134,8 @@ void flip_1080p(benchmark::State& state, FlipRange range) {
 }
 void BM_FlipLdr_1080p(benchmark::State& state) { flip_1080p(state, FlipRange::Ldr); }
 void BM_FlipHdr_1080p(benchmark::State& state) { flip_1080p(state, FlipRange::Hdr); }
-BENCHMARK(BM_FlipLdr_1080p)->MeasureProcessCPUTime()->UseRealTime()->Unit(benchmark::kMillisecond);
-BENCHMARK(BM_FlipHdr_1080p)->MeasureProcessCPUTime()->UseRealTime()->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_FlipLdr_1080p)->Arg(0)->Arg(1)->MeasureProcessCPUTime()->UseRealTime()->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_FlipHdr_1080p)->Arg(0)->Arg(1)->MeasureProcessCPUTime()->UseRealTime()->Unit(benchmark::kMillisecond);
 
 // The pooling alone (sorting only the buckets that hold the weighted quartiles).
 void BM_FlipStatistics_1080p(benchmark::State& state) {

@@ -30,7 +30,9 @@
 //        s(x) = a1 sqrt(pi / b1) exp(-pi^2 x^2 / b1) + a2 sqrt(pi / b2) exp(-pi^2 x^2 / b2), x in degrees,
 //      with the parameters of FlipCsf below; the 2-D kernel is normalised to sum 1, sampled every 1/ppd degrees
 //      over a radius of ceil(3 sqrt(max b / (2 pi^2)) ppd) pixels. Y and Cx use one Gaussian (separable); Cz's
-//      sum of two Gaussians is filtered as two separable passes that are added. The filtered colour goes back
+//      sum of two Gaussians is filtered as two separable passes that are added. (The evaluator skips the outer
+//      taps of the narrow Y and Cx kernels that are below 2^-24 of their centre tap: they change a filtered
+//      value by less than its float rounding.) The filtered colour goes back
 //      to linear RGB, is clamped to [0, 1], and is converted to CIELab with the Hunt adjustment
 //        a' = 0.01 L a, b' = 0.01 L b      (chroma perceived lower at low luminance)
 //      The colour difference is HyAB (Abasi et al. 2020), |L1 - L2| + sqrt((a1' - a2')^2 + (b1' - b2')^2),
