@@ -8,7 +8,8 @@
 // measure, the CSV columns it writes, whether higher is better, its threshold option `--fail-<option>`, its
 // chart and its column of the summary table - and the CSV, JSON, thresholds, charts and table iterate the
 // registry. Adding a metric is one source file (src/metrics/metric_<name>.cpp: the definition and its
-// FrameMeasure), one line in src/metrics/registry.cpp, and its section in docs/compare.md.
+// FrameMeasure), one line in src/metrics/registry.cpp (with its declaration in registry.h), and its section in
+// docs/compare.md.
 #pragma once
 
 #include "temporal/core/error.h"
