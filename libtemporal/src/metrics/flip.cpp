@@ -1,14 +1,14 @@
 // FLIP and HDR-FLIP (temporal/metrics/flip.h). The header gives the definitions and the paper steps; this file
 // explains the implementation choices.
 //
-// Layout of the work, per image: (1) a point-wise pass to YyCxCz (exposure and tone mapping for HDR-FLIP,
-// sRGB decoding for LDR inputs); (2) one horizontal pass that runs all seven 1-D filters a row needs (CSF of Y,
-// Cx, the two Gaussians of Cz, and the feature Gaussian with its two derivatives), reading each input row once;
-// (3) one vertical pass that finishes the seven 2-D filters and turns them, still in registers, into the five
-// per-pixel quantities the comparison needs (Hunt-adjusted CIELab and the edge and point magnitudes). The test
-// and the reference go through (1)-(3) separately, so a reference could be kept for several tests; (4) a
-// point-wise pass combines the two into the FLIP map. All passes are parallel over rows with unit-stride
-// inner loops over x; the filters work on strips of kStrip pixels so their accumulators stay in registers.
+// Layout of the work, per image: (1+2) one horizontal pass: each row goes to YyCxCz (exposure and tone mapping
+// for HDR-FLIP, sRGB decoding for LDR inputs) in a row buffer and all seven 1-D filters a row needs run on it
+// (CSF of Y, Cx, the two Gaussians of Cz, and the feature Gaussian with its two derivatives); (3) two vertical
+// passes over tiles finish the 2-D filters and turn them, strip by strip, into the five per-pixel quantities the
+// comparison needs (Hunt-adjusted CIELab, edge and point magnitudes). The test and the reference go through
+// them separately, so a reference could be kept for several tests; (4) a point-wise pass combines the two into
+// the FLIP map. Every pass is parallel (rows, tiles or chunks); the filters work on strips of kStrip pixels whose
+// accumulators stay in vector registers.
 #include "temporal/metrics/flip.h"
 
 #include "fast_math.h"
@@ -285,10 +285,11 @@ inline Vec16 load16(const float* p) {
 }
 inline void store16(float* p, const Vec16& v) { std::memcpy(p, &v, sizeof v); }
 
-// Step (1) on pixels [begin, end): linear RGB in [0, 1] (decoded, or exposed by `scale` and tone-mapped, then
-// clamped) -> YyCxCz. Invalid pixels are black. The pixel loops are free functions with restrict parameters:
-// inside the parallel lambdas GCC could not prove that the output planes do not alias the captured pointers,
-// and `valid` is a template choice because a load under a null test keeps a loop from vectorising.
+// Step (1) on `count` pixels: linear RGB in [0, 1] (decoded, or exposed by `scale` and tone-mapped, then
+// clamped) -> YyCxCz, and Yf = (Y + 16) / 116 for the feature filters. Invalid pixels are black. The pixel
+// loops are free functions with restrict parameters: inside the parallel lambdas GCC could not prove that the
+// outputs do not alias the captured pointers; `valid` is a template choice because a load under a null test
+// keeps a loop from vectorising.
 template <Prepare P, bool Valid>
 [[gnu::noinline]] void prepare_span(const float* __restrict R, const float* __restrict G, const float* __restrict Bl,
                                     const std::uint8_t* __restrict valid, float scale, const float* __restrict k,
