@@ -93,11 +93,11 @@ TEST_F(CompareCli, WritesCsvJsonAndPngWithoutDisplay) {
   const bool have_xvfb = test::run_command("command -v Xvfb >/dev/null") == 0;
   std::string out;
   const int code = run("--reference ref.####.exr a.####.exr b.####.exr --names good,noisy --csv m.csv --json m.json "
-                       "--plot plots/p.png --verbose", &out);
+                       "--plot plots/p.png --verbose --flip ldr", &out);
   if (have_xvfb) {
     EXPECT_EQ(code, 0) << out;
     EXPECT_NE(out.find("started Xvfb"), std::string::npos) << out;  // said only with --verbose
-    for (const char* name : {"p.png", "p-psnr-y.png", "p-ssim.png", "p-flicker.png", "p-speed.png"})
+    for (const char* name : {"p.png", "p-psnr-y.png", "p-ssim.png", "p-flicker.png", "p-flip.png", "p-speed.png"})
       EXPECT_TRUE(is_png(dir_ / "plots" / name, 1280, 720)) << out;
   } else {
     // No Xvfb: a clear error and exit 4, but CSV and JSON are written.
@@ -120,7 +120,7 @@ TEST_F(CompareCli, WritesCsvJsonAndPngWithoutDisplay) {
     EXPECT_TRUE(j.contains(key)) << key;
   ASSERT_EQ(j["sequences"].size(), 2u);
   EXPECT_EQ(j["sequences"][0]["name"], "good");
-  for (const char* key : {"psnr_rgb", "psnr_y", "ssim", "flicker"}) {
+  for (const char* key : {"psnr_rgb", "psnr_y", "ssim", "flicker", "flip"}) {
     EXPECT_TRUE(j["sequences"][1][key].contains("mean")) << key;
     EXPECT_TRUE(j["sequences"][1][key].contains("min")) << key;
   }
@@ -155,6 +155,19 @@ TEST_F(CompareCli, ThresholdsGiveExitThree) {
   EXPECT_EQ(j["failures"][0]["sequence"], "b");
   EXPECT_EQ(run("--reference ref.####.exr a.####.exr --fail-ssim 0.9999", &out), 3) << out;
   EXPECT_EQ(run("--reference ref.####.exr b.####.exr --fail-flicker 0.001 --fail-on worst", &out), 3) << out;
+  // FLIP: noise of 0.1 is clearly visible, 0.02 much less; the stdout table gains a flip column.
+  EXPECT_EQ(run("--reference ref.####.exr a.####.exr b.####.exr --flip ldr --fail-flip 0.9", &out), 0) << out;
+  EXPECT_NE(out.find("flip"), std::string::npos) << out;
+  EXPECT_EQ(run("--reference ref.####.exr a.####.exr b.####.exr --flip hdr --ppd 30 --fail-flip 0.001", &out), 3) << out;
+  EXPECT_NE(out.find("b: flip"), std::string::npos) << out;
+}
+
+TEST_F(CompareCli, FlipOptionErrorsAreUsageErrors) {
+  std::string out;
+  EXPECT_EQ(run("--reference ref.####.exr a.####.exr --fail-flip 0.1", &out), 1) << out;  // FLIP is off
+  EXPECT_NE(out.find("--flip ldr"), std::string::npos) << out;
+  EXPECT_EQ(run("--reference ref.####.exr a.####.exr --flip sometimes", &out), 1) << out;
+  EXPECT_EQ(run("--reference ref.####.exr a.####.exr --flip ldr --ppd 0", &out), 1) << out;
 }
 
 TEST_F(CompareCli, ExitCodesForUsageErrors) {
@@ -185,12 +198,12 @@ TEST_F(CompareCli, HelpListsEveryOptionAndEachIsAccepted) {
   ASSERT_EQ(run("--version", &version), 0);
   EXPECT_NE(version.find("compare "), std::string::npos);
   // Every option documented in --help, fed to the parser in one run (without --plot to stay fast).
-  const std::array<std::pair<const char*, const char*>, 19> options = {{
+  const std::array<std::pair<const char*, const char*>, 22> options = {{
       {"--reference", "ref.####.exr"}, {"--names", "one"}, {"--csv", "all.csv"}, {"--json", "all.json"},
       {"--gbuffer", "g.####.exr"}, {"--mask", "R"}, {"--layer", "rgb"}, {"--reference-layer", "rgb"},
-      {"--error-maps", "maps"}, {"--frames", "1-2"}, {"--peak", "max"}, {"--fail-psnr", "1"},
-      {"--fail-ssim", "0"}, {"--fail-flicker", "100"}, {"--fail-on", "worst"}, {"--threads", "1"},
-      {"--verbose", ""}, {"--plot", ""}, {"--help", ""}}};
+      {"--error-maps", "maps"}, {"--frames", "1-2"}, {"--peak", "max"}, {"--flip", "ldr"}, {"--ppd", "50"},
+      {"--fail-psnr", "1"}, {"--fail-ssim", "0"}, {"--fail-flicker", "100"}, {"--fail-flip", "1"},
+      {"--fail-on", "worst"}, {"--threads", "1"}, {"--verbose", ""}, {"--plot", ""}, {"--help", ""}}};
   std::string args;
   for (const auto& [name, value] : options) {
     EXPECT_NE(help.find(name), std::string::npos) << name << " is not in --help";
@@ -199,12 +212,18 @@ TEST_F(CompareCli, HelpListsEveryOptionAndEachIsAccepted) {
   }
   EXPECT_NE(help.find("Exit codes"), std::string::npos);
   EXPECT_NE(help.find("--peak TEXT=1"), std::string::npos) << "--peak default not shown";
+  EXPECT_NE(help.find("=off"), std::string::npos) << "--flip default not shown";
+  EXPECT_NE(help.find("67.0206"), std::string::npos) << "--ppd default not shown";
   std::string out;
   EXPECT_EQ(run(args + " a.####.exr", &out), 0) << args << "\n" << out;
   EXPECT_TRUE(fs::exists(dir_ / "maps" / "one.0002.exr"));
   EXPECT_FALSE(fs::exists(dir_ / "maps" / "one.0003.exr"));  // --frames 1-2
   const auto csv = read_text(dir_ / "all.csv");
   EXPECT_NE(csv.find("psnr_rgb_in_db"), std::string::npos);  // --mask columns
+  EXPECT_NE(csv.find("flip_in"), std::string::npos);         // FLIP's, with --flip and --mask
+  auto maps = read_exr((dir_ / "maps" / "one.0002.exr").string());
+  ASSERT_TRUE(maps) << maps.error().message;
+  EXPECT_NE(maps->plane("error.flip"), nullptr);
 }
 
 }  // namespace

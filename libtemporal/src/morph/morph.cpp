@@ -122,11 +122,6 @@ CompensatedValue compensate_value(float original, float low, float blurred, floa
   return {1.0f, float(std::pow(((1.0 + blurred) * og - 1.0) / blurred, 1.0 / gamma))};
 }
 
-float pixels_per_degree(float screen_width_m, float distance_m, int pixels_x) {
-  const double fov = 2.0 * std::atan(double(screen_width_m) / (2.0 * double(distance_m))) * 180.0 / std::numbers::pi;
-  return float(double(pixels_x) / fov);
-}
-
 Morpher::Morpher(MorphOptions options) : options_(std::move(options)) {}
 
 Status Morpher::check(const Image& color, const Image* gbuffer, const Image* next) const {

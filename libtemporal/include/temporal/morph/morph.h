@@ -18,6 +18,7 @@
 #include "temporal/core/error.h"
 #include "temporal/morph/grid_warp.h"
 #include "temporal/core/image.h"
+#include "temporal/core/viewing.h"  // pixels_per_degree (eye-tracking limit)
 #include "temporal/morph/blur_pyramid.h"
 
 #include <cstdint>
@@ -75,10 +76,6 @@ struct CompensatedValue {
 //   top^g + blurred * low^g = (1 + blurred) * original^g   (for original in [0, 1]).
 // Values outside [0, 1] are passed through (top = low = original).
 CompensatedValue compensate_value(float original, float low, float blurred, float gamma);
-
-// Pixels per degree of visual angle of a screen `screen_width_m` wide showing `pixels_x` pixels across, seen
-// from `distance_m` (at the screen centre).
-float pixels_per_degree(float screen_width_m, float distance_m, int pixels_x);
 
 // Upsamples rendered frames one at a time. Full-resolution scratch buffers are kept between calls (no
 // per-pixel allocation; only grid-sized vectors are rebuilt per frame).
