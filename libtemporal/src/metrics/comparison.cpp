@@ -11,7 +11,8 @@
 #include "temporal/metrics/flicker.h"
 #include "temporal/core/image.h"
 #include "temporal/metrics/metrics.h"
-#include "temporal/metrics/warp.h"
+#include "temporal/core/reproject.h"
+#include "temporal/core/runner.h"
 
 #include <algorithm>
 #include <chrono>
@@ -122,6 +123,9 @@ class Run {
   std::optional<SequencePattern> ref_pattern_, gbuf_pattern_;
   std::vector<TestState> tests_;
   bool gbuf_mask_ = false, ref_mask_ = false;
+  bool gbuf_geometry_ = false, have_prev_geometry_ = false;  // G-buffer depth and ids for the disocclusion test
+  std::vector<float> prev_z_;
+  std::vector<std::uint32_t> prev_id_;
   ExrSelection ref_sel_, gbuf_sel_;
   // The current frame: reference and G-buffer, and the shared work planes (allocated at the first frame).
   std::optional<Image> ref_, gbuf_;
@@ -181,6 +185,16 @@ Status Run::open() {
   ref_sel_ = ExrSelection{{report_.reference_layer}};
   if (ref_mask_) ref_sel_.layers.push_back(setup_.mask);
   gbuf_sel_ = ExrSelection{{"motion"}};
+  if (gbuf_pattern_) {
+    // With depth and ids the flicker drops disoccluded pixels by the shared rule (temporal/core/reproject.h),
+    // as the methods do; a G-buffer with motion only gets the off-screen rule.
+    auto info = read_exr_info(gbuf_pattern_->path(report_.frames.front()));
+    if (!info) return info.error();
+    const auto& c = info->channels;
+    gbuf_geometry_ = std::find(c.begin(), c.end(), "depth.Z") != c.end() && std::find(c.begin(), c.end(), "id") != c.end();
+    if (gbuf_geometry_) gbuf_sel_.layers.insert(gbuf_sel_.layers.end(), {"depth", "id"});
+    report_.disocclusion_tested = gbuf_geometry_;
+  }
   if (gbuf_mask_) gbuf_sel_.layers.push_back(setup_.mask);
   return {};
 }
@@ -287,6 +301,12 @@ Status Run::reference_frame(std::size_t fi, int frame) {
                                      size_text(width_, height_) + "; give the G-buffer rendered at the reference's size");
     if (!g->plane("motion.X") || !g->plane("motion.Y"))
       return Error::input(gpath, "the motion layer needs float channels motion.X and motion.Y");
+    if (gbuf_geometry_ && (!g->plane("depth.Z") || !g->uint_plane("id")))
+      return Error::input(gpath, "has no depth.Z or no uint id while frame " + std::to_string(report_.frames.front()) +
+                                     " has them; every G-buffer frame must carry the same layers");
+    if (const std::size_t bad = count_non_finite_layers(*g, {"motion", "depth"}); bad > 0)
+      warn(gpath, std::to_string(bad) + " pixels hold NaN or Inf in motion or depth: they have no history, so no "
+                                        "flicker value");
     gbuf_ = std::move(*g);
   }
   const bool cut = (gbuf_ && gbuf_->metadata().camera_cut.value_or(false)) || ref_->metadata().camera_cut.value_or(false);
@@ -305,10 +325,26 @@ Status Run::reference_frame(std::size_t fi, int frame) {
       previous.push_back(t.prev_y.data());
       warped_out.push_back(t.delta.data());
     }
-    const float* mx = gbuf_ ? gbuf_->plane("motion.X") : nullptr;
-    const float* my = gbuf_ ? gbuf_->plane("motion.Y") : nullptr;
-    warp_bilinear(previous, width_, height_, mx, my, warped_out);
+    reproject::Frames fr;
+    fr.width = width_;
+    fr.height = height_;
+    fr.motion_x = gbuf_ ? gbuf_->plane("motion.X") : nullptr;
+    fr.motion_y = gbuf_ ? gbuf_->plane("motion.Y") : nullptr;
+    if (gbuf_geometry_ && have_prev_geometry_) {
+      fr.z = gbuf_->plane("depth.Z");
+      fr.id = gbuf_->uint_plane("id");
+      fr.prev_z = prev_z_.data();
+      fr.prev_id = prev_id_.data();
+    }
+    reproject::warp_planes(fr, previous, warped_out);
     temporal_delta(ref_y_.data(), warped_.data(), n_, ref_delta_.data());
+  }
+  if (gbuf_geometry_ && gbuf_) {  // the previous frame's geometry for the next frame's disocclusion test
+    const float* z = gbuf_->plane("depth.Z");
+    const std::uint32_t* id = gbuf_->uint_plane("id");
+    prev_z_.assign(z, z + n_);
+    prev_id_.assign(id, id + n_);
+    have_prev_geometry_ = true;
   }
   return {};
 }

@@ -250,6 +250,7 @@ Status write_comparison_json(const ComparisonReport& report, const Thresholds& t
                  {"last", report.frames.empty() ? 0 : report.frames.back()},
                  {"count", report.frames.size()}};
   j["motion_compensated"] = report.motion_compensated;
+  j["disocclusion_tested"] = report.disocclusion_tested;
   j["peak"] = report.peak_from_data ? json("max") : json(report.peak);
   j["mask"] = report.mask.empty() ? json(nullptr) : json(report.mask);
   if (report.flip != FlipMode::Off)

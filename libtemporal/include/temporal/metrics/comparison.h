@@ -187,6 +187,7 @@ struct ComparisonReport {
   int width = 0, height = 0;
   std::vector<int> frames;
   bool motion_compensated = false;
+  bool disocclusion_tested = false;  // the G-buffer had depth and ids: flicker drops disoccluded pixels
   double peak = 1.0;
   bool peak_from_data = false;
   FlipMode flip = FlipMode::Off;
