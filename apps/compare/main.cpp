@@ -50,6 +50,9 @@ int main(int argc, char** argv) {
                  "Folder for error-map EXRs NAME.####.exr (error.R/G/B/Y, error.ssim, error.flicker, error.flip "
                  "with --flip, error.invalid)");
   app.add_option("--frames", frames, "Frames A-B (default: every reference frame on disk)");
+  app.add_option("--warmup", setup.warmup_frames,
+                 "The first N frames are summarised apart from the steady state (JSON `warmup`, `steady`)")
+      ->check(CLI::Range(0, 1000000));
   app.add_option("--peak", peak,
                  "Peak value L for PSNR and SSIM, in pixel units; `max` = idiff's rule per frame (largest value, "
                  "at least 1)");
@@ -72,6 +75,9 @@ int main(int argc, char** argv) {
     app.add_option("--fail-" + d.threshold_option, fail[d.name], d.threshold_help);
     fail_list += (fail_list.empty() ? "--fail-" : ", --fail-") + d.threshold_option;
   }
+  bool fail_nonfinite = false;
+  app.add_flag("--fail-nonfinite", fail_nonfinite,
+               "Exit 3 when a test frame holds NaN/Inf pixels or values whose squared error overflows (PSNR -inf)");
   app.add_option("--fail-on", fail_on, "What the thresholds judge: each sequence's mean over frames, or its worst frame")
       ->check(CLI::IsMember({"mean", "worst"}));
   app.footer("Exit codes: 0 success (thresholds passed), 1 usage error, 2 input error (missing, corrupt or mismatched "
@@ -99,19 +105,18 @@ int main(int argc, char** argv) {
     setup.parameters = tool.command_line();
     Thresholds thresholds;
     thresholds.worst_frame = fail_on == "worst";
+    thresholds.nonfinite = fail_nonfinite;
     for (const auto& [metric, limit] : fail)
       if (limit) thresholds.limits[metric] = *limit;
     if (auto st = check_threshold_setup(setup, thresholds); !st) return st;
 
-    ComparisonHooks hooks;
-    std::optional<tool::Progress> progress;
-    hooks.frame_done = [&](int frame, int, int total) {
-      if (!progress) progress.emplace("compare", total);
-      progress->step(frame);
-    };
-    hooks.warning = [&](const std::string& file, const std::string& text) { tool.print_warning(file, text); };
-    hooks.log = [&](const std::string& text) { tool.log(text); };
-    auto report = compare_sequences(setup, hooks);
+    // No output may replace a frame this comparison reads (error maps are checked by the engine).
+    auto inputs = comparison_inputs(setup);
+    if (!inputs) return inputs.error();
+    for (const auto& [path, option] : {std::pair{csv, "--csv"}, std::pair{json, "--json"}, std::pair{plot, "--plot"}})
+      if (!path.empty())
+        if (auto st = inputs->check(path, option); !st) return st;
+    auto report = compare_sequences(setup, tool.hooks());
     if (!report) return report.error();
     const auto failures = check_thresholds(*report, thresholds);
 
@@ -133,6 +138,7 @@ int main(int argc, char** argv) {
       } else {
         if (display->started()) tool.log("DISPLAY is not usable: started Xvfb on " + display->display() + " for the plots");
         for (const auto& [path, chart] : comparison_charts(*report, plot)) {
+          if (auto st = inputs->check(path, "--plot"); !st) return st;
           keep(write_chart_png(chart, path));
           tool.log("wrote " + path);
         }

@@ -123,6 +123,7 @@ class Run {
   std::optional<SequencePattern> ref_pattern_, gbuf_pattern_;
   std::vector<TestState> tests_;
   bool gbuf_mask_ = false, ref_mask_ = false;
+  ProtectedInputs inputs_;  // every file this comparison reads: no error map may replace one
   bool gbuf_geometry_ = false, have_prev_geometry_ = false;  // G-buffer depth and ids for the disocclusion test
   std::vector<float> prev_z_;
   std::vector<std::uint32_t> prev_id_;
@@ -156,6 +157,8 @@ Status Run::open() {
   report_.reference_layer = setup_.reference_layer.empty() ? report_.layer : setup_.reference_layer;
   report_.mask = setup_.mask;
   report_.motion_compensated = !setup_.gbuffer.empty();
+  report_.warmup_frames = setup_.warmup_frames;
+  report_.bootstrap = setup_.bootstrap;
   report_.peak = setup_.peak;
   report_.peak_from_data = setup_.peak_from_data;
   report_.flip = setup_.flip;
@@ -182,6 +185,13 @@ Status Run::open() {
   }
   if (auto st = open_tests(range); !st) return st;
   if (auto st = find_masks(); !st) return st;
+  auto inputs = comparison_inputs(setup_);
+  if (!inputs) return inputs.error();
+  inputs_ = std::move(*inputs);
+  if (!setup_.error_maps.empty())  // before any work: an error map that would replace a frame not read yet
+    for (const auto& t : tests_)
+      for (const int f : report_.frames)
+        if (auto st = inputs_.check(frame_file(setup_.error_maps, t.report.name, f), "--error-maps"); !st) return st;
   ref_sel_ = ExrSelection{{report_.reference_layer}};
   if (ref_mask_) ref_sel_.layers.push_back(setup_.mask);
   gbuf_sel_ = ExrSelection{{"motion"}};
@@ -416,6 +426,10 @@ Status Run::test_frame(TestState& t, std::size_t fi, int frame) {
   m.timings_ms = img->metadata().timings_ms;
   if (m.nonfinite_test)
     warn(path, std::to_string(m.nonfinite_test) + " pixels hold NaN or Inf; they are excluded from every metric");
+  for (const auto& sample : m.metrics)
+    if (!sample.values.empty() && std::isinf(sample.values.front()) && sample.values.front() < 0)
+      warn(path, sample.metric + " is -inf: the test holds values so far from the reference that the squared error "
+                                 "overflows (a broken output); --fail-nonfinite makes this a failure");
   if (maps)
     if (auto st = write_maps(*maps, *img, t, path, frame, m); !st) return st;
 
@@ -463,10 +477,34 @@ Status Run::write_maps(Image& maps, const Image& test, const TestState& t, const
   md.extra["reference"] = ref_path_;
   md.extra["test"] = path;
   md.extra["nonFinitePixels"] = std::to_string(m.nonfinite_test);
-  return write_exr(frame_file(setup_.error_maps, t.report.name, frame), maps);
+  const std::string out = frame_file(setup_.error_maps, t.report.name, frame);
+  if (Status st = inputs_.check(out, "--error-maps"); !st) return st;
+  return write_exr(out, maps);
 }
 
 }  // namespace
+
+Expected<ProtectedInputs> comparison_inputs(const ComparisonSetup& setup) {
+  ProtectedInputs inputs;
+  auto ref = SequencePattern::parse(setup.reference);
+  if (!ref) return ref.error();
+  auto frames = resolve_frames(*ref, setup.frames);
+  if (!frames) return frames.error();
+  std::vector<SequencePattern> patterns = {*ref};
+  for (const auto& t : setup.tests) {
+    auto p = SequencePattern::parse(t);
+    if (!p) return p.error();
+    patterns.push_back(*p);
+  }
+  if (!setup.gbuffer.empty()) {
+    auto g = SequencePattern::parse(setup.gbuffer);
+    if (!g) return g.error();
+    patterns.push_back(*g);
+  }
+  for (const auto& p : patterns)
+    for (const int f : *frames) inputs.add(p.path(f));
+  return inputs;
+}
 
 std::string sequence_name(const std::string& pattern) {
   std::string name = fs::path(pattern).filename().string();
@@ -532,6 +570,13 @@ MetricSummary summarize(const SequenceReport& sequence, std::string_view metric,
   return s;
 }
 
+std::vector<double> metric_series(const SequenceReport& sequence, std::string_view metric, std::size_t column) {
+  std::vector<double> v;
+  v.reserve(sequence.frames.size());
+  for (const auto& f : sequence.frames) v.push_back(f.value(metric, column));
+  return v;
+}
+
 std::optional<double> mean_compute_ms(const SequenceReport& sequence) {
   double sum = 0.0;
   std::size_t count = 0;
@@ -551,6 +596,7 @@ std::optional<double> mean_compute_ms(const SequenceReport& sequence) {
 }
 
 std::string ThresholdFailure::message() const {
+  if (!text.empty()) return sequence + ": " + text;
   const MetricDefinition* d = find_metric(metric);
   const char* unit = d ? d->unit.c_str() : "";
   const bool higher = d ? d->higher_is_better : true;
@@ -581,7 +627,22 @@ std::vector<ThresholdFailure> check_thresholds(const ComparisonReport& report, c
       if (!s.count) continue;  // no value (e.g. flicker of a one-frame sequence): nothing to judge
       const double v = th.worst_frame ? s.worst() : s.mean;
       const bool fail = s.higher_is_better ? v < limit->second : v > limit->second;
-      if (fail) failures.push_back({seq.name, name, v, limit->second});
+      if (fail) failures.push_back({seq.name, name, v, limit->second, {}});
+    }
+  if (th.nonfinite)
+    for (const auto& seq : report.sequences) {
+      std::size_t frames = 0, pixels = 0;
+      for (const auto& f : seq.frames) {
+        bool bad = f.nonfinite_test > 0;
+        for (const auto& sample : f.metrics)
+          bad = bad || (!sample.values.empty() && std::isinf(sample.values.front()) && sample.values.front() < 0);
+        frames += bad ? 1 : 0;
+        pixels += f.nonfinite_test;
+      }
+      if (frames > 0)
+        failures.push_back({seq.name, "nonfinite", double(frames), 0.0,
+                            std::to_string(frames) + " frames with NaN/Inf pixels (" + std::to_string(pixels) +
+                                " pixels) or an overflowing error (--fail-nonfinite)"});
     }
   return failures;
 }
