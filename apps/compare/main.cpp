@@ -29,8 +29,13 @@ int main(int argc, char** argv) {
   ComparisonSetup setup;
   std::string csv, json, plot, frames, peak = "1";
   std::string fail_on = "mean";
-  app.add_option("--reference", setup.reference, "Reference sequence, e.g. ref.####.exr")->required();
-  app.add_option("tests", setup.tests, "Test sequences (one or more), e.g. taa.####.exr phlm.####.exr")->required();
+  std::vector<std::string> merge;
+  app.add_option("--reference", setup.reference, "Reference sequence, e.g. ref.####.exr (not with --merge)");
+  app.add_option("tests", setup.tests, "Test sequences (one or more), e.g. taa.####.exr phlm.####.exr");
+  app.add_option("--merge", merge,
+                 "Instead of comparing: merge per-shard CSVs of one comparison (disjoint --frames ranges) into "
+                 "--csv/--json/--plot; the means and intervals equal a single run's exactly")
+      ->excludes("--reference");
   app.add_option("--names", setup.names, "Comma-separated names of the test sequences (default: file names)")
       ->delimiter(',')->default_str("");
   app.add_option("--csv", csv, "Per-frame metrics CSV to write");
@@ -110,13 +115,20 @@ int main(int argc, char** argv) {
       if (limit) thresholds.limits[metric] = *limit;
     if (auto st = check_threshold_setup(setup, thresholds); !st) return st;
 
-    // No output may replace a frame this comparison reads (error maps are checked by the engine).
-    auto inputs = comparison_inputs(setup);
-    if (!inputs) return inputs.error();
+    if (merge.empty() && (setup.reference.empty() || setup.tests.empty()))
+      return Error::usage("give --reference REF.####.exr and at least one test sequence (or --merge A.csv B.csv ...)");
+    // No output may replace a file this run reads (error maps are checked by the engine).
+    ProtectedInputs inputs;
+    if (merge.empty()) {
+      auto found = comparison_inputs(setup);
+      if (!found) return found.error();
+      inputs = std::move(*found);
+    }
+    for (const auto& m : merge) inputs.add(m);
     for (const auto& [path, option] : {std::pair{csv, "--csv"}, std::pair{json, "--json"}, std::pair{plot, "--plot"}})
       if (!path.empty())
-        if (auto st = inputs->check(path, option); !st) return st;
-    auto report = compare_sequences(setup, tool.hooks());
+        if (auto st = inputs.check(path, option); !st) return st;
+    auto report = merge.empty() ? compare_sequences(setup, tool.hooks()) : merge_comparison_csvs(merge, setup);
     if (!report) return report.error();
     const auto failures = check_thresholds(*report, thresholds);
 
@@ -138,7 +150,7 @@ int main(int argc, char** argv) {
       } else {
         if (display->started()) tool.log("DISPLAY is not usable: started Xvfb on " + display->display() + " for the plots");
         for (const auto& [path, chart] : comparison_charts(*report, plot)) {
-          if (auto st = inputs->check(path, "--plot"); !st) return st;
+          if (auto st = inputs.check(path, "--plot"); !st) return st;
           keep(write_chart_png(chart, path));
           tool.log("wrote " + path);
         }

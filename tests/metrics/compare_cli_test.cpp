@@ -274,5 +274,33 @@ TEST_F(CompareCli, BadRunsLoseNothingAndOverflowIsReported) {
   EXPECT_TRUE(found);
 }
 
+// Issue 14: a comparison run as shards (disjoint --frames ranges) and merged gives exactly the single run's
+// means and intervals; each shard primes its first frame's flicker from the frame before it.
+TEST_F(CompareCli, ShardsMergeIntoTheSingleRunExactly) {
+  std::string out;
+  const std::string common = "--reference ref.####.exr a.####.exr b.####.exr --gbuffer g.####.exr --warmup 1";
+  ASSERT_EQ(run(common + " --json whole.json --csv whole.csv", &out), 0) << out;
+  ASSERT_EQ(run(common + " --frames 1-1 --csv s1.csv", &out), 0) << out;
+  ASSERT_EQ(run(common + " --frames 2-3 --csv s2.csv", &out), 0) << out;
+  const auto s2 = read_text(dir_ / "s2.csv");  // shown when a mean differs
+  ASSERT_EQ(run("--merge s2.csv s1.csv --warmup 1 --json merged.json --csv merged.csv", &out), 0) << out;
+  const auto whole = nlohmann::json::parse(read_text(dir_ / "whole.json"));
+  const auto merged = nlohmann::json::parse(read_text(dir_ / "merged.json"));
+  ASSERT_EQ(whole["sequences"].size(), merged["sequences"].size());
+  for (std::size_t s = 0; s < whole["sequences"].size(); ++s)
+    for (const char* m : {"psnr_rgb", "psnr_y", "ssim", "flicker"}) {
+      const auto& w = whole["sequences"][s][m];
+      const auto& g = merged["sequences"][s][m];
+      EXPECT_EQ(w["frames"], g["frames"]) << m;
+      EXPECT_EQ(w["mean"], g["mean"]) << m << " " << s2;  // exactly, not approximately
+      EXPECT_EQ(w["ci95"], g["ci95"]) << m;
+      EXPECT_EQ(w["steady"], g["steady"]) << m;
+    }
+  EXPECT_EQ(whole["paired"], merged["paired"]);
+  // Overlapping shards are refused.
+  EXPECT_EQ(run("--merge s1.csv whole.csv --json x.json", &out), 2) << out;
+  EXPECT_NE(out.find("two shards"), std::string::npos) << out;
+}
+
 }  // namespace
 }  // namespace temporal

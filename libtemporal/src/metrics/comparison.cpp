@@ -80,19 +80,30 @@ class Run {
 
   Expected<ComparisonReport> run() {
     if (auto st = open(); !st) return st.error();
-    for (std::size_t fi = 0; fi < report_.frames.size(); ++fi) {
-      const int frame = report_.frames[fi];
+    // A range that starts after the first frame on disk (a shard of a longer sequence) first reads the frame
+    // before it, without reporting it: the first compared frame then gets the flicker value a single run over the
+    // whole sequence gives it, and per-shard results merge exactly (docs/compare.md, "Shards").
+    std::vector<int> order = report_.frames;
+    const bool prime = setup_.frames && previous_frame_exists(report_.frames.front() - 1);
+    if (prime) order.insert(order.begin(), report_.frames.front() - 1);
+    for (std::size_t fi = 0; fi < order.size(); ++fi) {
+      const int frame = order[fi];
+      priming_ = prime && fi == 0;
       if (auto st = reference_frame(fi, frame); !st) return st.error();
-      for (auto& t : tests_)
+      for (auto& t : tests_) {
         if (auto st = test_frame(t, fi, frame); !st) return st.error();
-      if (ref_invalid_)
+        if (priming_) t.report.frames.pop_back();  // history only
+      }
+      if (ref_invalid_ && !priming_)
         warn(ref_path_, std::to_string(ref_invalid_) + " pixels hold NaN or Inf; they are excluded from every metric");
       for (std::size_t i = 0; i < n_; ++i)
         if (!ref_valid_[i]) ref_y_[i] = std::numeric_limits<float>::quiet_NaN();
       std::swap(ref_y_, ref_prev_y_);
       ref_has_prev_ = true;
-      if (hooks_.frame_done) hooks_.frame_done(frame, int(fi + 1), int(report_.frames.size()));
+      if (hooks_.frame_done && !priming_)
+        hooks_.frame_done(frame, int(fi + (prime ? 0 : 1)), int(report_.frames.size()));
     }
+    priming_ = false;
     for (auto& t : tests_) report_.sequences.push_back(std::move(t.report));
     return std::move(report_);
   }
@@ -124,6 +135,14 @@ class Run {
   std::vector<TestState> tests_;
   bool gbuf_mask_ = false, ref_mask_ = false;
   ProtectedInputs inputs_;  // every file this comparison reads: no error map may replace one
+  bool priming_ = false;     // this frame only primes the history (the frame before a --frames range)
+  // True when frame `f` of the reference, of every test and of the G-buffer exists on disk.
+  bool previous_frame_exists(int f) const {
+    if (f < 0 || !std::filesystem::exists(ref_pattern_->path(f))) return false;
+    for (const auto& t : tests_)
+      if (!std::filesystem::exists(t.pattern.path(f))) return false;
+    return !gbuf_pattern_ || std::filesystem::exists(gbuf_pattern_->path(f));
+  }
   bool gbuf_geometry_ = false, have_prev_geometry_ = false;  // G-buffer depth and ids for the disocclusion test
   std::vector<float> prev_z_;
   std::vector<std::uint32_t> prev_id_;
@@ -409,7 +428,7 @@ Status Run::test_frame(TestState& t, std::size_t fi, int frame) {
   if (change) temporal_delta(t.y.data(), t.delta.data(), n_, t.delta.data());  // t.delta held the warped history
 
   std::optional<Image> maps;
-  if (!setup_.error_maps.empty()) maps.emplace(width_, height_);
+  if (!setup_.error_maps.empty() && !priming_) maps.emplace(width_, height_);
   const FrameInputs in = inputs(t, frame, planes, names, mask, m.peak, change, maps ? &*maps : nullptr);
   for (std::size_t k = 0; k < measures_.size(); ++k) {
     MetricSample sample;

@@ -5,6 +5,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <charconv>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -18,15 +19,21 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// CSV field: empty for "no value", `inf` / `-inf` for infinities, else %.*g.
-std::string field(double v, int digits = 8) {
+// CSV field: empty for "no value", `inf` / `-inf` for infinities, else the shortest text that reads back as the
+// same double (std::to_chars): per-shard CSVs then merge into exactly the single run's means (read_comparison_csv).
+// `digits` > 0 rounds instead (timings, whose last digits mean nothing).
+std::string field(double v, int digits = 0) {
   if (std::isnan(v)) return "";
   if (std::isinf(v)) return v > 0 ? "inf" : "-inf";
   char text[64];
-  std::snprintf(text, sizeof text, "%.*g", digits, v);
-  return text;
+  if (digits > 0) {
+    std::snprintf(text, sizeof text, "%.*g", digits, v);
+    return text;
+  }
+  const auto r = std::to_chars(text, text + sizeof text, v);
+  return std::string(text, r.ptr);
 }
-std::string field(const std::optional<double>& v, int digits = 8) { return v ? field(*v, digits) : std::string(); }
+std::string field(const std::optional<double>& v, int digits = 0) { return v ? field(*v, digits) : std::string(); }
 
 std::string csv_quote(const std::string& s) {
   if (s.find_first_of(",\"\n") == std::string::npos) return s;
@@ -109,7 +116,7 @@ std::vector<CsvColumn> csv_layout(const ComparisonReport& report) {
   cols.push_back({"nonfinite_test", [](const SequenceReport&, const FrameMetrics& f) { return std::to_string(f.nonfinite_test); }});
   cols.push_back({"nonfinite_reference",
                   [](const SequenceReport&, const FrameMetrics& f) { return std::to_string(f.nonfinite_reference); }});
-  cols.push_back({"compute_ms", [](const SequenceReport&, const FrameMetrics& f) { return field(f.compute_ms); }});
+  cols.push_back({"compute_ms", [](const SequenceReport&, const FrameMetrics& f) { return field(f.compute_ms, 8); }});
   cols.push_back({"metrics_ms", [](const SequenceReport&, const FrameMetrics& f) { return field(f.metrics_ms, 5); }});
   if (mask) {
     cols.push_back({"mask_fraction", [](const SequenceReport&, const FrameMetrics& f) { return field(f.mask_fraction); }});

@@ -23,6 +23,7 @@
 #include <functional>
 #include <limits>
 #include <map>
+#include <set>
 #include <memory>
 #include <optional>
 #include <span>
@@ -261,6 +262,19 @@ struct ThresholdFailure {
 // turn it on).
 Status check_threshold_setup(const ComparisonSetup& setup, const Thresholds& thresholds);
 std::vector<ThresholdFailure> check_thresholds(const ComparisonReport& report, const Thresholds& thresholds);
+
+// --- Shards ---------------------------------------------------------------------------------------------------
+
+// Reads a CSV written by write_comparison_csv back into a report (per-frame values exactly as computed; the
+// inputs' metadata is not in the CSV). Input error for a file that is not such a CSV.
+Expected<ComparisonReport> read_comparison_csv(const std::string& path);
+// Joins per-shard reports of one comparison (same metrics, same sequences in the same order, disjoint frame
+// ranges) into one, frames in order. `names` (the shards' files) are for messages and the merged report's
+// `reference`. The merged summaries equal a single run's exactly (docs/compare.md, "Shards").
+Expected<ComparisonReport> merge_comparisons(const std::vector<ComparisonReport>& parts,
+                                            const std::vector<std::string>& names = {});
+// read_comparison_csv of each file, merge_comparisons, and the summary settings of `setup` (warm-up, bootstrap).
+Expected<ComparisonReport> merge_comparison_csvs(const std::vector<std::string>& csvs, const ComparisonSetup& setup);
 
 // --- Outputs (written atomically: temporary file, then rename) ---------------------------------------------
 
