@@ -119,9 +119,11 @@ class UpsampleStage final : public FrameStage {
 
   std::string frame_summary() const override {
     char line[200];
-    std::snprintf(line, sizeof line, "%s, %d slots, %.2f ms (flow %.2f, morph %.2f, blur %.2f), %.2f pixels/degree",
+    std::snprintf(line, sizeof line,
+                  "%s, %d slots, %.2f ms (flow %.2f, morph %.2f, blur %.2f), gamma %.3g, %.2f pixels/degree",
                   info_.name.c_str(), options_.morph.factor, total_ms_, timings_.flow_ms, timings_.morph_ms,
-                  timings_.blur_ms, morpher_ ? morpher_->options().grid.pixels_per_degree : 0.0f);
+                  timings_.blur_ms, double(options_.morph.gamma),
+                  double(morpher_ ? morpher_->options().grid.pixels_per_degree : 0.0f));
     return line;
   }
 

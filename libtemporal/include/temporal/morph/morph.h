@@ -38,7 +38,8 @@ struct MorphOptions {
   std::string method = "didyk";  // a name of the registry, morph_methods() (temporal/morph/methods.h)
   int factor = 3;             // displayed frames per rendered frame, >= 2 (40 Hz -> 120 Hz: 3)
   float gamma = 2.2f;         // display gamma g: displayed light = value^g, value in [0, 1]
-  GridOptions grid;           // cell size, snapping, eye-tracking limit (pixels per degree, fps)
+  GridOptions grid;           // cell size, snapping, eye-tracking limit (pixels per degree and fps: the sequence
+                              // stage sets them from ViewingOptions and the input's rate, morph_stage.h)
   float blur_level = 2.0f;    // pyramid level read for the low-pass layer L (fractional allowed)
   // Smooth-step from cell distortion to blur strength of the in-between frames: 0 below distortion_low,
   // 1 above distortion_high (section 5.1, "Selective Blur").
