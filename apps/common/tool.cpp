@@ -59,10 +59,14 @@ void Tool::add_params(const ParamList& params) {
     std::visit(
         [&](auto* v) {
           using T = std::remove_pointer_t<decltype(v)>;
-          if constexpr (std::is_same_v<T, bool>)
-            app_.add_flag(p.flag, *v, help);
-          else
+          if constexpr (std::is_same_v<T, bool>) {
+            if (p.inverted)
+              app_.add_flag_callback(p.flag, [v] { *v = false; }, help);  // --no-snap: clears a default-on field
+            else
+              app_.add_flag(p.flag, *v, help);
+          } else {
             app_.add_option(p.flag, *v, help);
+          }
         },
         p.value);
     params_.push_back(p);

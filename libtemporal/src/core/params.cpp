@@ -31,10 +31,10 @@ std::string join(const std::vector<std::string>& items) {
 
 std::string param_value_text(const Param& p) {
   return std::visit(
-      [](auto* v) -> std::string {
+      [&p](auto* v) -> std::string {
         using T = std::remove_pointer_t<decltype(v)>;
         if constexpr (std::is_same_v<T, bool>)
-          return *v ? "on" : "off";
+          return *v != p.inverted ? "on" : "off";
         else if constexpr (std::is_same_v<T, std::string>)
           return *v;
         else

@@ -55,7 +55,7 @@ Expected<Plan> make_plan(const SequenceOptions& o, const StageInputs& needs) {
   if (!input) return input.error();
   auto out = SequencePattern::parse(o.out);
   if (!out) return out.error();
-  if (input->has_placeholder() && !out->has_placeholder())
+  if ((input->has_placeholder() || needs.outputs_per_frame > 1) && !out->has_placeholder())
     return Error::usage("--out '" + o.out + "' needs a frame placeholder (#### or %04d) for a sequence");
   if (Status s = check_output_name(o.out, "--out"); !s) return s.error();
   if (!o.state_out.empty())
@@ -110,7 +110,9 @@ class InputWindow {
   Status advance(int frame) {
     while (!cache_.empty() && cache_.front().first < frame) cache_.pop_front();
     int next = cache_.empty() ? frame : cache_.back().first + 1;
-    for (; next <= frame + needs_.lookahead; ++next) {
+    const int last = needs_.lookahead_past_range ? frame + needs_.lookahead
+                                                 : std::min(frame + needs_.lookahead, plan_.frames.back());
+    for (; next <= last; ++next) {
       const std::string path = plan_.input.path(next);
       if (next != frame && !std::filesystem::exists(path)) break;
       auto img = read_exr(path, ExrSelection{needs_.input_layers});

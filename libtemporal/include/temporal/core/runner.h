@@ -58,8 +58,12 @@ struct StageInputs {
   // 0: the scale is read from the input header's temporal:jitterFactor.
   int gbuffer_scale = 1;
   // Frames after the current one the stage sees (morph-120hz blend: 1; --perceive: the eye's window - 1), read
-  // from disk even past the selected range while the files exist.
+  // from disk even past the selected range while the files exist (unless lookahead_past_range is false: then
+  // only frames of the list are read, and the last frame of the list sees none).
   int lookahead = 0;
+  bool lookahead_past_range = true;
+  // Outputs the stage writes per input frame (morph-120hz: factor); above 1, --out must have a placeholder.
+  int outputs_per_frame = 1;
 };
 
 // One frame handed to a stage.
