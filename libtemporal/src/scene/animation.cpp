@@ -1,5 +1,5 @@
 // Animation sampler evaluation, glTF 2.0 section 3.11 and Appendix C ("Interpolation").
-#include "scene_impl.h"
+#include "scene_description.h"
 
 #include <algorithm>
 #include <cmath>
