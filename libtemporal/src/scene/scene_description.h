@@ -80,6 +80,10 @@ struct Node {
 struct Skin {
   std::vector<int> joints;              // node indices
   std::vector<glm::mat4> inverse_bind;  // one per joint: mesh space to joint space at bind time
+  // How normals are skinned. glTF (false): by the inverse transpose of the weight-blended joint matrix
+  // (section 3.7.3.2). UsdSkel (true): by the weight-blended inverse transposes of the joint matrices, as
+  // OpenUSD's UsdSkelSkinNormalsLBS does. The two differ where a vertex blends joints that turn apart.
+  bool blend_normal_matrices = false;
 };
 
 // Per-primitive data that ScenePrimitive does not carry: skin influences, morph deltas, point caches.
@@ -97,6 +101,8 @@ struct PrimitiveData {
   int point_sampler = -1;
   int normal_sampler = -1;
   std::vector<std::uint32_t> vertex_point;
+  std::vector<std::uint32_t> vertex_normal;  // vertex -> element of normal_sampler (faceVarying normals);
+                                             // empty: the vertex's point
   glm::vec3 local_min{0.0f}, local_max{0.0f};
 };
 

@@ -228,6 +228,7 @@ struct DeformInput {
   const float* weights = nullptr;    // morph weights of the node, nullptr: not morphed
   std::size_t n_targets = 0;
   const glm::mat4* joints = nullptr;  // joint matrices of the node's skin, nullptr: not skinned
+  const glm::mat3* joint_normals = nullptr;  // their inverse transposes when the skin blends those (UsdSkel)
   const float* points = nullptr;      // sampled points (3 per point), nullptr: rest positions
   const float* point_normals = nullptr;
 };
@@ -240,8 +241,9 @@ void deform(const ScenePrimitive& prim, const PrimitiveData& pd, const DeformInp
   const auto influences = static_cast<std::size_t>(pd.influences);
   for (std::size_t v = 0; v < nv; ++v) {
     const std::size_t pt = pd.vertex_point.empty() ? v : pd.vertex_point[v];
+    const std::size_t ne = pd.vertex_normal.empty() ? pt : pd.vertex_normal[v];
     glm::vec3 p = in.points ? glm::make_vec3(in.points + 3 * pt) : prim.positions[v];
-    glm::vec3 nrm = in.point_normals ? glm::make_vec3(in.point_normals + 3 * pt) : prim.normals[v];
+    glm::vec3 nrm = in.point_normals ? glm::make_vec3(in.point_normals + 3 * ne) : prim.normals[v];
     // Morph targets first (glTF section 3.7.2.2; UsdSkel applies blend shapes before skinning too).
     for (std::size_t k = 0; k < in.n_targets; ++k) {
       if (in.weights[k] == 0.0f) continue;
@@ -261,7 +263,17 @@ void deform(const ScenePrimitive& prim, const PrimitiveData& pd, const DeformInp
       xf = inst.model;
     }
     inst.world_positions[v] = glm::vec3(xf * glm::vec4(p, 1.0f));
-    inst.world_normals[v] = safe_normalize(transform_normal(xf, nrm));
+    if (in.joint_normals) {
+      glm::vec3 n(0.0f);
+      const std::uint16_t* jv = &pd.joints[v * influences];
+      const float* wv = &pd.weights[v * influences];
+      for (std::size_t c = 0; c < influences; ++c) {
+        if (wv[c] != 0.0f) n += wv[c] * (in.joint_normals[jv[c]] * nrm);
+      }
+      inst.world_normals[v] = safe_normalize(n);
+    } else {
+      inst.world_normals[v] = safe_normalize(transform_normal(xf, nrm));
+    }
   }
   if (pd.flat_normals) {
     // Generated flat normals follow the deformed triangles.
@@ -270,8 +282,8 @@ void deform(const ScenePrimitive& prim, const PrimitiveData& pd, const DeformInp
                                                      inst.world_positions[t + 2] - inst.world_positions[t]));
       inst.world_normals[t] = inst.world_normals[t + 1] = inst.world_normals[t + 2] = nn;
     }
-  } else if (pd.smooth_normals && (in.points || in.n_targets > 0)) {
-    smooth_normals(prim, pd, inst, scratch);
+  } else if (pd.smooth_normals) {
+    smooth_normals(prim, pd, inst, scratch);  // generated smooth: recomputed from the deformed triangles
   }
 }
 
@@ -348,14 +360,20 @@ void Scene::evaluate(double time_s, FrameState& out) const {
   std::vector<glm::mat4> world;
   world_matrices(m, local, ta, world);
 
-  // Joint matrices of every skin (glTF section 3.7.3.1): world(joint) * inverseBind(joint).
+  // Joint matrices of every skin (glTF section 3.7.3.1): world(joint) * inverseBind(joint); for skins that
+  // blend normal matrices, their inverse transposes too.
   std::vector<std::vector<glm::mat4>> joint_matrices(m.skins.size());
+  std::vector<std::vector<glm::mat3>> joint_normals(m.skins.size());
   for (std::size_t s = 0; s < m.skins.size(); ++s) {
     const scene_detail::Skin& skin = m.skins[s];
     joint_matrices[s].resize(skin.joints.size());
     for (std::size_t j = 0; j < skin.joints.size(); ++j) {
       joint_matrices[s][j] = world[static_cast<std::size_t>(skin.joints[j])] * skin.inverse_bind[j];
     }
+    if (!skin.blend_normal_matrices) continue;
+    joint_normals[s].resize(skin.joints.size());
+    for (std::size_t j = 0; j < skin.joints.size(); ++j)
+      joint_normals[s][j] = glm::transpose(glm::inverse(glm::mat3(joint_matrices[s][j])));
   }
 
   std::vector<float> points, point_normals;
@@ -385,7 +403,10 @@ void Scene::evaluate(double time_s, FrameState& out) const {
       in.weights = local.weights.data() + node.weight_offset;
       in.n_targets = std::min(pd.target_positions.size(), static_cast<std::size_t>(node.weight_count));
     }
-    if (skinned) in.joints = joint_matrices[static_cast<std::size_t>(node.skin)].data();
+    if (skinned) {
+      in.joints = joint_matrices[static_cast<std::size_t>(node.skin)].data();
+      if (!joint_normals[static_cast<std::size_t>(node.skin)].empty()) in.joint_normals = joint_normals[static_cast<std::size_t>(node.skin)].data();
+    }
     if (cached) {
       const scene_detail::Sampler& s = m.samplers[static_cast<std::size_t>(pd.point_sampler)];
       points.resize(static_cast<std::size_t>(s.components));
