@@ -71,6 +71,17 @@ Expected<RenderOutputs> RenderOutputs::parse(const std::string& list) {
   return o;
 }
 
+SceneGeometry geometry_of(const Scene& scene) {
+  SceneGeometry g;
+  g.primitives = &scene.primitives();
+  g.materials = &scene.materials();
+  g.textures = &scene.textures();
+  g.bounds_min = scene.bounds_min();
+  g.bounds_max = scene.bounds_max();
+  g.ambient = scene.ambient();
+  return g;
+}
+
 glm::mat4 camera_projection(const CameraState& camera, int width, int height) {
   // The image's aspect wins over the camera's (glTF leaves letterboxing to the viewer); a non-positive far
   // plane (glTF's infinite projection) is replaced by 1000 x near so depth stays finite.
@@ -226,7 +237,7 @@ Status Renderer::Impl::init() {
   if (auto s = build("gbuffer", kGeometryVertex, kGbufferFragment, gbuffer_program); !s) return s;
   if (auto s = build("shadow", kGeometryVertex, kShadowFragment, shadow_program); !s) return s;
   if (auto s = build("rsm", kGeometryVertex, kRsmFragment, rsm_program); !s) return s;
-  if (auto s = build("shade", kFullscreenVertex, deferred_fragment(p.direct, p.shadow, p.ssao, p.gi), shade_program); !s)
+  if (auto s = build("shade", kFullscreenVertex, deferred_fragment(p.direct, p.shadow, p.ssao, p.gi, scene.ambient != glm::vec3(0.0f)), shade_program); !s)
     return s;
   g.GenVertexArrays(1, &empty_vao);
   g.GenBuffers(1, &vpl_buffer);
@@ -494,6 +505,8 @@ void Renderer::Impl::shade(const Fbo& gb, const Fbo& target, const View& v, std:
   g.Uniform1ui(g.GetUniformLocation(prog, "u_seed"), seed);
   const float clamp_d = p.vpl_clamp > 0 ? p.vpl_clamp : 0.02f * scene_diagonal;
   g.Uniform1f(g.GetUniformLocation(prog, "u_vpl_clamp2"), clamp_d * clamp_d);
+  if (scene.ambient != glm::vec3(0.0f))
+    g.Uniform3f(g.GetUniformLocation(prog, "u_ambient"), state->ambient.x, state->ambient.y, state->ambient.z);
   g.BindVertexArray(empty_vao);
   g.DrawArrays(GL_TRIANGLES, 0, 3);
   g.BindVertexArray(0);

@@ -28,6 +28,7 @@ glm::vec3 Scene::bounds_max() const { return impl_->bounds_max; }
 double Scene::clip_duration() const { return impl_->clip_duration; }
 std::vector<std::string> Scene::clip_names() const { return impl_->clip_names; }
 const std::string& Scene::format() const { return impl_->format; }
+glm::vec3 Scene::ambient() const { return impl_->ambient; }
 
 std::vector<std::string> Scene::camera_names() const {
   std::vector<std::string> names;

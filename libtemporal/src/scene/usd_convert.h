@@ -104,7 +104,8 @@ struct Converter {
   // The material key of a mesh (or of one of its GeomSubsets, `gprim`): bound Material, display colour,
   // sidedness. Materials are created once every key is known (create_materials), so that SceneMaterial
   // indices follow the order of the Material prims.
-  std::string material_key(const Prim& gprim, const Prim& mesh, bool double_sided);
+  std::string material_key(const Prim& gprim, const Prim& mesh, bool double_sided, const double* color = nullptr);
+  bool color_slots(MeshJob& job, bool double_sided);
   Status material_slots(MeshJob& job);
   Status create_materials();
   Status preview_surface(const Prim& material, const MaterialRecipe& recipe, SceneMaterial& m, std::string& uv);

@@ -8,6 +8,7 @@
 #include <OpenImageIO/imageio.h>
 
 #include <algorithm>
+#include <array>
 #include <cstdio>
 
 namespace temporal::scene_detail::usd_detail {
@@ -69,14 +70,18 @@ std::string format_color(glm::vec3 c) {
 
 }  // namespace
 
-std::string Converter::material_key(const Prim& gprim, const Prim& mesh, bool double_sided) {
+std::string Converter::material_key(const Prim& gprim, const Prim& mesh, bool double_sided, const double* color) {
   MaterialRecipe r;
   const Prim* m = bound_material(stage, gprim, &gprim == &mesh);
   if (!m && &gprim != &mesh) m = bound_material(stage, mesh, true);
   r.material = m ? m->path : "";
   r.double_sided = double_sided;
   if (!m || reads_display_color(stage, *this, *m)) {
-    if (auto c = numbers(mesh, "primvars:displayColor", 3); c && !c->empty()) {
+    auto c = numbers(mesh, "primvars:displayColor", 3);
+    if (color) {
+      r.has_color = true;
+      r.display_color = glm::vec3(float(color[0]), float(color[1]), float(color[2]));
+    } else if (c && !c->empty()) {
       r.has_color = true;
       r.display_color = glm::vec3(float((*c)[0]), float((*c)[1]), float((*c)[2]));
       if (c->size() > 3)
@@ -89,9 +94,37 @@ std::string Converter::material_key(const Prim& gprim, const Prim& mesh, bool do
   return key;
 }
 
+// Faces grouped by their uniform displayColor (at most 64 colours), each group its own material: for meshes
+// coloured per face whose material reads displayColor (or that have no material).
+bool Converter::color_slots(MeshJob& job, bool double_sided) {
+  const Prim& mesh = *job.prim;
+  const Value* interp = mesh.property_meta("primvars:displayColor", "interpolation");
+  if (!interp || interp->text.size() != 1 || interp->text[0] != "uniform") return false;
+  const Prim* m = bound_material(stage, mesh, true);
+  if (m && !reads_display_color(stage, *this, *m)) return false;
+  auto colors = numbers(mesh, "primvars:displayColor", 3);
+  auto counts = numbers(mesh, "faceVertexCounts", 1);
+  if (!colors || !counts || colors->size() != 3 * counts->size() || value(mesh, "primvars:displayColor:indices")) return false;
+  std::vector<std::array<double, 3>> distinct;
+  std::vector<int> face_slot(counts->size());
+  for (std::size_t f = 0; f < counts->size(); ++f) {
+    const std::array<double, 3> c = {(*colors)[3 * f], (*colors)[3 * f + 1], (*colors)[3 * f + 2]};
+    auto it = std::find(distinct.begin(), distinct.end(), c);
+    face_slot[f] = int(it - distinct.begin());
+    if (it == distinct.end()) distinct.push_back(c);
+  }
+  if (distinct.size() > 64) return false;
+  job.material_keys.push_back(material_key(mesh, mesh, double_sided, distinct[0].data()));
+  job.slot_faces.assign(distinct.size(), {});
+  for (std::size_t f = 0; f < face_slot.size(); ++f) job.slot_faces[std::size_t(face_slot[f])].push_back(int(f));
+  for (const auto& c : distinct) job.material_keys.push_back(material_key(mesh, mesh, double_sided, c.data()));
+  return true;
+}
+
 Status Converter::material_slots(MeshJob& job) {
   const Prim& mesh = *job.prim;
   const bool double_sided = number(mesh, "doubleSided").value_or(0.0) != 0.0;
+  if (color_slots(job, double_sided)) return {};
   job.material_keys.push_back(material_key(mesh, mesh, double_sided));
   for (const auto& c : mesh.children) {
     const Prim& subset = *c;

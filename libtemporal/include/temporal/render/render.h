@@ -106,7 +106,12 @@ struct SceneGeometry {
   const std::vector<SceneMaterial>* materials = nullptr;
   const std::vector<SceneTexture>* textures = nullptr;
   glm::vec3 bounds_min{-1.0f}, bounds_max{1.0f};  // world-space bounds (SSAO radius, VPL clamp defaults)
+  glm::vec3 ambient{0.0f};  // non-zero: the scene has a uniform environment (USD DomeLight), added to gi as
+                            // albedo (1 - metallic) * FrameState::ambient
 };
+
+// The geometry of a loaded scene (it must outlive the renderer).
+SceneGeometry geometry_of(const Scene& scene);
 
 struct FrameInput {
   int frame = 0;

@@ -150,6 +150,8 @@ class Scene {
   std::vector<std::string> camera_names() const;
   // "glTF 2.0" or "USD".
   const std::string& format() const;
+  // Radiance of a uniform environment light (USD DomeLight: intensity * 2^exposure * color); 0 for glTF.
+  glm::vec3 ambient() const;
 
   // The frames render-gbuffer replays when no --frames are given: 0 .. ceil(S * fps) - 1 for S =
   // duration_s when positive, else the clip's duration, else one camera-path period when a path is set;
