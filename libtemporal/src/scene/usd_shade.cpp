@@ -144,7 +144,10 @@ namespace {
 
 // An image file as RGBA8, top row first (OpenImageIO).
 Status read_image(const std::string& file, const std::string& where, SceneTexture& tex) {
-  auto in = OIIO::ImageInput::open(file);
+  // Colours as stored: OpenImageIO would otherwise premultiply them by alpha (glTF's images are not).
+  OIIO::ImageSpec config;
+  config.attribute("oiio:UnassociatedAlpha", 1);
+  auto in = OIIO::ImageInput::open(file, &config);
   if (!in) return Error::input(where, "cannot read the texture '" + file + "': " + OIIO::geterror());
   const OIIO::ImageSpec& spec = in->spec();
   const int channels = spec.nchannels;
