@@ -99,6 +99,8 @@ struct Converter {
 
   // ---- meshes (usd_mesh.cpp) -----------------------------------------------------------------------------
   Status mesh(const MeshJob& job);
+  void emit_primitives(const MeshJob& job, ScenePrimitive& full, PrimitiveData& data,
+                       std::vector<std::vector<std::uint32_t>>& slot_tris);
 
   // ---- materials (usd_shade.cpp) -------------------------------------------------------------------------
   // The material key of a mesh (or of one of its GeomSubsets, `gprim`): bound Material, display colour,

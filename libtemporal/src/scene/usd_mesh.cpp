@@ -137,6 +137,77 @@ std::vector<std::uint32_t> remap_used(std::vector<std::uint32_t>& indices, std::
   return keep;
 }
 
+// Vertices and per-slot triangles of a mesh.
+struct MeshBuild {
+  ScenePrimitive full;  // every vertex
+  PrimitiveData data;
+  std::vector<std::vector<std::uint32_t>> slot_tris;
+  std::vector<std::uint32_t> corner_of;  // vertex -> face-vertex (when one vertex per face-vertex)
+  std::size_t skipped = 0;               // faces of fewer than 3 vertices
+};
+
+struct Faces {
+  const std::vector<char>& hole;
+  const std::vector<int>& slot;
+  bool left_handed = false;
+  bool corners = false;  // one vertex per face-vertex (a primitive varies per face or face-vertex)
+};
+
+// Fans every face from its first vertex (the other way round for leftHanded meshes) into its slot's triangles.
+void triangulate(const Topology& topo, const Primvar& normals, const Primvar& st, const Faces& faces, MeshBuild& b) {
+  std::vector<std::uint32_t> face;
+  for (std::size_t f = 0; f < topo.faces; ++f) {
+    const std::size_t n = std::size_t(topo.counts[f]), s0 = topo.face_start[f];
+    if (faces.hole[f] || n < 3) {
+      b.skipped += n < 3 && !faces.hole[f];
+      continue;
+    }
+    face.resize(n);
+    for (std::size_t k = 0; k < n; ++k) {
+      const std::size_t fv = s0 + k, pt = std::size_t(topo.indices[fv]);
+      if (!faces.corners) {
+        face[k] = std::uint32_t(pt);
+        continue;
+      }
+      face[k] = std::uint32_t(b.full.positions.size());
+      b.full.positions.emplace_back(topo.points[3 * pt], topo.points[3 * pt + 1], topo.points[3 * pt + 2]);
+      if (normals) {
+        const double* nv = normals.at(f, pt, fv);
+        b.full.normals.emplace_back(nv[0], nv[1], nv[2]);
+      }
+      if (st) {
+        const double* t = st.at(f, pt, fv);
+        b.full.texcoords.emplace_back(float(t[0]), float(1.0 - t[1]));
+      }
+      b.corner_of.push_back(std::uint32_t(fv));
+      b.data.vertex_point.push_back(std::uint32_t(pt));
+    }
+    auto& tris = b.slot_tris[std::size_t(faces.slot[f])];
+    for (std::size_t k = 1; k + 1 < n; ++k) {
+      if (faces.left_handed) tris.insert(tris.end(), {face[0], face[k + 1], face[k]});
+      else tris.insert(tris.end(), {face[0], face[k], face[k + 1]});
+    }
+  }
+  if (faces.corners) return;
+  b.full.positions.resize(topo.point_count);
+  for (std::size_t i = 0; i < topo.point_count; ++i)
+    b.full.positions[i] = glm::vec3(float(topo.points[3 * i]), float(topo.points[3 * i + 1]), float(topo.points[3 * i + 2]));
+  if (normals) {
+    b.full.normals.resize(topo.point_count);
+    for (std::size_t i = 0; i < topo.point_count; ++i) {
+      const double* nv = normals.at(0, i, 0);
+      b.full.normals[i] = glm::vec3(float(nv[0]), float(nv[1]), float(nv[2]));
+    }
+  }
+  if (st) {
+    b.full.texcoords.resize(topo.point_count);
+    for (std::size_t i = 0; i < topo.point_count; ++i) {
+      const double* t = st.at(0, i, 0);
+      b.full.texcoords[i] = glm::vec2(float(t[0]), float(1.0 - t[1]));
+    }
+  }
+}
+
 }  // namespace
 
 Status Converter::mesh(const MeshJob& job) {
@@ -148,7 +219,6 @@ Status Converter::mesh(const MeshJob& job) {
     warn_once("subdiv:" + scheme, "meshes with subdivisionScheme '" + scheme + "' (first: " + p.path +
                                       ") are drawn as their control cage: subdivision is not evaluated");
   }
-  const bool left = token(p, "orientation").value_or("rightHanded") == "leftHanded";
   std::vector<char> hole(topo.faces, 0);
   if (auto holes = numbers(p, "holeIndices", 1))
     for (double h : *holes)
@@ -161,101 +231,55 @@ Status Converter::mesh(const MeshJob& job) {
   const Primvar st = read_primvar(*this, p, uv_name, 2, Interp::Vertex, topo, problems);
   for (const auto& pr : problems) warn(where(p) + ": " + pr + ": ignored");
 
-  // One vertex per point, unless a primvar varies per face or per face-vertex: then one per face-vertex.
-  const bool corners = (normals && (normals.interp == Interp::Uniform || normals.interp == Interp::FaceVarying)) ||
-                       (st && (st.interp == Interp::Uniform || st.interp == Interp::FaceVarying));
   std::vector<int> slot(topo.faces, 0);
   for (std::size_t k = 0; k < job.slot_faces.size(); ++k)
     for (int f : job.slot_faces[k])
       if (f >= 0 && std::size_t(f) < topo.faces) slot[std::size_t(f)] = int(k) + 1;
-  ScenePrimitive full;
-  PrimitiveData data;
-  std::vector<std::vector<std::uint32_t>> slot_tris(job.material_keys.size());
-  std::vector<std::uint32_t> corner_of;  // vertex -> face-vertex (when one vertex per face-vertex)
-  std::size_t skipped = 0;
-  for (std::size_t f = 0; f < topo.faces; ++f) {
-    const std::size_t n = std::size_t(topo.counts[f]), s0 = topo.face_start[f];
-    if (hole[f] || n < 3) {
-      skipped += n < 3 && !hole[f];
-      continue;
-    }
-    auto vertex = [&](std::size_t k) -> std::uint32_t {
-      const std::size_t fv = s0 + k, pt = std::size_t(topo.indices[fv]);
-      if (!corners) return std::uint32_t(pt);
-      const auto v = std::uint32_t(full.positions.size());
-      full.positions.emplace_back(topo.points[3 * pt], topo.points[3 * pt + 1], topo.points[3 * pt + 2]);
-      if (normals) {
-        const double* nv = normals.at(f, pt, fv);
-        full.normals.emplace_back(nv[0], nv[1], nv[2]);
-      }
-      corner_of.push_back(std::uint32_t(fv));
-      if (st) {
-        const double* t = st.at(f, pt, fv);
-        full.texcoords.emplace_back(float(t[0]), float(1.0 - t[1]));
-      }
-      data.vertex_point.push_back(std::uint32_t(pt));
-      return v;
-    };
-    std::vector<std::uint32_t> face(n);
-    for (std::size_t k = 0; k < n; ++k) face[k] = vertex(k);
-    auto& tris = slot_tris[std::size_t(slot[f])];
-    for (std::size_t k = 1; k + 1 < n; ++k) {
-      if (left) tris.insert(tris.end(), {face[0], face[k + 1], face[k]});
-      else tris.insert(tris.end(), {face[0], face[k], face[k + 1]});
-    }
-  }
-  if (skipped) warn(where(p) + ": " + std::to_string(skipped) + " faces of mesh " + p.path + " have fewer than 3 vertices: skipped");
-  if (!corners) {
-    full.positions.resize(topo.point_count);
-    for (std::size_t i = 0; i < topo.point_count; ++i)
-      full.positions[i] = glm::vec3(float(topo.points[3 * i]), float(topo.points[3 * i + 1]), float(topo.points[3 * i + 2]));
-    if (normals) {
-      full.normals.resize(topo.point_count);
-      for (std::size_t i = 0; i < topo.point_count; ++i) {
-        const double* nv = normals.at(0, i, 0);
-        full.normals[i] = glm::vec3(float(nv[0]), float(nv[1]), float(nv[2]));
-      }
-    }
-    if (st) {
-      full.texcoords.resize(topo.point_count);
-      for (std::size_t i = 0; i < topo.point_count; ++i) {
-        const double* t = st.at(0, i, 0);
-        full.texcoords[i] = glm::vec2(float(t[0]), float(1.0 - t[1]));
-      }
-    }
-  }
+  Faces faces{hole, slot};
+  faces.left_handed = token(p, "orientation").value_or("rightHanded") == "leftHanded";
+  faces.corners = (normals && (normals.interp == Interp::Uniform || normals.interp == Interp::FaceVarying)) ||
+                  (st && (st.interp == Interp::Uniform || st.interp == Interp::FaceVarying));
+  MeshBuild b;
+  b.slot_tris.resize(job.material_keys.size());
+  triangulate(topo, normals, st, faces, b);
+  if (b.skipped) warn(where(p) + ": " + std::to_string(b.skipped) + " faces of mesh " + p.path + " have fewer than 3 vertices: skipped");
   std::vector<std::uint32_t> all_tris;
-  for (const auto& t : slot_tris) all_tris.insert(all_tris.end(), t.begin(), t.end());
+  for (const auto& t : b.slot_tris) all_tris.insert(all_tris.end(), t.begin(), t.end());
   if (all_tris.empty()) {
     warn(where(p) + ": mesh " + p.path + " has no triangles: skipped");
     return {};
   }
   if (!normals) {
-    full.normals = smooth_normals(full.positions, all_tris, data.vertex_point, topo.point_count);
-    data.smooth_normals = true;
+    b.full.normals = smooth_normals(b.full.positions, all_tris, b.data.vertex_point, topo.point_count);
+    b.data.smooth_normals = true;
   }
-  normalise_normals(full.normals);
+  normalise_normals(b.full.normals);
 
-  // Point cache: time-sampled points (and vertex normals) replace the rest values every evaluation.
+  // Point cache: time-sampled points (and normals) replace the rest values every evaluation.
   auto points_sampler = sampler(p, "points", int(3 * topo.point_count), Interpolation::Linear);
   if (!points_sampler) return points_sampler.error();
-  data.point_sampler = *points_sampler;
-  if (data.point_sampler >= 0 && normals && normals.indices.empty() &&
+  b.data.point_sampler = *points_sampler;
+  if (b.data.point_sampler >= 0 && normals && normals.indices.empty() &&
       (normals.interp == Interp::Vertex || normals.interp == Interp::FaceVarying)) {
     const bool fv = normals.interp == Interp::FaceVarying;
     auto ns = sampler(p, p.attribute("primvars:normals") ? "primvars:normals" : "normals",
                       int(3 * (fv ? topo.indices.size() : topo.point_count)), Interpolation::Linear);
     if (!ns) return ns.error();
-    data.normal_sampler = *ns;
-    if (fv) data.vertex_normal = corner_of;
+    b.data.normal_sampler = *ns;
+    if (fv) b.data.vertex_normal = b.corner_of;
   }
-  if (Status s = bind_skin(p, job.node, topo.point_count, full, data); !s) return s;
+  if (Status s = bind_skin(p, job.node, topo.point_count, b.full, b.data); !s) return s;
+  emit_primitives(job, b.full, b.data, b.slot_tris);
+  return {};
+}
 
+// One primitive and draw per non-empty slot. Meshes without GeomSubset materials have one slot and keep every
+// vertex; each subset's primitive keeps only its own vertices, with their skin and morph data.
+void Converter::emit_primitives(const MeshJob& job, ScenePrimitive& full, PrimitiveData& data,
+                                std::vector<std::vector<std::uint32_t>>& slot_tris) {
   const std::size_t used_slots = std::size_t(std::count_if(slot_tris.begin(), slot_tris.end(), [](const auto& t) { return !t.empty(); }));
   for (std::size_t k = 0; k < slot_tris.size(); ++k) {
     if (slot_tris[k].empty()) continue;
-    // Meshes without GeomSubset materials have one slot and keep every vertex; each subset's primitive
-    // keeps only its own vertices, with their skin and morph data.
     ScenePrimitive prim = used_slots == 1 ? std::move(full) : full;
     PrimitiveData pd = used_slots == 1 ? std::move(data) : data;
     prim.indices = std::move(slot_tris[k]);
@@ -280,7 +304,6 @@ Status Converter::mesh(const MeshJob& job) {
     out.primitive_data.push_back(std::move(pd));
     out.draws.push_back({job.node, static_cast<int>(out.primitives.size()) - 1});
   }
-  return {};
 }
 
 }  // namespace temporal::scene_detail::usd_detail

@@ -72,11 +72,14 @@ struct PayloadOptions {
 
 // Sets the terms of `base` from "direct,shadow,ssao,gi" (any subset, any order, at least one).
 Expected<PayloadOptions> parse_payload_terms(const std::string& list, PayloadOptions base = {});
+// The enabled terms as parse_payload_terms reads them ("direct,shadow,ssao,gi").
+std::string payload_terms_string(const PayloadOptions& payload);
 
 struct RenderOutputs {
   bool gbuffer = true, shade = true, reference = true, color = true;
   // "gbuffer,shade,reference,color" (any subset, at least one).
   static Expected<RenderOutputs> parse(const std::string& list);
+  std::string to_string() const;
 };
 
 struct RenderOptions {
@@ -99,6 +102,12 @@ struct RenderOptions {
 
 // Checks sizes, factor and payload settings without touching OpenGL (Usage errors naming the option).
 Status validate(const RenderOptions& options);
+
+// Command-line forms of RenderOptions fields: "WIDTHxHEIGHT" and the shade mip bias ("auto" or a number).
+Status parse_size(const std::string& text, RenderOptions& options);
+std::string size_string(const RenderOptions& options);
+Status parse_shade_mip_bias(const std::string& text, RenderOptions& options);
+std::string shade_mip_bias_string(const RenderOptions& options);
 
 // The static part of a scene: what Scene::load returns (tests build it by hand).
 struct SceneGeometry {
