@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <array>
 #include <cstdio>
+#include <filesystem>
 
 namespace temporal::scene_detail::usd_detail {
 namespace {
@@ -144,6 +145,8 @@ namespace {
 
 // An image file as RGBA8, top row first (OpenImageIO).
 Status read_image(const std::string& file, const std::string& where, SceneTexture& tex) {
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(file, ec)) return Error::input(where, "the texture '" + file + "' does not exist");
   // Colours as stored: OpenImageIO would otherwise premultiply them by alpha (glTF's images are not).
   OIIO::ImageSpec config;
   config.attribute("oiio:UnassociatedAlpha", 1);

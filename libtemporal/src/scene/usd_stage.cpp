@@ -376,6 +376,14 @@ class Composer {
   Status count_node(const std::string& where) {
     if (++index_nodes_ > limits_.max_index_nodes)
       return Error::input(where, "more than " + std::to_string(limits_.max_index_nodes) + " specs contribute to one prim");
+    return count_work(where, 1);
+  }
+
+  Status count_work(const std::string& where, long nodes) {
+    total_nodes_ += nodes;
+    if (total_nodes_ > limits_.max_total_nodes)
+      return Error::input(where, "composing the stage visits more than " + std::to_string(limits_.max_total_nodes) +
+                                     " specs (arcs that multiply each other?)");
     return {};
   }
 
@@ -492,6 +500,7 @@ class Composer {
       return Error::input(stage_.root_layer_->path, "the stage has more than " + std::to_string(limits_.max_prims) + " prims");
     index_nodes_ = 0;
     for_each_node(index, [&](Node&) { ++index_nodes_; return true; });
+    if (Status s = count_work(stage_.root_layer_->path, index_nodes_); !s) return s;
     // Direct arcs of this prim's specs (the mirrored nodes' own specs), then its variants.
     std::vector<Node*> with_spec;
     for_each_node(index, [&](Node& n) {
@@ -552,6 +561,7 @@ class Composer {
   std::shared_ptr<const PathMap> identity_ = std::make_shared<PathMap>(PathMap{"/", "/", nullptr});
   int prim_count_ = 0;
   int index_nodes_ = 0;
+  long total_nodes_ = 0;
 };
 
 Expected<std::unique_ptr<Stage>> Stage::open(const std::string& path, const StageLimits& limits) {

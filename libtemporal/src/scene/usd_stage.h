@@ -66,6 +66,7 @@ struct StageLimits {
   int max_prims = 1 << 20;     // composed prims
   int max_index_nodes = 4096;  // specs contributing to one prim
   int max_arc_depth = 64;      // nested references / payloads / variants
+  long max_total_nodes = 1L << 23;  // specs visited while composing the whole stage (bounds the work)
 };
 
 class Stage {

@@ -1064,8 +1064,13 @@ Expected<std::unique_ptr<Layer>> parse_usda(std::string_view text, const std::st
 }
 
 Expected<std::unique_ptr<Layer>> read_usda(const std::string& path) {
+  // Only regular files: an asset path naming a device (/dev/zero, a pipe) must not hang the reader.
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(path, ec)) return Error::input(path, "cannot open the layer (no such file)");
+  if (std::filesystem::file_size(path, ec) > (std::uintmax_t(1) << 31))
+    return Error::input(path, "the layer is larger than 2 GiB");
   std::ifstream in(path, std::ios::binary);
-  if (!in) return Error::input(path, "cannot open the layer (missing file or no permission)");
+  if (!in) return Error::input(path, "cannot open the layer (no permission?)");
   std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   if (text.rfind("PXR-USDC", 0) == 0 || text.rfind("PK\x03\x04", 0) == 0) {
     return Error::input(path, "a binary USD (crate) file or .usdz package, which cannot be read without OpenUSD; convert "
