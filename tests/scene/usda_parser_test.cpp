@@ -7,7 +7,10 @@
 
 #include <gtest/gtest.h>
 
+#include <charconv>
 #include <cmath>
+#include <cstdio>
+#include <cstring>
 #include <string>
 
 namespace temporal::usd {
@@ -208,6 +211,47 @@ TEST(UsdaParser, LaterSpecsOfOnePropertyInOneLayerWin) {
   // OpenUSD's lbs.usda declares points twice in one prim; the second declaration is the one it uses.
   auto l = parse_ok("#usda 1.0\ndef Mesh \"M\" {\n  point3f[] points = [(1, 1, 1)]\n  point3f[] points = [(2, 2, 2)]\n}\n");
   EXPECT_EQ(l->prim_at("/M")->property("points")->default_value.numbers, (std::vector<double>{2, 2, 2}));
+}
+
+// The parser converts the usual numbers itself (Clinger's fast path) and the rest with std::from_chars: every
+// value must be the double from_chars gives, bit for bit (floats printed with 9 and 17 digits, fixed notation,
+// and the edge cases of both paths).
+TEST(UsdaParser, NumbersAreTheDoublesFromCharsGives) {
+  std::vector<std::string> texts = {"0", "-0", "1", "-1", ".5", "5.", "1e5", "1E-5", "-2.5e+3", "123456789",
+                                    "0.000123456789", "1e22", "1e-22", "1e23", "1e-23", "12345678901234567890",
+                                    "0.1", "3.40282e+38", "1.17549435e-38", "4.9e-324", "00012", "0.000", "9007199254740993",
+                                    "0.30000000000000004", "2.2250738585072014e-308"};
+  std::uint32_t state = 12345u;  // a fixed linear congruential sequence of float bit patterns
+  for (int i = 0; i < 3000; ++i) {
+    state = state * 1664525u + 1013904223u;
+    float x;
+    std::memcpy(&x, &state, 4);
+    if (!std::isfinite(x)) continue;
+    char buf[64];
+    std::snprintf(buf, sizeof buf, i % 3 == 0 ? "%.9g" : i % 3 == 1 ? "%.17g" : "%.6f", double(x));
+    texts.push_back(buf);
+  }
+  std::string layer = "#usda 1.0\ndef \"A\" {\n  double[] a = [";
+  for (const auto& t : texts) layer += t + ", ";
+  layer += "]\n}\n";
+  auto l = parse_ok(layer);
+  const auto& got = l->prim_at("/A")->property("a")->default_value.numbers;
+  ASSERT_EQ(got.size(), texts.size());
+  for (std::size_t i = 0; i < texts.size(); ++i) {
+    const std::string& t = texts[i];
+    const bool negative = t[0] == '-';
+    double expect = 0.0;
+    std::from_chars(t.data() + negative, t.data() + t.size(), expect);
+    if (negative) expect = -expect;
+    EXPECT_EQ(std::memcmp(&got[i], &expect, sizeof(double)), 0) << t << ": " << got[i] << " vs " << expect;
+  }
+  // Beyond double: infinity and zero, as strtod gives them.
+  auto big = parse_ok("#usda 1.0\ndef \"A\" {\n  double[] a = [1e400, -1e400, 1e-400]\n}\n");
+  const auto& b = big->prim_at("/A")->property("a")->default_value.numbers;
+  ASSERT_EQ(b.size(), 3u);
+  EXPECT_TRUE(std::isinf(b[0]) && b[0] > 0);
+  EXPECT_TRUE(std::isinf(b[1]) && b[1] < 0);
+  EXPECT_EQ(b[2], 0.0);
 }
 
 TEST(UsdaParser, ResolvesRelativePaths) {

@@ -80,8 +80,11 @@ struct Converter {
   const Value* value(const Prim& prim, std::string_view name) const;
   std::optional<double> number(const Prim& prim, std::string_view name) const;
   std::optional<std::string> token(const Prim& prim, std::string_view name) const;
-  // Numbers of an attribute with `tuple` numbers per element (nullopt when unauthored or another shape).
-  std::optional<std::vector<double>> numbers(const Prim& prim, std::string_view name, int tuple) const;
+  // Numbers of an attribute with `tuple` numbers per element (nullptr when unauthored or another shape); they
+  // live as long as the stage.
+  const std::vector<double>* numbers(const Prim& prim, std::string_view name, int tuple) const;
+  // The same with `fallback` when absent.
+  std::vector<double> numbers_or(const Prim& prim, std::string_view name, int tuple, std::vector<double> fallback) const;
   // A sampler over the attribute's time samples (seconds), each sample holding `components` floats after
   // `convert` (which may reorder, e.g. quaternions from USD's w, x, y, z to x, y, z, w). -1 when the attribute
   // has fewer than two time samples. Samples of another size are an error naming the sample.

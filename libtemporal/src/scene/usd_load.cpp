@@ -53,10 +53,16 @@ std::optional<std::string> Converter::token(const Prim& prim, std::string_view n
   return v->text[0];
 }
 
-std::optional<std::vector<double>> Converter::numbers(const Prim& prim, std::string_view name, int tuple) const {
+const std::vector<double>* Converter::numbers(const Prim& prim, std::string_view name, int tuple) const {
   const Value* v = value(prim, name);
-  if (!v || v->kind != Value::Kind::Number || v->tuple != tuple) return std::nullopt;
-  return v->numbers;
+  if (!v || v->kind != Value::Kind::Number || v->tuple != tuple) return nullptr;
+  return &v->numbers;
+}
+
+std::vector<double> Converter::numbers_or(const Prim& prim, std::string_view name, int tuple,
+                                          std::vector<double> fallback) const {
+  const std::vector<double>* v = numbers(prim, name, tuple);
+  return v ? *v : fallback;
 }
 
 float Converter::seconds(const Site& site, double layer_time_code) const {
@@ -88,7 +94,8 @@ Expected<int> Converter::sampler(const Prim& prim, std::string_view name, int co
     sampled = true;
   }
   if (keys.size() < 2) return -1;
-  std::stable_sort(keys.begin(), keys.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+  auto earlier = [](const auto& a, const auto& b) { return a.first < b.first; };
+  if (!std::is_sorted(keys.begin(), keys.end(), earlier)) std::stable_sort(keys.begin(), keys.end(), earlier);  // negative scale
   Sampler s;
   s.components = components;
   s.interpolation = interpolation;
@@ -286,7 +293,7 @@ Status Converter::camera(const Prim& p, int node) {
   def.orthographic = token(p, "projection").value_or("perspective") == "orthographic";
   const double focal = number(p, "focalLength").value_or(50.0);
   const double aperture = number(p, "verticalAperture").value_or(15.2908);
-  const auto clipping = numbers(p, "clippingRange", 2).value_or(std::vector<double>{1.0, 1000000.0});
+  const auto clipping = numbers_or(p, "clippingRange", 2, {1.0, 1000000.0});
   if (!(focal > 0.0) || !(aperture > 0.0) || clipping.size() != 2 || !(clipping[0] > 0.0) || !(clipping[1] > clipping[0]))
     return Error::input(where(p), "camera " + p.path + " has a non-positive focalLength or verticalAperture, or a "
                                   "clippingRange that is not 0 < near < far");
@@ -320,7 +327,7 @@ Status Converter::light(const Prim& p, int node) {
     return number(p, name).value_or(fallback);
   };
   const double radiance = input("intensity", 1.0) * std::exp2(input("exposure", 0.0));
-  auto color = numbers(p, "inputs:color", 3);
+  const std::vector<double>* color = numbers(p, "inputs:color", 3);
   if (!color) color = numbers(p, "color", 3);
   const glm::vec3 rgb = color ? glm::vec3(float((*color)[0]), float((*color)[1]), float((*color)[2])) : glm::vec3(1.0f);
   const bool normalize = input("normalize", 0.0) != 0.0;

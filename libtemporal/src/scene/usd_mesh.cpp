@@ -30,8 +30,11 @@ struct Primvar {
   }
 };
 
+// The arrays live in the stage's layers (no copies).
 struct Topology {
-  std::vector<double> points, counts, indices;
+  const std::vector<double>* points = nullptr;
+  const std::vector<double>* counts = nullptr;
+  const std::vector<double>* indices = nullptr;
   std::vector<std::size_t> face_start;  // first face-vertex of each face
   std::size_t faces = 0, point_count = 0;
 };
@@ -63,7 +66,7 @@ Primvar read_primvar(const Converter& cv, const Prim& p, const std::string& name
   const std::size_t needed = pv.interp == Interp::Constant ? 1
                              : pv.interp == Interp::Uniform ? topo.faces
                              : pv.interp == Interp::Vertex ? topo.point_count
-                                                           : topo.indices.size();
+                                                           : topo.indices->size();
   const std::size_t have = pv.indices.empty() ? elements : pv.indices.size();
   bool ok = pv.interp == Interp::Constant ? have >= 1 : have == needed;
   for (double i : pv.indices) ok = ok && i >= 0.0 && i < double(elements) && i == std::floor(i);
@@ -76,32 +79,29 @@ Primvar read_primvar(const Converter& cv, const Prim& p, const std::string& name
 }
 
 Status read_topology(const Converter& cv, const Prim& p, Topology& t) {
-  auto points = cv.numbers(p, "points", 3);
-  auto counts = cv.numbers(p, "faceVertexCounts", 1);
-  auto indices = cv.numbers(p, "faceVertexIndices", 1);
-  if (!points || !counts || !indices)
+  t.points = cv.numbers(p, "points", 3);
+  t.counts = cv.numbers(p, "faceVertexCounts", 1);
+  t.indices = cv.numbers(p, "faceVertexIndices", 1);
+  if (!t.points || !t.counts || !t.indices)
     return Error::input(where(p), "mesh " + p.path + " lacks points, faceVertexCounts or faceVertexIndices");
-  t.points = std::move(*points);
-  t.counts = std::move(*counts);
-  t.indices = std::move(*indices);
-  t.point_count = t.points.size() / 3;
-  t.faces = t.counts.size();
-  if (!std::all_of(t.points.begin(), t.points.end(), [](double x) { return std::isfinite(x); }))
+  t.point_count = t.points->size() / 3;
+  t.faces = t.counts->size();
+  if (!std::all_of(t.points->begin(), t.points->end(), [](double x) { return std::isfinite(x); }))
     return Error::input(where(p), "the points of mesh " + p.path + " hold NaN or infinite values");
   std::size_t sum = 0;
   t.face_start.resize(t.faces);
   for (std::size_t f = 0; f < t.faces; ++f) {
-    const double c = t.counts[f];
-    if (!(c >= 0.0) || c != std::floor(c) || c > double(t.indices.size()))
+    const double c = (*t.counts)[f];
+    if (!(c >= 0.0) || c != std::floor(c) || c > double(t.indices->size()))
       return Error::input(where(p), "faceVertexCounts[" + std::to_string(f) + "] of mesh " + p.path + " is not a valid count");
     t.face_start[f] = sum;
     sum += static_cast<std::size_t>(c);
   }
-  if (sum != t.indices.size())
+  if (sum != t.indices->size())
     return Error::input(where(p), "mesh " + p.path + ": faceVertexCounts add up to " + std::to_string(sum) +
-                                      " but faceVertexIndices has " + std::to_string(t.indices.size()) + " entries");
-  for (std::size_t i = 0; i < t.indices.size(); ++i) {
-    const double x = t.indices[i];
+                                      " but faceVertexIndices has " + std::to_string(t.indices->size()) + " entries");
+  for (std::size_t i = 0; i < t.indices->size(); ++i) {
+    const double x = (*t.indices)[i];
     if (!(x >= 0.0) || x >= double(t.point_count) || x != std::floor(x))
       return Error::input(where(p), "faceVertexIndices[" + std::to_string(i) + "] = " + std::to_string(x) + " of mesh " + p.path +
                                         " is out of range (the mesh has " + std::to_string(t.point_count) + " points)");
@@ -157,20 +157,20 @@ struct Faces {
 void triangulate(const Topology& topo, const Primvar& normals, const Primvar& st, const Faces& faces, MeshBuild& b) {
   std::vector<std::uint32_t> face;
   for (std::size_t f = 0; f < topo.faces; ++f) {
-    const std::size_t n = std::size_t(topo.counts[f]), s0 = topo.face_start[f];
+    const std::size_t n = std::size_t((*topo.counts)[f]), s0 = topo.face_start[f];
     if (faces.hole[f] || n < 3) {
       b.skipped += n < 3 && !faces.hole[f];
       continue;
     }
     face.resize(n);
     for (std::size_t k = 0; k < n; ++k) {
-      const std::size_t fv = s0 + k, pt = std::size_t(topo.indices[fv]);
+      const std::size_t fv = s0 + k, pt = std::size_t((*topo.indices)[fv]);
       if (!faces.corners) {
         face[k] = std::uint32_t(pt);
         continue;
       }
       face[k] = std::uint32_t(b.full.positions.size());
-      b.full.positions.emplace_back(topo.points[3 * pt], topo.points[3 * pt + 1], topo.points[3 * pt + 2]);
+      b.full.positions.emplace_back((*topo.points)[3 * pt], (*topo.points)[3 * pt + 1], (*topo.points)[3 * pt + 2]);
       if (normals) {
         const double* nv = normals.at(f, pt, fv);
         b.full.normals.emplace_back(nv[0], nv[1], nv[2]);
@@ -191,7 +191,7 @@ void triangulate(const Topology& topo, const Primvar& normals, const Primvar& st
   if (faces.corners) return;
   b.full.positions.resize(topo.point_count);
   for (std::size_t i = 0; i < topo.point_count; ++i)
-    b.full.positions[i] = glm::vec3(float(topo.points[3 * i]), float(topo.points[3 * i + 1]), float(topo.points[3 * i + 2]));
+    b.full.positions[i] = glm::vec3(float((*topo.points)[3 * i]), float((*topo.points)[3 * i + 1]), float((*topo.points)[3 * i + 2]));
   if (normals) {
     b.full.normals.resize(topo.point_count);
     for (std::size_t i = 0; i < topo.point_count; ++i) {
@@ -220,7 +220,7 @@ Status Converter::mesh(const MeshJob& job) {
                                       ") are drawn as their control cage: subdivision is not evaluated");
   }
   std::vector<char> hole(topo.faces, 0);
-  if (auto holes = numbers(p, "holeIndices", 1))
+  if (const auto* holes = numbers(p, "holeIndices", 1))
     for (double h : *holes)
       if (h >= 0.0 && h < double(topo.faces)) hole[std::size_t(h)] = 1;
   const int first_material = material_index.at(job.material_keys[0]);
@@ -263,7 +263,7 @@ Status Converter::mesh(const MeshJob& job) {
       (normals.interp == Interp::Vertex || normals.interp == Interp::FaceVarying)) {
     const bool fv = normals.interp == Interp::FaceVarying;
     auto ns = sampler(p, p.attribute("primvars:normals") ? "primvars:normals" : "normals",
-                      int(3 * (fv ? topo.indices.size() : topo.point_count)), Interpolation::Linear);
+                      int(3 * (fv ? topo.indices->size() : topo.point_count)), Interpolation::Linear);
     if (!ns) return ns.error();
     b.data.normal_sampler = *ns;
     if (fv) b.data.vertex_normal = b.corner_of;

@@ -78,7 +78,7 @@ std::string Converter::material_key(const Prim& gprim, const Prim& mesh, bool do
   r.material = m ? m->path : "";
   r.double_sided = double_sided;
   if (!m || reads_display_color(stage, *this, *m)) {
-    auto c = numbers(mesh, "primvars:displayColor", 3);
+    const std::vector<double>* c = numbers(mesh, "primvars:displayColor", 3);
     if (color) {
       r.has_color = true;
       r.display_color = glm::vec3(float(color[0]), float(color[1]), float(color[2]));
@@ -103,8 +103,8 @@ bool Converter::color_slots(MeshJob& job, bool double_sided) {
   if (!interp || interp->text.size() != 1 || interp->text[0] != "uniform") return false;
   const Prim* m = bound_material(stage, mesh, true);
   if (m && !reads_display_color(stage, *this, *m)) return false;
-  auto colors = numbers(mesh, "primvars:displayColor", 3);
-  auto counts = numbers(mesh, "faceVertexCounts", 1);
+  const std::vector<double>* colors = numbers(mesh, "primvars:displayColor", 3);
+  const std::vector<double>* counts = numbers(mesh, "faceVertexCounts", 1);
   if (!colors || !counts || colors->size() != 3 * counts->size() || value(mesh, "primvars:displayColor:indices")) return false;
   std::vector<std::array<double, 3>> distinct;
   std::vector<int> face_slot(counts->size());
@@ -132,7 +132,7 @@ Status Converter::material_slots(MeshJob& job) {
     if (subset.type_name != "GeomSubset" || !subset.active || !subset.defined()) continue;
     if (!bound_material(stage, subset, false)) continue;
     if (token(subset, "elementType").value_or("face") != "face") continue;
-    auto faces = numbers(subset, "indices", 1);
+    const std::vector<double>* faces = numbers(subset, "indices", 1);
     if (!faces) continue;
     job.material_keys.push_back(material_key(subset, mesh, double_sided));
     std::vector<int> f(faces->begin(), faces->end());
@@ -152,24 +152,31 @@ Status read_image(const std::string& file, const std::string& where, SceneTextur
   config.attribute("oiio:UnassociatedAlpha", 1);
   auto in = OIIO::ImageInput::open(file, &config);
   if (!in) return Error::input(where, "cannot read the texture '" + file + "': " + OIIO::geterror());
+  in->threads(1);  // textures are small; a thread pool would cost more than it saves (and scene loads may run in parallel)
   const OIIO::ImageSpec& spec = in->spec();
   const int channels = spec.nchannels;
   if (spec.width <= 0 || spec.height <= 0 || spec.width > 16384 || spec.height > 16384 || channels < 1)
     return Error::input(where, "the texture '" + file + "' has an unsupported size or no channels");
   const std::size_t pixels = std::size_t(spec.width) * std::size_t(spec.height);
-  std::vector<std::uint8_t> data(pixels * std::size_t(channels));
-  if (!in->read_image(0, 0, 0, channels, OIIO::TypeDesc::UINT8, data.data()))
-    return Error::input(where, "cannot decode the texture '" + file + "': " + in->geterror());
   tex.width = spec.width;
   tex.height = spec.height;
   tex.rgba8.resize(pixels * 4);
-  for (std::size_t i = 0; i < pixels; ++i) {
-    const std::uint8_t* c = &data[i * std::size_t(channels)];
-    std::uint8_t* o = &tex.rgba8[i * 4];
-    if (channels >= 3) {
-      o[0] = c[0], o[1] = c[1], o[2] = c[2], o[3] = channels >= 4 ? c[3] : 255;
-    } else {
-      o[0] = o[1] = o[2] = c[0], o[3] = channels == 2 ? c[1] : 255;
+  if (channels == 4) {  // straight into place
+    if (!in->read_image(0, 0, 0, 4, OIIO::TypeDesc::UINT8, tex.rgba8.data()))
+      return Error::input(where, "cannot decode the texture '" + file + "': " + in->geterror());
+  } else {
+    std::vector<std::uint8_t> data(pixels * std::size_t(channels));
+    if (!in->read_image(0, 0, 0, channels, OIIO::TypeDesc::UINT8, data.data()))
+      return Error::input(where, "cannot decode the texture '" + file + "': " + in->geterror());
+    for (std::size_t i = 0; i < pixels; ++i) {
+      const std::uint8_t* c = &data[i * std::size_t(channels)];
+      std::uint8_t* o = &tex.rgba8[i * 4];
+      if (channels >= 3) {
+        o[0] = c[0], o[1] = c[1], o[2] = c[2], o[3] = 255;  // 3 channels, or the first 4 of more
+        if (channels > 4) o[3] = c[3];
+      } else {
+        o[0] = o[1] = o[2] = c[0], o[3] = channels == 2 ? c[1] : 255;
+      }
     }
   }
   // "auto" colour space: 8-bit images are sRGB-encoded, float images linear (UsdUVTexture).
@@ -218,11 +225,11 @@ Status Converter::preview_surface(const Prim& material, const MaterialRecipe& r,
     return {};
   }
   auto input = [&](const char* name, double fallback) { return number(*surface, std::string("inputs:") + name).value_or(fallback); };
-  const auto diffuse = numbers(*surface, "inputs:diffuseColor", 3).value_or(std::vector<double>{0.18, 0.18, 0.18});
+  const auto diffuse = numbers_or(*surface, "inputs:diffuseColor", 3, {0.18, 0.18, 0.18});
   m.base_color_factor = glm::vec4(float(diffuse[0]), float(diffuse[1]), float(diffuse[2]), float(input("opacity", 1.0)));
   m.metallic = float(input("metallic", 0.0));
   m.roughness = float(input("roughness", 0.5));
-  const auto emissive = numbers(*surface, "inputs:emissiveColor", 3).value_or(std::vector<double>{0.0, 0.0, 0.0});
+  const auto emissive = numbers_or(*surface, "inputs:emissiveColor", 3, {0.0, 0.0, 0.0});
   m.emissive = glm::vec3(float(emissive[0]), float(emissive[1]), float(emissive[2]));
   for (const char* unsupported : {"inputs:metallic", "inputs:roughness", "inputs:normal", "inputs:emissiveColor", "inputs:occlusion"}) {
     std::string output;
@@ -267,8 +274,8 @@ Status Converter::uv_texture(const Prim& tex, SceneMaterial& m, std::string& uv)
     warn_once("udim", where(tex) + ": UDIM textures are not supported: " + tex.path + " drawn without its texture");
     return {};
   }
-  const auto scale = numbers(tex, "inputs:scale", 4).value_or(std::vector<double>{1.0, 1.0, 1.0, 1.0});
-  const auto bias = numbers(tex, "inputs:bias", 4).value_or(std::vector<double>{0.0, 0.0, 0.0, 0.0});
+  const auto scale = numbers_or(tex, "inputs:scale", 4, {1.0, 1.0, 1.0, 1.0});
+  const auto bias = numbers_or(tex, "inputs:bias", 4, {0.0, 0.0, 0.0, 0.0});
   if (std::any_of(bias.begin(), bias.end(), [](double b) { return b != 0.0; }))
     warn_once("bias:" + tex.path, where(tex) + ": inputs:bias of UsdUVTexture is not applied");
   m.base_color_factor = glm::vec4(float(scale[0]), float(scale[1]), float(scale[2]), float(scale[3]) * m.base_color_factor.a);

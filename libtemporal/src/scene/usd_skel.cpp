@@ -77,11 +77,11 @@ Status Converter::skeleton(const Prim& p, int node) {
   sk.path = p.path;
   sk.joints = tokens(*this, p, "joints");
   const std::size_t n = sk.joints.size();
-  auto bind = numbers(p, "bindTransforms", 16);
-  auto rest = numbers(p, "restTransforms", 16);
+  const std::vector<double>* bind = numbers(p, "bindTransforms", 16);
+  const std::vector<double>* rest = numbers(p, "restTransforms", 16);
   if (n > 0 && (!bind || bind->size() != 16 * n))
     return Error::input(where(p), "skeleton " + p.path + " needs one bindTransforms matrix per joint (" + std::to_string(n) + ")");
-  if (rest && rest->size() != 16 * n) rest.reset();
+  if (rest && rest->size() != 16 * n) rest = nullptr;
   for (std::size_t j = 0; j < n; ++j) sk.bind.push_back(matrix_at(*bind, j));
 
   // The bound animation (skel:animationSource on the skeleton or an ancestor) and its joint order.
@@ -95,7 +95,7 @@ Status Converter::skeleton(const Prim& p, int node) {
   }
   const int na = int(anim_joints.size());
   int samplers[3] = {-1, -1, -1};
-  std::optional<std::vector<double>> constants[3];
+  const std::vector<double>* constants[3] = {nullptr, nullptr, nullptr};
   const char* names[3] = {"translations", "rotations", "scales"};
   for (int c = 0; c < 3 && anim; ++c) {
     const int comps = c == 1 ? 4 : 3;
@@ -103,7 +103,7 @@ Status Converter::skeleton(const Prim& p, int node) {
     if (!s) return s.error();
     samplers[c] = *s;
     constants[c] = numbers(*anim, names[c], comps);
-    if (constants[c] && constants[c]->size() != std::size_t(comps * na)) constants[c].reset();
+    if (constants[c] && constants[c]->size() != std::size_t(comps * na)) constants[c] = nullptr;
   }
   for (std::size_t j = 0; j < n; ++j) {
     const std::string& path = sk.joints[j];
@@ -149,7 +149,7 @@ Status Converter::skeleton(const Prim& p, int node) {
     auto w = sampler(*anim, "blendShapeWeights", nb, Interpolation::Linear);
     if (!w) return w.error();
     sk.blend_weight_sampler = *w;
-    if (auto rw = numbers(*anim, "blendShapeWeights", 1); rw && rw->size() == std::size_t(nb))
+    if (const auto* rw = numbers(*anim, "blendShapeWeights", 1); rw && rw->size() == std::size_t(nb))
       for (double x : *rw) sk.blend_weight_rest.push_back(float(x));
   }
   skeletons[p.path] = std::move(sk);
@@ -159,7 +159,8 @@ Status Converter::skeleton(const Prim& p, int node) {
 namespace {
 
 struct Influences {
-  std::vector<double> indices, weights;
+  const std::vector<double>* indices = nullptr;
+  const std::vector<double>* weights = nullptr;
   int size = 1;
   bool constant = false;
 };
@@ -178,8 +179,8 @@ Status read_influences(const Converter& cv, const Prim& mesh, std::size_t points
                                          std::to_string(in.size) + ") values per " + (in.constant ? "mesh" : "point") +
                                          " (" + std::to_string(expect) + "), they hold " + std::to_string(idx->size()) + " / " +
                                          std::to_string(w->size()));
-  in.indices = std::move(*idx);
-  in.weights = std::move(*w);
+  in.indices = idx;
+  in.weights = w;
   return {};
 }
 
@@ -229,8 +230,8 @@ Status Converter::bind_skin(const Prim& mesh, int node, std::size_t point_count,
     for (std::size_t v = 0; v < nv; ++v) {
       const std::size_t base = in.constant ? 0 : point(v) * std::size_t(in.size);
       for (int c = 0; c < in.size; ++c) {
-        const double ji = in.indices[base + std::size_t(c)];
-        const double w = in.weights[base + std::size_t(c)];
+        const double ji = (*in.indices)[base + std::size_t(c)];
+        const double w = (*in.weights)[base + std::size_t(c)];
         const bool used = std::isfinite(w) && w > 0.0;
         if (used && !(ji >= 0.0 && ji < double(order.size())))
           return Error::input(where(mesh), "skel:jointIndices of " + mesh.path + " holds " + std::to_string(ji) +
@@ -258,9 +259,9 @@ Status Converter::blend_shapes(const Prim& mesh, int node, const Skeleton& sk, c
   auto point = [&](std::size_t v) { return data.vertex_point.empty() ? v : std::size_t(data.vertex_point[v]); };
   for (std::size_t k = 0; k < shapes.size(); ++k) {
     const Prim* shape = stage.prim_at(targets[k]);
-    auto offsets = shape ? numbers(*shape, "offsets", 3) : std::nullopt;
+    const std::vector<double>* offsets = shape ? numbers(*shape, "offsets", 3) : nullptr;
     if (!offsets) return Error::input(where(mesh), "blend shape target " + targets[k] + " of " + mesh.path + " has no offsets");
-    auto indices = numbers(*shape, "pointIndices", 1);
+    const std::vector<double>* indices = numbers(*shape, "pointIndices", 1);
     const std::size_t count = offsets->size() / 3;
     if (indices ? indices->size() != count : count != point_count)
       return Error::input(where(*shape), "blend shape " + shape->path + ": offsets and pointIndices (or the mesh's points) differ in count");
