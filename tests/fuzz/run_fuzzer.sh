@@ -3,7 +3,8 @@
 #   run_fuzzer.sh FUZZER WORK_DIR SECONDS MAX_LEN SEED_SPEC...
 # SEED_SPEC is DIR:EXT[,EXT...]: every file under DIR (recursively) with one of the extensions is copied into
 # WORK_DIR/seeds (never into the repository); a DIR that does not exist is skipped with a message (the shared
-# assets are optional). First every committed reproducer in tests/fuzz/regressions/<target>/ runs once, then
+# assets are optional). A DIR starting with SHARED means the shared assets: $TEMPORAL_SHARED_ASSETS, else
+# $TEMPORAL_SHARED_DEFAULT (the CTests set it to ../shared/assets beside the source tree). First every committed reproducer in tests/fuzz/regressions/<target>/ runs once, then
 # the fuzzer runs on WORK_DIR/corpus (kept between runs) and the seeds. Crashes are written to
 # WORK_DIR/crash-*: turn each into a regression file. Exit status: the fuzzer's (0: no crash).
 set -euo pipefail
@@ -12,8 +13,10 @@ shift 4
 name="$(basename "$fuzzer")"
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
 mkdir -p "$work/seeds" "$work/corpus"
+shared="${TEMPORAL_SHARED_ASSETS:-${TEMPORAL_SHARED_DEFAULT:-}}"
 for spec in "$@"; do
   dir="${spec%%:*}" exts="${spec#*:}"
+  [[ "$dir" == SHARED* ]] && dir="$shared${dir#SHARED}"
   if [[ ! -d "$dir" ]]; then
     echo "$name: seed folder $dir is absent: skipped"
     continue
