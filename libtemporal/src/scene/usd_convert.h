@@ -120,7 +120,8 @@ struct Converter {
   Status skeleton(const Prim& prim, int node);
   // A sampler holding components [first, first + count) of sampler `whole` (one joint of an array sample).
   int slice(int whole, int first, int count);
-  // Skinning and blend shapes of a mesh; `vertex_point` maps the primitive's vertices to mesh points.
+  // Skinning and blend shapes of a mesh (under a SkelRoot, bound to a converted Skeleton); per-point data
+  // reaches the primitive's vertices through data.vertex_point.
   Status bind_skin(const Prim& mesh, int node, std::size_t point_count, ScenePrimitive& prim, PrimitiveData& data);
   Status blend_shapes(const Prim& mesh, int node, const Skeleton& skeleton, const std::vector<std::string>& shapes,
                       std::size_t point_count, ScenePrimitive& prim, PrimitiveData& data);

@@ -374,7 +374,7 @@ Status Converter::light(const Prim& p, int node) {
 Status Converter::finish_time() {
   out.clip_duration = 0.0;
   if (!sampled) return {};
-  const double end = stage.has_time_range() && stage.root_layer().has("endTimeCode") ? stage.end_time_code() : last_tc;
+  const double end = stage.root_layer().has("endTimeCode") ? stage.end_time_code() : last_tc;
   // The timeline holds its last frame for one frame: startTimeCode .. endTimeCode at framesPerSecond.
   const double d = (end - start_tc + tcps / stage.frames_per_second()) / tcps;
   out.clip_duration = d > 0.0 && std::isfinite(d) ? d : 0.0;

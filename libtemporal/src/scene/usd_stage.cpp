@@ -148,7 +148,6 @@ const Prim* Stage::prim_at(std::string_view path) const {
 
 double Stage::start_time_code() const { return root_layer_->number("startTimeCode", 0.0); }
 double Stage::end_time_code() const { return root_layer_->number("endTimeCode", start_time_code()); }
-bool Stage::has_time_range() const { return root_layer_->has("startTimeCode") || root_layer_->has("endTimeCode"); }
 double Stage::time_codes_per_second() const {
   const double fps = root_layer_->number("framesPerSecond", 24.0);
   const double t = root_layer_->number("timeCodesPerSecond", fps);

@@ -85,7 +85,6 @@ class Stage {
   // Stage metadata (root layer) with USD's fallbacks.
   double start_time_code() const;
   double end_time_code() const;
-  bool has_time_range() const;
   double time_codes_per_second() const;
   double frames_per_second() const;
   std::string up_axis() const;
