@@ -122,6 +122,32 @@ TEST(RenderCli, MissingBufferAndUnsupportedExtensionAreInputErrors) {
   EXPECT_FALSE(fs::exists(dir / "o" / "gbuffer.0000.exr"));
 }
 
+TEST(RenderCli, UsdScenesRenderAndBadUsdIsRefusedWithItsPosition) {
+  const auto dir = test::scratch_dir("render_cli_usd");
+  std::string output;
+  // The USD copy of a built-in scene renders (one frame; frames come from its timeline as for glTF).
+  const std::string usda = (test::source_dir() / "assets" / "scenes" / "morph_test.usda").string();
+  ASSERT_EQ(test::run_command(tool() + " " + usda + " --out " + (dir / "ok").string() +
+                                  " --size 32x24 --frames 3-3 --outputs gbuffer --verbose",
+                              &output),
+            0)
+      << output;
+  EXPECT_TRUE(fs::exists(dir / "ok" / "gbuffer.0003.exr"));
+  // Malformed text: exit 2, `render-gbuffer: file:line:column: what is wrong`.
+  std::ofstream(dir / "bad.usda") << "#usda 1.0\ndef Mesh \"M\" {\n    float x = \"text\"\n}\n";
+  EXPECT_EQ(test::run_command(tool() + " " + (dir / "bad.usda").string() + " --out " + (dir / "o").string(), &output), 2)
+      << output;
+  EXPECT_NE(output.find("render-gbuffer: " + (dir / "bad.usda").string() + ":3:15: "), std::string::npos) << output;
+  // A crate file: exit 2 with the command that converts it.
+  std::ofstream(dir / "crate.usd") << "PXR-USDC" << std::string(88, '\0');
+  EXPECT_EQ(test::run_command(tool() + " " + (dir / "crate.usd").string() + " --out " + (dir / "o").string(), &output), 2)
+      << output;
+  EXPECT_NE(output.find("usdcat -o file.usda crate.usd"), std::string::npos) << output;
+  // USD scenes have one timeline: a named clip is a usage error.
+  EXPECT_EQ(test::run_command(tool() + " " + usda + " --out " + (dir / "o").string() + " --clip wave", &output), 1) << output;
+  EXPECT_FALSE(fs::exists(dir / "o" / "gbuffer.0000.exr"));
+}
+
 TEST(RenderCli, MissingSceneIsAnInputError) {
   const auto dir = test::scratch_dir("render_cli_missing");
   std::string output;

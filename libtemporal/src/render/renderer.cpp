@@ -20,55 +20,15 @@ namespace temporal {
 
 using namespace render_detail;
 
-// ---- option parsing ------------------------------------------------------------------------------------
-
-namespace {
-std::vector<std::string> split_list(const std::string& list) {
-  std::vector<std::string> out;
-  std::stringstream ss(list);
-  std::string item;
-  while (std::getline(ss, item, ','))
-    if (!item.empty()) out.push_back(item);
-  return out;
-}
-}  // namespace
-
-Expected<PayloadOptions> parse_payload_terms(const std::string& list, PayloadOptions base) {
-  base.direct = base.shadow = base.ssao = base.gi = false;
-  const auto items = split_list(list);
-  if (items.empty()) return Error::usage("--payload needs at least one of direct, shadow, ssao, gi");
-  for (const auto& t : items) {
-    if (t == "direct") base.direct = true;
-    else if (t == "shadow") base.shadow = true;
-    else if (t == "ssao") base.ssao = true;
-    else if (t == "gi") base.gi = true;
-    else return Error::usage("unknown payload term '" + t + "': use direct, shadow, ssao, gi");
-  }
-  return base;
-}
-
-std::vector<std::string> PayloadOptions::channels() const {
-  std::vector<std::string> c = {"R", "G", "B"};
-  if (direct) c.insert(c.end(), {"direct.R", "direct.G", "direct.B"});
-  if (shadow) c.push_back("shadow.Y");
-  if (ssao) c.push_back("ssao.Y");
-  if (gi) c.insert(c.end(), {"gi.R", "gi.G", "gi.B"});
-  return c;
-}
-
-Expected<RenderOutputs> RenderOutputs::parse(const std::string& list) {
-  RenderOutputs o;
-  o.gbuffer = o.shade = o.reference = o.color = false;
-  const auto items = split_list(list);
-  if (items.empty()) return Error::usage("--outputs needs at least one of gbuffer, shade, reference, color");
-  for (const auto& t : items) {
-    if (t == "gbuffer") o.gbuffer = true;
-    else if (t == "shade") o.shade = true;
-    else if (t == "reference") o.reference = true;
-    else if (t == "color") o.color = true;
-    else return Error::usage("unknown output '" + t + "': use gbuffer, shade, reference, color");
-  }
-  return o;
+SceneGeometry geometry_of(const Scene& scene) {
+  SceneGeometry g;
+  g.primitives = &scene.primitives();
+  g.materials = &scene.materials();
+  g.textures = &scene.textures();
+  g.bounds_min = scene.bounds_min();
+  g.bounds_max = scene.bounds_max();
+  g.ambient = scene.ambient();
+  return g;
 }
 
 glm::mat4 camera_projection(const CameraState& camera, int width, int height) {
@@ -226,7 +186,7 @@ Status Renderer::Impl::init() {
   if (auto s = build("gbuffer", kGeometryVertex, kGbufferFragment, gbuffer_program); !s) return s;
   if (auto s = build("shadow", kGeometryVertex, kShadowFragment, shadow_program); !s) return s;
   if (auto s = build("rsm", kGeometryVertex, kRsmFragment, rsm_program); !s) return s;
-  if (auto s = build("shade", kFullscreenVertex, deferred_fragment(p.direct, p.shadow, p.ssao, p.gi), shade_program); !s)
+  if (auto s = build("shade", kFullscreenVertex, deferred_fragment(p.direct, p.shadow, p.ssao, p.gi, scene.ambient != glm::vec3(0.0f)), shade_program); !s)
     return s;
   g.GenVertexArrays(1, &empty_vao);
   g.GenBuffers(1, &vpl_buffer);
@@ -494,6 +454,8 @@ void Renderer::Impl::shade(const Fbo& gb, const Fbo& target, const View& v, std:
   g.Uniform1ui(g.GetUniformLocation(prog, "u_seed"), seed);
   const float clamp_d = p.vpl_clamp > 0 ? p.vpl_clamp : 0.02f * scene_diagonal;
   g.Uniform1f(g.GetUniformLocation(prog, "u_vpl_clamp2"), clamp_d * clamp_d);
+  if (scene.ambient != glm::vec3(0.0f))
+    g.Uniform3f(g.GetUniformLocation(prog, "u_ambient"), state->ambient.x, state->ambient.y, state->ambient.z);
   g.BindVertexArray(empty_vao);
   g.DrawArrays(GL_TRIANGLES, 0, 3);
   g.BindVertexArray(0);
@@ -633,25 +595,6 @@ Renderer::~Renderer() = default;
 
 const RenderOptions& Renderer::options() const { return impl_->options; }
 std::string Renderer::gl_description() const { return impl_->context->description(); }
-
-Status validate(const RenderOptions& options) {
-  const PayloadOptions& p = options.payload;
-  if (options.width < 1 || options.height < 1 || options.width > 16384 || options.height > 16384)
-    return Error::usage("--size must be between 1x1 and 16384x16384");
-  if (options.factor < 1 || options.width % options.factor != 0 || options.height % options.factor != 0)
-    return Error::usage("--factor " + std::to_string(options.factor) + " must divide the width and height (" +
-                        std::to_string(options.width) + "x" + std::to_string(options.height) + ")");
-  if (options.reference_spp < 1) return Error::usage("--reference-spp must be at least 1");
-  if (options.shade_mip_bias && !(std::abs(*options.shade_mip_bias) <= 16.0f))
-    return Error::usage("--shade-mip-bias must be a number between -16 and 16 (or 'auto')");
-  if (p.pcf_kernel < 1 || p.pcf_kernel > 32) return Error::usage("--pcf must be between 1 and 32");
-  if (p.shadow_map_size < 16 || p.shadow_map_size > 8192) return Error::usage("--shadow-map-size must be in 16..8192");
-  if (p.ssao_directions < 1 || p.ssao_steps < 1) return Error::usage("--ssao-directions and --ssao-steps must be >= 1");
-  if (p.vpl_count < 1 || p.vpl_count > kMaxVpls)
-    return Error::usage("--vpls must be between 1 and " + std::to_string(kMaxVpls));
-  if (p.rsm_size < 4 || p.rsm_size > 2048) return Error::usage("--rsm-size must be in 4..2048");
-  return {};
-}
 
 Expected<Renderer> Renderer::create(const RenderOptions& options, const SceneGeometry& scene) {
   if (auto s = validate(options); !s) return s.error();

@@ -179,6 +179,7 @@ uniform float u_proj_scale;    // pixels per world unit at depth 1 (P[1][1] * he
 uniform uint u_seed;           // changes every frame (and every reference sample)
 uniform int u_vpl_count;
 uniform float u_vpl_clamp2;    // minimum squared VPL distance
+uniform vec3 u_ambient;        // radiance of the environment (AMBIENT only)
 const float PI = 3.14159265358979;
 
 uint pcg(uint v) {
@@ -294,6 +295,10 @@ void main() {
     acc += vec3(abs(b.x), b.y, b.z) * (c / max(d2, u_vpl_clamp2));
   }
   gi = diffuse * acc / PI;
+#ifdef AMBIENT
+  // A uniform environment (USD DomeLight) of radiance L: a Lambertian surface reflects diffuse * L (docs/usd.md).
+  gi += diffuse * u_ambient;
+#endif
 #endif
   o_direct = vec4(direct, shadow);
   o_gi = vec4(gi, ao);
@@ -301,8 +306,9 @@ void main() {
 }
 )GLSL";
 
-std::string deferred_fragment(bool direct, bool shadow, bool ssao, bool gi) {
+std::string deferred_fragment(bool direct, bool shadow, bool ssao, bool gi, bool ambient) {
   std::string s = "#version 450 core\n";
+  if (ambient) s += "#define AMBIENT 1\n";
   if (direct) s += "#define TERM_DIRECT 1\n";
   if (shadow) s += "#define TERM_SHADOW 1\n";
   if (ssao) s += "#define TERM_SSAO 1\n";
