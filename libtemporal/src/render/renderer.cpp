@@ -93,7 +93,9 @@ Expected<Fbo> make_fbo(const GlFunctions& gl, int w, int h, const std::vector<GL
   const GLenum status = gl.CheckFramebufferStatus(GL_FRAMEBUFFER);
   gl.BindFramebuffer(GL_FRAMEBUFFER, 0);
   if (status != GL_FRAMEBUFFER_COMPLETE)
-    return Error::internal(std::string("framebuffer ") + name + " is incomplete (status " + std::to_string(status) + ")");
+    return Error::usage(std::string("OpenGL cannot make the ") + std::to_string(w) + "x" + std::to_string(h) + " " + name +
+                        " framebuffer (status " + std::to_string(status) +
+                        "): the image is beyond what llvmpipe can allocate here; reduce --size");
   return f;
 }
 
@@ -119,6 +121,18 @@ struct LightView {
   float texel_world = 0.0f;    // world size of a shadow-map texel near the scene centre
   float rsm_measure = 0.0f;    // directional: world area of an RSM texel; else solid angle of the centre texel
 };
+
+// The instant of frame N at `fps` in microseconds (wrapping after 71 minutes): the key of every random pattern.
+// Rates whose frames share instants (40 Hz frame n, 120 Hz frame 3n) get the same key.
+std::uint32_t instant_key(int frame, double fps) {
+  return std::uint32_t(std::uint64_t(std::llround(double(frame) / fps * 1e6)));
+}
+
+// The index frame_jitter() hashes or walks: random jitter is keyed by the instant; the regular and Halton patterns
+// walk their sequence with the frame number (their order is what makes them regular or low-discrepancy).
+int jitter_frame(JitterMode mode, int frame, std::uint32_t instant) {
+  return mode == JitterMode::Random ? int(instant & 0x7fffffffu) : frame;
+}
 
 }  // namespace
 
@@ -146,7 +160,7 @@ struct Renderer::Impl {
   Status init();
   void set_lights(GLuint program, const FrameState& state) const;
   Status light_maps(const FrameState& state);
-  void select_vpls(int frame, int sample);
+  void select_vpls(std::uint32_t instant, int sample);
   struct View {
     glm::mat4 view{1.0f}, proj{1.0f}, proj_jittered{1.0f}, prev_vp{1.0f};
     glm::vec3 camera_pos{0.0f};
@@ -344,13 +358,13 @@ Status Renderer::Impl::light_maps(const FrameState& state) {
 // carrying its reflected flux times (lit texels / vpl_count), so the sum estimates the whole RSM's
 // one-bounce light without bias. The set changes every frame and every reference sample (seed 000 relies
 // on accumulating this noise over time).
-void Renderer::Impl::select_vpls(int frame, int sample) {
+void Renderer::Impl::select_vpls(std::uint32_t instant, int sample) {
   if (!rsm.fbo) return;
   const int count = rsm_valid.empty() ? 0 : options.payload.vpl_count;
   vpl_scratch.assign(std::size_t(kMaxVpls) * 8, 0.0f);
   const float scale = count > 0 ? float(rsm_valid.size()) / float(count) : 0.0f;
   for (int i = 0; i < count; ++i) {
-    const std::uint32_t r = hash_u32(options.seed, std::uint32_t(frame), std::uint32_t(sample) + 0x5151u, std::uint32_t(i));
+    const std::uint32_t r = hash_u32(options.seed, instant, std::uint32_t(sample) + 0x5151u, std::uint32_t(i));
     const std::size_t t = rsm_valid[r % rsm_valid.size()];
     // Packed as the shader reads it (shaders.cpp, Vpls): (position, n.x), (flux with sign(n.z) on r, n.y).
     float* v = &vpl_scratch[std::size_t(i) * 8];
@@ -630,11 +644,14 @@ Expected<RenderedFrame> Renderer::render(const FrameInput& in) {
   if (payload && (o.payload.shadow || o.payload.gi)) {
     const auto t0 = Clock::now();
     if (auto s = im.light_maps(*in.current); !s) return s.error();
-    im.select_vpls(in.frame, 0);
+    im.select_vpls(instant_key(in.frame, in.fps), 0);
     finish();
     result.timings_ms[kPassLightMaps] = ms_since(t0);
   }
-  const std::uint32_t frame_seed = hash_u32(o.seed, std::uint32_t(in.frame), 0xa0u);
+  // Random patterns (SSAO rotations, VPL sets, random jitter) are keyed by the frame's instant, not its number, so
+  // a 40 Hz frame n and a 120 Hz frame 3n are the same render (docs/conventions.md, "Jitter" and "Noise").
+  const std::uint32_t instant = instant_key(in.frame, in.fps);
+  const std::uint32_t frame_seed = hash_u32(o.seed, instant, 0xa0u);
 
   const Impl::View full = im.make_view(in, w, h, {0.0f, 0.0f});
   if (out.gbuffer) {
@@ -650,7 +667,7 @@ Expected<RenderedFrame> Renderer::render(const FrameInput& in) {
     // The low-resolution payload: a G-buffer rendered at 1/k with this frame's jitter (in low-res pixels,
     // conventions "Jitter"), shaded directly. Its samples are exactly full-res pixel centres for the regular
     // pattern. Textures are read at the full-resolution mip level (LOD bias -log2 k by default, RenderOptions).
-    const glm::vec2 jitter = frame_jitter(o.shade_jitter, in.frame, k, o.seed);
+    const glm::vec2 jitter = frame_jitter(o.shade_jitter, jitter_frame(o.shade_jitter, in.frame, instant), k, o.seed);
     const Impl::View low = im.make_view(in, w / k, h / k, jitter);
     const float lod_bias = o.shade_mip_bias ? *o.shade_mip_bias : -std::log2(float(k));
     const auto t0 = Clock::now();
@@ -666,7 +683,8 @@ Expected<RenderedFrame> Renderer::render(const FrameInput& in) {
   }
   if (out.color) {
     // Colour: the same payload at full resolution, one sample per pixel at the colour jitter (no AA).
-    const glm::vec2 jitter = frame_jitter(o.color_jitter, in.frame, k, o.seed ^ 0xc0104u);
+    const glm::vec2 jitter =
+        frame_jitter(o.color_jitter, jitter_frame(o.color_jitter, in.frame, instant), k, o.seed ^ 0xc0104u);
     const Impl::View view = im.make_view(in, w, h, jitter);
     const auto t0 = Clock::now();
     im.draw_gbuffer(im.gbuffer_full, view);
@@ -691,9 +709,9 @@ Expected<RenderedFrame> Renderer::render(const FrameInput& in) {
       const auto i = std::uint32_t(s + 1);
       const glm::vec2 jitter(radical_inverse(i, 2) - 0.5f, radical_inverse(i, 3) - 0.5f);
       const Impl::View view = im.make_view(in, w, h, jitter);
-      if (s > 0 && im.rsm.fbo) im.select_vpls(in.frame, s);
+      if (s > 0 && im.rsm.fbo) im.select_vpls(instant, s);
       im.draw_gbuffer(im.gbuffer_full, view);
-      im.shade(im.gbuffer_full, im.shade_full, view, hash_u32(o.seed, std::uint32_t(in.frame), 0xbeefu, i), true,
+      im.shade(im.gbuffer_full, im.shade_full, view, hash_u32(o.seed, instant, 0xbeefu, i), true,
                s == 0);
     }
     finish();

@@ -2,6 +2,8 @@
 #include "temporal/render/replay.h"
 
 #include <cmath>
+
+#include <glm/matrix.hpp>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -32,6 +34,13 @@ Status validate(const ReplayOptions& options) {
     return Error::usage("--compression dwaa is lossy on data layers: use zip, piz or none");
   if (options.frames && options.frames->first < 0) return Error::usage("--frames must not be negative");
   if (options.frames && options.duration_s > 0.0) return Error::usage("give --frames or --duration, not both");
+  if (!(options.fps <= 10000.0)) return Error::usage("--fps must be at most 10000");
+  // Bounded so that a typing error (inf, 1e30) cannot start a render of 2^31 frames: at most a million frames.
+  if (!(options.duration_s >= 0.0) || !(options.duration_s * options.fps <= 1e6))
+    return Error::usage("--duration must be between 0 and 1e6 / fps seconds (a million frames); got " +
+                        std::to_string(options.duration_s));
+  if (options.frames && options.frames->count() > 1'000'000)
+    return Error::usage("--frames covers more than a million frames: render it in parts");
   return {};
 }
 
@@ -40,6 +49,21 @@ FrameRange replay_frames(const Scene& scene, const ReplayOptions& options) {
 }
 
 namespace {
+
+// A camera whose transform is singular (a node scaled by 0) or not finite has no view: every pixel would be NaN.
+Status check_camera(const FrameState& state, int frame, double fps) {
+  const glm::mat4& v = state.camera.view;
+  const CameraState& cam = state.camera;
+  bool finite = std::isfinite(cam.yfov) && std::isfinite(cam.znear) && std::isfinite(cam.zfar) && cam.yfov > 0.0f &&
+                cam.znear > 0.0f && cam.zfar > cam.znear;
+  for (int c = 0; c < 4; ++c)
+    for (int r = 0; r < 4; ++r) finite = finite && std::isfinite(v[c][r]);
+  const float det = glm::determinant(glm::mat3(v));
+  if (finite && std::abs(det) > 1e-12f) return {};
+  return Error::input({}, "the camera's transform at frame " + std::to_string(frame) + " (t = " + std::to_string(frame / fps) +
+                              " s) is " + (finite ? "singular (a camera node scaled by 0?)" : "not finite") +
+                              ": fix the scene's camera, or pass --camera-path orbit|dolly for an automatic one");
+}
 
 std::string frame_path(const std::string& dir, const char* name, int frame) {
   char buf[32];
@@ -120,7 +144,10 @@ Status replay(const Scene& scene, const RenderOptions& render, const ReplayOptio
     in.fps = options.fps;
     in.current = &current;
     in.previous = previous ? &*previous : nullptr;
-    in.camera_cut = frame == range.first;
+    // Only frame 0 starts the sequence: a render of frames A-B (a shard of a longer sequence, docs/pipelines.md)
+    // evaluates frame A - 1 for its motion and gives exactly the files of a single run over 0-B, headers included.
+    in.camera_cut = frame == 0;
+    if (Status s = check_camera(current, frame, options.fps); !s) return s;
     auto rendered = renderer->render(in);
     if (!rendered) return rendered.error();
     if (auto s = write_outputs(*rendered, options, frame); !s) return s;

@@ -166,7 +166,7 @@ layout(binding = 3) uniform sampler2DShadow u_shadow_map;
 layout(std140, binding = 0) uniform Vpls { vec4 vpl_data[2 * MAX_VPLS]; };
 layout(location = 0) out vec4 o_direct;  // rgb direct, a shadow
 layout(location = 1) out vec4 o_gi;      // rgb gi, a ssao
-layout(location = 2) out vec4 o_sum;     // rgb direct * shadow + gi * ssao
+layout(location = 2) out vec4 o_sum;     // rgb direct * shadow + gi * ssao (shadow * ssao without direct and gi)
 uniform vec3 u_camera_pos;
 uniform mat4 u_light_vp;       // world -> key light's shadow texture coordinates and depth, [0, 1]
 uniform int u_pcf;             // PCF kernel N (N x N taps)
@@ -302,7 +302,13 @@ void main() {
 #endif
   o_direct = vec4(direct, shadow);
   o_gi = vec4(gi, ao);
+#if defined(TERM_DIRECT) || defined(TERM_GI)
   o_sum = vec4(direct * shadow + gi * ao, 0.0);
+#else
+  // Neither radiance term: the sum is the visibility terms themselves, as grey, so that R,G,B is never an
+  // all-zero image that every method reproduces "perfectly" (docs/render-gbuffer.md, Outputs).
+  o_sum = vec4(vec3(shadow * ao), 0.0);
+#endif
 }
 )GLSL";
 

@@ -34,8 +34,11 @@ std::string one_line(std::string s) {
   return s;
 }
 
+// A decimal index of at most 9 digits (a longer number cannot be an index, and would overflow std::stoul): such
+// a name is then looked up as a name and refused as unknown.
 bool is_index(const std::string& s) {
-  return !s.empty() && std::all_of(s.begin(), s.end(), [](unsigned char c) { return std::isdigit(c) != 0; });
+  return !s.empty() && s.size() <= 9 &&
+         std::all_of(s.begin(), s.end(), [](unsigned char c) { return std::isdigit(c) != 0; });
 }
 
 std::string join(const std::vector<std::string>& v) {

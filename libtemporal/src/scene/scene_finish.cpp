@@ -15,8 +15,11 @@ namespace {
 
 using scene_detail::Impl;
 
+// A decimal index of at most 9 digits (a longer number cannot be an index, and would overflow std::stoul): such
+// a name is then looked up as a name and refused as unknown.
 bool is_index(const std::string& s) {
-  return !s.empty() && std::all_of(s.begin(), s.end(), [](unsigned char c) { return std::isdigit(c) != 0; });
+  return !s.empty() && s.size() <= 9 &&
+         std::all_of(s.begin(), s.end(), [](unsigned char c) { return std::isdigit(c) != 0; });
 }
 
 std::string join(const std::vector<std::string>& v) {
@@ -69,6 +72,20 @@ Status Scene::finish(const SceneLoadOptions& options) {
   Impl& impl = *impl_;
   const std::string& path = impl.file;
   if (impl.draws.empty()) return Error::input(path, "the scene has no triangles to draw");
+  // Vertex data that is not finite would put NaN into every output that sees the surface (albedo, colour,
+  // payload, reference): a malformed scene, refused whichever format it came from.
+  for (std::size_t i = 0; i < impl.primitives.size(); ++i) {
+    const ScenePrimitive& p = impl.primitives[i];
+    auto finite3 = [](const glm::vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); };
+    auto finite2 = [](const glm::vec2& v) { return std::isfinite(v.x) && std::isfinite(v.y); };
+    const char* bad = !std::all_of(p.positions.begin(), p.positions.end(), finite3)   ? "positions"
+                      : !std::all_of(p.normals.begin(), p.normals.end(), finite3)     ? "normals"
+                      : !std::all_of(p.texcoords.begin(), p.texcoords.end(), finite2) ? "texture coordinates"
+                                                                                      : nullptr;
+    if (bad)
+      return Error::input(path, "primitive " + std::to_string(i) + " has " + bad + " that hold NaN or infinite values: "
+                                    "the file is malformed; re-export it");
+  }
   compute_bounds(*this, impl);
   const glm::vec3 center = 0.5f * (impl.bounds_min + impl.bounds_max);
   const float radius = std::max(0.5f * glm::length(impl.bounds_max - impl.bounds_min), 1e-3f);
