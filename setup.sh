@@ -15,6 +15,7 @@ PACKAGES=(
   libvtk9-dev xvfb xauth
   libtbb-dev libcli11-dev libfmt-dev
   libgtest-dev libgmock-dev libbenchmark-dev
+  ffmpeg fonts-dejavu-core chromium
 )
 
 say() { printf 'setup.sh: %s\n' "$*" >&2; }
