@@ -99,28 +99,27 @@ void write_sequences(const fs::path& dir) {
   }
 }
 
+// Each test writes its own sequences into its own folder: CTest runs the tests of this file as parallel processes.
 class Report : public ::testing::Test {
  protected:
-  static void SetUpTestSuite() {
-    dir_ = new fs::path(test::scratch_dir("report-sequences"));
-    write_sequences(*dir_);
+  void SetUp() override {
+    dir = test::scratch_dir(std::string("report-") + ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    write_sequences(dir);
   }
-  static void TearDownTestSuite() { delete dir_; }
   ComparisonSetup setup(std::vector<std::string> tests, std::vector<std::string> names) const {
     ComparisonSetup s;
-    s.reference = (*dir_ / "ref.####.exr").string();
-    for (const auto& t : tests) s.tests.push_back((*dir_ / (t + ".####.exr")).string());
+    s.reference = (dir / "ref.####.exr").string();
+    for (const auto& t : tests) s.tests.push_back((dir / (t + ".####.exr")).string());
     s.names = std::move(names);
-    s.gbuffer = (*dir_ / "g.####.exr").string();
+    s.gbuffer = (dir / "g.####.exr").string();
     return s;
   }
   int run(const std::string& args, std::string* out = nullptr) const {
-    return test::run_command("cd " + dir_->string() + " && env -u DISPLAY " + test::tool_path("compare").string() + " " + args,
+    return test::run_command("cd " + dir.string() + " && env -u DISPLAY " + test::tool_path("compare").string() + " " + args,
                              out);
   }
-  static fs::path* dir_;
+  fs::path dir;
 };
-fs::path* Report::dir_ = nullptr;
 
 // --- The engine's frame observer -----------------------------------------------------------------------------
 
@@ -188,7 +187,7 @@ TEST(ComputeKind, FromTheHeadersToolAndAttributes) {
 // at their largest possible value; the speed chart plots only the methods' own compute time: not the render time
 // of a render-gbuffer input (filter-phlm's 61 ms "input") nor the simulation time of morph-120hz --perceive.
 TEST_F(Report, ChartsHaveTitlesNamesRangesAndOnlyMethodTimes) {
-  ComparisonSetup s = setup({"good", "noisy", "input", "perceived"}, {"phlm", "taa", "input", "perceived"});
+  ComparisonSetup s = setup({"input", "good", "noisy", "perceived"}, {"input", "phlm", "taa", "perceived"});
   s.flip = FlipMode::Ldr;
   auto r = compare_sequences(s);
   ASSERT_TRUE(r) << r.error().message;
@@ -213,12 +212,15 @@ TEST_F(Report, ChartsHaveTitlesNamesRangesAndOnlyMethodTimes) {
       EXPECT_EQ(chart.series[1].name, "taa");
       EXPECT_DOUBLE_EQ(chart.series[0].x[0], 5.0);
       EXPECT_DOUBLE_EQ(chart.series[1].x[0], 2.0);
+      EXPECT_EQ(chart.series[0].color, 1);  // phlm and taa keep their colours of the other charts
+      EXPECT_EQ(chart.series[1].color, 2);
       EXPECT_NE(chart.x_label.find("ms"), std::string::npos);
       continue;
     }
     ASSERT_EQ(chart.series.size(), 4u) << f;
-    EXPECT_EQ(chart.series[0].name, "phlm");
+    EXPECT_EQ(chart.series[1].name, "phlm");
     EXPECT_EQ(chart.series[3].name, "perceived");
+    EXPECT_EQ(chart.series[1].color, 1);
     if (f == "p-ssim.png") {
       EXPECT_LE(y.high, 1.0) << "the SSIM axis runs past 1";
       EXPECT_DOUBLE_EQ(y.high, 1.0);  // the best SSIM (~0.999) plus the margin reaches the cap
@@ -237,10 +239,10 @@ TEST_F(Report, ChartsHaveTitlesNamesRangesAndOnlyMethodTimes) {
   const auto json_path = test::scratch_dir("report-json") / "m.json";
   ASSERT_TRUE(write_comparison_json(*r, {}, {}, "compare", "", json_path.string()));
   const auto j = nlohmann::json::parse(read_text(json_path));
-  EXPECT_EQ(j["sequences"][0]["compute_kind"], "method");
-  EXPECT_EQ(j["sequences"][2]["compute_kind"], "render");
+  EXPECT_EQ(j["sequences"][1]["compute_kind"], "method");
+  EXPECT_EQ(j["sequences"][0]["compute_kind"], "render");
   EXPECT_EQ(j["sequences"][3]["compute_kind"], "simulation");
-  EXPECT_EQ(j["sequences"][2]["tool"], "render-gbuffer 0.1.0");
+  EXPECT_EQ(j["sequences"][0]["tool"], "render-gbuffer 0.1.0");
 }
 
 TEST(ChartRange, HandValues) {
@@ -288,7 +290,7 @@ TEST_F(Report, PlotWritesPngSvgOrPdfByExtensionAndRefusesOthers) {
   ASSERT_EQ(run(base + "--plot charts/fig.pdf", &out), 0) << out;
   ASSERT_EQ(run(base + "--plot charts/fig.svg", &out), 0) << out;
   ASSERT_EQ(run(base + "--plot charts/fig.png", &out), 0) << out;
-  const fs::path d = *dir_ / "charts";
+  const fs::path d = dir / "charts";
   for (const char* stem : {"fig", "fig-psnr-y", "fig-ssim", "fig-flicker", "fig-speed"}) {
     const std::string pdf = read_text(d / (std::string(stem) + ".pdf"));
     EXPECT_EQ(pdf.rfind("%PDF-", 0), 0u) << stem << ".pdf is not a PDF";
@@ -306,7 +308,7 @@ TEST_F(Report, PlotWritesPngSvgOrPdfByExtensionAndRefusesOthers) {
   for (const std::string bad : {"--plot fig.jpg", "--plot fig", "--plot fig.eps"}) {
     EXPECT_EQ(run(base + bad + " --csv never.csv", &out), 1) << bad << "\n" << out;
     EXPECT_NE(out.find(".png, .svg or .pdf"), std::string::npos) << out;
-    EXPECT_FALSE(fs::exists(*dir_ / "never.csv")) << "the run went ahead after a refused --plot";
+    EXPECT_FALSE(fs::exists(dir / "never.csv")) << "the run went ahead after a refused --plot";
   }
   for (const auto& e : fs::directory_iterator(d)) EXPECT_EQ(e.path().filename().string().find(".tmp"), std::string::npos);
 }
@@ -318,7 +320,7 @@ TEST_F(Report, PlotWritesPngSvgOrPdfByExtensionAndRefusesOthers) {
 TEST_F(Report, ProgressLineIsErasedBeforeTheTable) {
   if (test::run_command("command -v script >/dev/null") != 0) GTEST_SKIP() << "script (util-linux) is not installed";
   std::string out;
-  ASSERT_EQ(test::run_command("cd " + dir_->string() + " && script -qec '" + test::tool_path("compare").string() +
+  ASSERT_EQ(test::run_command("cd " + dir.string() + " && script -qec '" + test::tool_path("compare").string() +
                                   " --reference ref.####.exr good.####.exr noisy.####.exr' /dev/null",
                               &out),
             0)
@@ -340,7 +342,7 @@ TEST_F(Report, PngWritesEveryFrameAndTheSheet) {
                 &out),
             0)
       << out;
-  const fs::path d = *dir_ / "png";
+  const fs::path d = dir / "png";
   for (int f = 1; f <= 3; ++f) {
     char n[8];
     std::snprintf(n, sizeof n, "%04d", f);
@@ -373,14 +375,14 @@ TEST_F(Report, PngWritesEveryFrameAndTheSheet) {
 
 // No output of the pictures replaces an input: a test sequence that lives where the report writes its maps.
 TEST_F(Report, ReportRefusesToReplaceAnInput) {
-  fs::create_directories(*dir_ / "clash" / "maps");
-  for (int f = 0; f < 6; ++f) fs::copy_file(*dir_ / frame_name("good", f), *dir_ / "clash" / "maps" / frame_name("phlm", f),
+  fs::create_directories(dir / "clash" / "maps");
+  for (int f = 0; f < 6; ++f) fs::copy_file(dir / frame_name("good", f), dir / "clash" / "maps" / frame_name("phlm", f),
                                             fs::copy_options::overwrite_existing);
-  const std::string before = read_text(*dir_ / "clash" / "maps" / "phlm.0005.exr");
+  const std::string before = read_text(dir / "clash" / "maps" / "phlm.0005.exr");
   std::string out;
   EXPECT_EQ(run("--reference ref.####.exr clash/maps/phlm.####.exr --names phlm --report clash", &out), 1) << out;
   EXPECT_NE(out.find("one of this run's inputs"), std::string::npos) << out;
-  EXPECT_EQ(read_text(*dir_ / "clash" / "maps" / "phlm.0005.exr"), before);
+  EXPECT_EQ(read_text(dir / "clash" / "maps" / "phlm.0005.exr"), before);
 }
 
 // Every file the page names exists; links point to EXRs; nothing comes from a network; the tables hold the JSON's
@@ -392,7 +394,7 @@ TEST_F(Report, ReportPageIsCompleteAndOffline) {
                 &out),
             0)
       << out;
-  const fs::path d = *dir_ / "rep";
+  const fs::path d = dir / "rep";
   const std::string html = read_text(d / "index.html");
   ASSERT_FALSE(html.empty());
   EXPECT_EQ(html.find("http://"), std::string::npos);
@@ -467,8 +469,8 @@ TEST_F(Report, ChromiumRendersTheReport) {
                 &out),
             0)
       << out;
-  const fs::path page = fs::canonical(*dir_ / "browser" / "index.html");
-  const fs::path shot = *dir_ / "browser-screenshot.png";
+  const fs::path page = fs::canonical(dir / "browser" / "index.html");
+  const fs::path shot = dir / "browser-screenshot.png";
   const fs::path profile = test::scratch_dir("report-chromium-profile");
   // As root Chromium needs --no-sandbox; --disable-gpu and an empty profile keep it headless and quiet here.
   const std::string flags = " --headless --no-sandbox --disable-gpu --disable-dev-shm-usage --hide-scrollbars "

@@ -130,7 +130,8 @@ Status write_chart(const Chart& chart, const std::string& path) {
     vtkPlot* plot = xy->AddPlot(chart.style == ChartStyle::Lines ? vtkChart::LINE : vtkChart::POINTS);
     plot->SetInputData(table, 0, 1);
     plot->SetLabel(ys->GetName());
-    const auto* c = kPalette[s % (sizeof kPalette / sizeof kPalette[0])];
+    const std::size_t entry = series.color >= 0 ? std::size_t(series.color) : s;
+    const auto* c = kPalette[entry % (sizeof kPalette / sizeof kPalette[0])];
     plot->SetColor(c[0], c[1], c[2], 255);
     plot->SetWidth(chart.style == ChartStyle::Lines ? 2.0f : 1.0f);
     if (auto* points = vtkPlotPoints::SafeDownCast(plot)) {

@@ -47,9 +47,11 @@ std::vector<std::pair<std::string, Chart>> comparison_charts(const ComparisonRep
     c.y_lowest = d->chart.lowest;
     c.y_highest = d->chart.highest;
     bool any = false;
-    for (const auto& s : report.sequences) {
+    for (std::size_t i = 0; i < report.sequences.size(); ++i) {
+      const SequenceReport& s = report.sequences[i];
       ChartSeries series;
       series.name = s.name;
+      series.color = int(i);
       for (const auto& f : s.frames) {
         const double v = f.value(name);
         series.x.push_back(f.frame);
@@ -69,12 +71,13 @@ std::vector<std::pair<std::string, Chart>> comparison_charts(const ComparisonRep
   speed.x_label = "method compute time per frame (ms, temporal:computeMs, I/O excluded)";
   speed.y_label = "mean PSNR (" + report.layer + ", dB)";
   speed.style = ChartStyle::Points;
-  for (const auto& s : report.sequences) {
+  for (std::size_t i = 0; i < report.sequences.size(); ++i) {
+    const SequenceReport& s = report.sequences[i];
     if (s.compute_kind != ComputeKind::Method) continue;
     const auto ms = mean_compute_ms(s);
     const auto psnr = summarize(s, "psnr_rgb");
     if (!ms || !psnr.count || !std::isfinite(psnr.mean)) continue;
-    speed.series.push_back({s.name, {*ms}, {psnr.mean}});
+    speed.series.push_back({s.name, {*ms}, {psnr.mean}, int(i)});  // the colour it has in the other charts
   }
   if (!speed.series.empty()) charts.emplace_back(stem + "-speed" + ext, std::move(speed));
   return charts;

@@ -21,6 +21,7 @@ struct ChartSeries {
   std::string name;  // legend entry
   std::vector<double> x;
   std::vector<double> y;
+  int color = -1;    // palette entry (Tableau 10); -1: the series' position. A method keeps its colour across charts
 };
 
 enum class ChartStyle {
