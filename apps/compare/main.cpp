@@ -29,8 +29,13 @@ int main(int argc, char** argv) {
   ComparisonSetup setup;
   std::string csv, json, plot, frames, peak = "1";
   std::string fail_on = "mean";
-  app.add_option("--reference", setup.reference, "Reference sequence, e.g. ref.####.exr")->required();
-  app.add_option("tests", setup.tests, "Test sequences (one or more), e.g. taa.####.exr phlm.####.exr")->required();
+  std::vector<std::string> merge;
+  app.add_option("--reference", setup.reference, "Reference sequence, e.g. ref.####.exr (not with --merge)");
+  app.add_option("tests", setup.tests, "Test sequences (one or more), e.g. taa.####.exr phlm.####.exr");
+  app.add_option("--merge", merge,
+                 "Instead of comparing: merge per-shard CSVs of one comparison (disjoint --frames ranges) into "
+                 "--csv/--json/--plot; the means and intervals equal a single run's exactly")
+      ->excludes("--reference");
   app.add_option("--names", setup.names, "Comma-separated names of the test sequences (default: file names)")
       ->delimiter(',')->default_str("");
   app.add_option("--csv", csv, "Per-frame metrics CSV to write");
@@ -50,6 +55,9 @@ int main(int argc, char** argv) {
                  "Folder for error-map EXRs NAME.####.exr (error.R/G/B/Y, error.ssim, error.flicker, error.flip "
                  "with --flip, error.invalid)");
   app.add_option("--frames", frames, "Frames A-B (default: every reference frame on disk)");
+  app.add_option("--warmup", setup.warmup_frames,
+                 "The first N frames are summarised apart from the steady state (JSON `warmup`, `steady`)")
+      ->check(CLI::Range(0, 1000000));
   app.add_option("--peak", peak,
                  "Peak value L for PSNR and SSIM, in pixel units; `max` = idiff's rule per frame (largest value, "
                  "at least 1)");
@@ -72,6 +80,9 @@ int main(int argc, char** argv) {
     app.add_option("--fail-" + d.threshold_option, fail[d.name], d.threshold_help);
     fail_list += (fail_list.empty() ? "--fail-" : ", --fail-") + d.threshold_option;
   }
+  bool fail_nonfinite = false;
+  app.add_flag("--fail-nonfinite", fail_nonfinite,
+               "Exit 3 when a test frame holds NaN/Inf pixels or values whose squared error overflows (PSNR -inf)");
   app.add_option("--fail-on", fail_on, "What the thresholds judge: each sequence's mean over frames, or its worst frame")
       ->check(CLI::IsMember({"mean", "worst"}));
   app.footer("Exit codes: 0 success (thresholds passed), 1 usage error, 2 input error (missing, corrupt or mismatched "
@@ -99,19 +110,25 @@ int main(int argc, char** argv) {
     setup.parameters = tool.command_line();
     Thresholds thresholds;
     thresholds.worst_frame = fail_on == "worst";
+    thresholds.nonfinite = fail_nonfinite;
     for (const auto& [metric, limit] : fail)
       if (limit) thresholds.limits[metric] = *limit;
     if (auto st = check_threshold_setup(setup, thresholds); !st) return st;
 
-    ComparisonHooks hooks;
-    std::optional<tool::Progress> progress;
-    hooks.frame_done = [&](int frame, int, int total) {
-      if (!progress) progress.emplace("compare", total);
-      progress->step(frame);
-    };
-    hooks.warning = [&](const std::string& file, const std::string& text) { tool.print_warning(file, text); };
-    hooks.log = [&](const std::string& text) { tool.log(text); };
-    auto report = compare_sequences(setup, hooks);
+    if (merge.empty() && (setup.reference.empty() || setup.tests.empty()))
+      return Error::usage("give --reference REF.####.exr and at least one test sequence (or --merge A.csv B.csv ...)");
+    // No output may replace a file this run reads (error maps are checked by the engine).
+    ProtectedInputs inputs;
+    if (merge.empty()) {
+      auto found = comparison_inputs(setup);
+      if (!found) return found.error();
+      inputs = std::move(*found);
+    }
+    for (const auto& m : merge) inputs.add(m);
+    for (const auto& [path, option] : {std::pair{csv, "--csv"}, std::pair{json, "--json"}, std::pair{plot, "--plot"}})
+      if (!path.empty())
+        if (auto st = inputs.check(path, option); !st) return st;
+    auto report = merge.empty() ? compare_sequences(setup, tool.hooks()) : merge_comparison_csvs(merge, setup);
     if (!report) return report.error();
     const auto failures = check_thresholds(*report, thresholds);
 
@@ -133,6 +150,7 @@ int main(int argc, char** argv) {
       } else {
         if (display->started()) tool.log("DISPLAY is not usable: started Xvfb on " + display->display() + " for the plots");
         for (const auto& [path, chart] : comparison_charts(*report, plot)) {
+          if (auto st = inputs.check(path, "--plot"); !st) return st;
           keep(write_chart_png(chart, path));
           tool.log("wrote " + path);
         }

@@ -72,8 +72,13 @@ strip_csv() {
 import csv, sys
 rows = list(csv.reader(open(sys.argv[1])))
 keep = [i for i, h in enumerate(rows[0]) if not (h.endswith("_ms") or h.startswith("ms_") or h == "metrics_ms")]
+def norm(x):  # 8 significant digits: compare wrote %.8g before it wrote round-trip digits
+    try:
+        return x if x in ("", "inf", "-inf") else "%.8g" % float(x)
+    except ValueError:
+        return x
 for r in rows:
-    print(",".join(r[i] for i in keep if i < len(r)))
+    print(",".join(norm(r[i]) for i in keep if i < len(r)))
 PY
 }
 

@@ -12,6 +12,7 @@
 #include <array>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <random>
 #include <sstream>
 
@@ -224,6 +225,81 @@ TEST_F(CompareCli, HelpListsEveryOptionAndEachIsAccepted) {
   auto maps = read_exr((dir_ / "maps" / "one.0002.exr").string());
   ASSERT_TRUE(maps) << maps.error().message;
   EXPECT_NE(maps->plane("error.flip"), nullptr);
+}
+
+// Issue 11: no output replaces an input (exit 1, nothing changed), overflowing values are reported and can fail
+// the run, non-finite thresholds are usage errors; and the JSON carries intervals and paired differences.
+TEST_F(CompareCli, BadRunsLoseNothingAndOverflowIsReported) {
+  auto checksum = [&] {
+    std::string all;
+    for (const char* f : {"ref.0001.exr", "a.0001.exr", "a.0002.exr", "b.0003.exr", "g.0001.exr"}) all += read_text(dir_ / f);
+    return std::hash<std::string>{}(all);
+  };
+  const auto before = checksum();
+  std::string out;
+  for (const std::string args : {"--csv ref.0001.exr", "--json a.0002.exr", "--plot a.0003.exr",
+                                 "--error-maps . --names a", "--error-maps ./ --names x,b"}) {
+    const std::string tests = args.find("x,b") != std::string::npos ? " a.####.exr b.####.exr" : " a.####.exr";
+    EXPECT_EQ(run("--reference ref.####.exr" + tests + " --gbuffer g.####.exr " + args, &out), 1) << args << out;
+    EXPECT_NE(out.find("one of this run's inputs"), std::string::npos) << out;
+  }
+  EXPECT_EQ(run("--reference ref.####.exr a.####.exr --fail-psnr nan", &out), 1) << out;
+  EXPECT_EQ(checksum(), before);
+  // A broken output with huge finite values: PSNR -inf, said per frame; --fail-nonfinite turns it into exit 3.
+  auto a2 = read_exr((dir_ / "a.0002.exr").string());
+  ASSERT_TRUE(a2);
+  a2->plane("G")[100] = 1e30f;
+  ASSERT_TRUE(write_exr((dir_ / "c.0001.exr").string(), *a2));
+  ASSERT_TRUE(write_exr((dir_ / "c.0002.exr").string(), *a2));
+  ASSERT_TRUE(write_exr((dir_ / "c.0003.exr").string(), *a2));
+  EXPECT_EQ(run("--reference ref.####.exr c.####.exr", &out), 0) << out;
+  EXPECT_NE(out.find("is -inf"), std::string::npos) << out;
+  EXPECT_EQ(run("--reference ref.####.exr c.####.exr --fail-nonfinite", &out), 3) << out;
+  EXPECT_NE(out.find("3 frames"), std::string::npos) << out;
+  // Intervals and paired differences in the JSON.
+  ASSERT_EQ(run("--reference ref.####.exr a.####.exr b.####.exr --warmup 1 --json s.json", &out), 0) << out;
+  const auto j = nlohmann::json::parse(read_text(dir_ / "s.json"));
+  const auto& psnr = j["sequences"][0]["psnr_rgb"];
+  ASSERT_TRUE(psnr["ci95"].is_array());
+  EXPECT_LE(psnr["ci95"][0].get<double>(), psnr["mean"].get<double>());
+  EXPECT_GE(psnr["ci95"][1].get<double>(), psnr["mean"].get<double>());
+  EXPECT_EQ(psnr["steady"]["frames"].get<int>(), 2);
+  bool found = false;
+  for (const auto& p : j["paired"])
+    if (p["a"] == "a" && p["b"] == "b" && p["metric"] == "psnr_rgb") {
+      found = true;
+      EXPECT_GT(p["mean_difference"].get<double>(), 5.0);  // noise 0.02 against 0.1: about 14 dB apart
+      EXPECT_GT(p["ci95"][0].get<double>(), 0.0);
+    }
+  EXPECT_TRUE(found);
+}
+
+// Issue 14: a comparison run as shards (disjoint --frames ranges) and merged gives exactly the single run's
+// means and intervals; each shard primes its first frame's flicker from the frame before it.
+TEST_F(CompareCli, ShardsMergeIntoTheSingleRunExactly) {
+  std::string out;
+  const std::string common = "--reference ref.####.exr a.####.exr b.####.exr --gbuffer g.####.exr --warmup 1";
+  ASSERT_EQ(run(common + " --json whole.json --csv whole.csv", &out), 0) << out;
+  ASSERT_EQ(run(common + " --frames 1-1 --csv s1.csv", &out), 0) << out;
+  ASSERT_EQ(run(common + " --frames 2-3 --csv s2.csv", &out), 0) << out;
+  const auto s2 = read_text(dir_ / "s2.csv");  // shown when a mean differs
+  ASSERT_EQ(run("--merge s2.csv s1.csv --warmup 1 --json merged.json --csv merged.csv", &out), 0) << out;
+  const auto whole = nlohmann::json::parse(read_text(dir_ / "whole.json"));
+  const auto merged = nlohmann::json::parse(read_text(dir_ / "merged.json"));
+  ASSERT_EQ(whole["sequences"].size(), merged["sequences"].size());
+  for (std::size_t s = 0; s < whole["sequences"].size(); ++s)
+    for (const char* m : {"psnr_rgb", "psnr_y", "ssim", "flicker"}) {
+      const auto& w = whole["sequences"][s][m];
+      const auto& g = merged["sequences"][s][m];
+      EXPECT_EQ(w["frames"], g["frames"]) << m;
+      EXPECT_EQ(w["mean"], g["mean"]) << m << " " << s2;  // exactly, not approximately
+      EXPECT_EQ(w["ci95"], g["ci95"]) << m;
+      EXPECT_EQ(w["steady"], g["steady"]) << m;
+    }
+  EXPECT_EQ(whole["paired"], merged["paired"]);
+  // Overlapping shards are refused.
+  EXPECT_EQ(run("--merge s1.csv whole.csv --json x.json", &out), 2) << out;
+  EXPECT_NE(out.find("two shards"), std::string::npos) << out;
 }
 
 }  // namespace

@@ -95,26 +95,6 @@ Expected<Plan> make_plan(const SequenceOptions& o, const StageInputs& needs) {
   return plan;
 }
 
-// The files a run reads, by identity (device and inode), so that no output ever replaces one of them.
-class InputFiles {
- public:
-  void add(const std::string& path) {
-    struct stat st {};
-    if (::stat(path.c_str(), &st) == 0) ids_.insert({st.st_dev, st.st_ino});
-  }
-  // Usage error when `path` exists and is one of the inputs (same file by device and inode, which also
-  // catches another spelling of the same path, a hard link or a symbolic link).
-  Status check(const std::string& path, const char* what) const {
-    struct stat st {};
-    if (::stat(path.c_str(), &st) != 0 || !ids_.count({st.st_dev, st.st_ino})) return Status::ok();
-    return Error::usage(std::string(what) + " '" + path + "' is one of this run's inputs: writing it would destroy "
-                        "data not read yet; choose another output folder or name");
-  }
-
- private:
-  std::set<std::pair<dev_t, ino_t>> ids_;
-};
-
 // The G-buffer layers to read (selection for read_exr).
 std::vector<std::string> gbuffer_selection(const StageInputs& needs) {
   std::vector<std::string> layers;
@@ -170,7 +150,7 @@ Status check_gbuffer_size(const Image& g, const Image& input, const StageInputs&
                                  " per axis (full = k * low)");
 }
 
-Status write_state(const Plan& plan, const FrameStage& stage, const RunIdentity& id, int frame, const InputFiles& inputs) {
+Status write_state(const Plan& plan, const FrameStage& stage, const RunIdentity& id, int frame, const ProtectedInputs& inputs) {
   if (Status s = inputs.check(plan.state_out->path(frame), "--state-out"); !s) return s;
   auto state = stage.save_state();
   if (!state) return state.error();
@@ -182,6 +162,19 @@ Status write_state(const Plan& plan, const FrameStage& stage, const RunIdentity&
 }
 
 }  // namespace
+
+void ProtectedInputs::add(const std::string& path) {
+  struct stat st {};
+  if (::stat(path.c_str(), &st) == 0) ids_.insert({std::uint64_t(st.st_dev), std::uint64_t(st.st_ino)});
+}
+
+Status ProtectedInputs::check(const std::string& path, const std::string& what) const {
+  struct stat st {};
+  if (::stat(path.c_str(), &st) != 0 || !ids_.count({std::uint64_t(st.st_dev), std::uint64_t(st.st_ino)}))
+    return Status::ok();
+  return Error::usage(what + " '" + path + "' is one of this run's inputs: writing it would destroy data not read "
+                      "yet; choose another output folder or name");
+}
 
 Expected<ExrCompression> parse_data_compression(const std::string& name) {
   auto c = parse_compression(name);
@@ -254,7 +247,7 @@ Expected<RunSummary> run_sequence(const SequenceOptions& options, FrameStage& st
 
   // Every file the run reads: no output may replace one of them (an output pattern equal to an input pattern,
   // another spelling of it, or a link to it).
-  InputFiles inputs;
+  ProtectedInputs inputs;
   for (const int f : plan->frames) {
     inputs.add(plan->input.path(f));
     for (int k = 1; k <= needs.lookahead; ++k) inputs.add(plan->input.path(f + k));

@@ -80,19 +80,30 @@ class Run {
 
   Expected<ComparisonReport> run() {
     if (auto st = open(); !st) return st.error();
-    for (std::size_t fi = 0; fi < report_.frames.size(); ++fi) {
-      const int frame = report_.frames[fi];
+    // A range that starts after the first frame on disk (a shard of a longer sequence) first reads the frame
+    // before it, without reporting it: the first compared frame then gets the flicker value a single run over the
+    // whole sequence gives it, and per-shard results merge exactly (docs/compare.md, "Shards").
+    std::vector<int> order = report_.frames;
+    const bool prime = setup_.frames && previous_frame_exists(report_.frames.front() - 1);
+    if (prime) order.insert(order.begin(), report_.frames.front() - 1);
+    for (std::size_t fi = 0; fi < order.size(); ++fi) {
+      const int frame = order[fi];
+      priming_ = prime && fi == 0;
       if (auto st = reference_frame(fi, frame); !st) return st.error();
-      for (auto& t : tests_)
+      for (auto& t : tests_) {
         if (auto st = test_frame(t, fi, frame); !st) return st.error();
-      if (ref_invalid_)
+        if (priming_) t.report.frames.pop_back();  // history only
+      }
+      if (ref_invalid_ && !priming_)
         warn(ref_path_, std::to_string(ref_invalid_) + " pixels hold NaN or Inf; they are excluded from every metric");
       for (std::size_t i = 0; i < n_; ++i)
         if (!ref_valid_[i]) ref_y_[i] = std::numeric_limits<float>::quiet_NaN();
       std::swap(ref_y_, ref_prev_y_);
       ref_has_prev_ = true;
-      if (hooks_.frame_done) hooks_.frame_done(frame, int(fi + 1), int(report_.frames.size()));
+      if (hooks_.frame_done && !priming_)
+        hooks_.frame_done(frame, int(fi + (prime ? 0 : 1)), int(report_.frames.size()));
     }
+    priming_ = false;
     for (auto& t : tests_) report_.sequences.push_back(std::move(t.report));
     return std::move(report_);
   }
@@ -123,6 +134,15 @@ class Run {
   std::optional<SequencePattern> ref_pattern_, gbuf_pattern_;
   std::vector<TestState> tests_;
   bool gbuf_mask_ = false, ref_mask_ = false;
+  ProtectedInputs inputs_;  // every file this comparison reads: no error map may replace one
+  bool priming_ = false;     // this frame only primes the history (the frame before a --frames range)
+  // True when frame `f` of the reference, of every test and of the G-buffer exists on disk.
+  bool previous_frame_exists(int f) const {
+    if (f < 0 || !std::filesystem::exists(ref_pattern_->path(f))) return false;
+    for (const auto& t : tests_)
+      if (!std::filesystem::exists(t.pattern.path(f))) return false;
+    return !gbuf_pattern_ || std::filesystem::exists(gbuf_pattern_->path(f));
+  }
   bool gbuf_geometry_ = false, have_prev_geometry_ = false;  // G-buffer depth and ids for the disocclusion test
   std::vector<float> prev_z_;
   std::vector<std::uint32_t> prev_id_;
@@ -156,6 +176,8 @@ Status Run::open() {
   report_.reference_layer = setup_.reference_layer.empty() ? report_.layer : setup_.reference_layer;
   report_.mask = setup_.mask;
   report_.motion_compensated = !setup_.gbuffer.empty();
+  report_.warmup_frames = setup_.warmup_frames;
+  report_.bootstrap = setup_.bootstrap;
   report_.peak = setup_.peak;
   report_.peak_from_data = setup_.peak_from_data;
   report_.flip = setup_.flip;
@@ -182,6 +204,13 @@ Status Run::open() {
   }
   if (auto st = open_tests(range); !st) return st;
   if (auto st = find_masks(); !st) return st;
+  auto inputs = comparison_inputs(setup_);
+  if (!inputs) return inputs.error();
+  inputs_ = std::move(*inputs);
+  if (!setup_.error_maps.empty())  // before any work: an error map that would replace a frame not read yet
+    for (const auto& t : tests_)
+      for (const int f : report_.frames)
+        if (auto st = inputs_.check(frame_file(setup_.error_maps, t.report.name, f), "--error-maps"); !st) return st;
   ref_sel_ = ExrSelection{{report_.reference_layer}};
   if (ref_mask_) ref_sel_.layers.push_back(setup_.mask);
   gbuf_sel_ = ExrSelection{{"motion"}};
@@ -399,7 +428,7 @@ Status Run::test_frame(TestState& t, std::size_t fi, int frame) {
   if (change) temporal_delta(t.y.data(), t.delta.data(), n_, t.delta.data());  // t.delta held the warped history
 
   std::optional<Image> maps;
-  if (!setup_.error_maps.empty()) maps.emplace(width_, height_);
+  if (!setup_.error_maps.empty() && !priming_) maps.emplace(width_, height_);
   const FrameInputs in = inputs(t, frame, planes, names, mask, m.peak, change, maps ? &*maps : nullptr);
   for (std::size_t k = 0; k < measures_.size(); ++k) {
     MetricSample sample;
@@ -416,6 +445,10 @@ Status Run::test_frame(TestState& t, std::size_t fi, int frame) {
   m.timings_ms = img->metadata().timings_ms;
   if (m.nonfinite_test)
     warn(path, std::to_string(m.nonfinite_test) + " pixels hold NaN or Inf; they are excluded from every metric");
+  for (const auto& sample : m.metrics)
+    if (!sample.values.empty() && std::isinf(sample.values.front()) && sample.values.front() < 0)
+      warn(path, sample.metric + " is -inf: the test holds values so far from the reference that the squared error "
+                                 "overflows (a broken output); --fail-nonfinite makes this a failure");
   if (maps)
     if (auto st = write_maps(*maps, *img, t, path, frame, m); !st) return st;
 
@@ -463,10 +496,34 @@ Status Run::write_maps(Image& maps, const Image& test, const TestState& t, const
   md.extra["reference"] = ref_path_;
   md.extra["test"] = path;
   md.extra["nonFinitePixels"] = std::to_string(m.nonfinite_test);
-  return write_exr(frame_file(setup_.error_maps, t.report.name, frame), maps);
+  const std::string out = frame_file(setup_.error_maps, t.report.name, frame);
+  if (Status st = inputs_.check(out, "--error-maps"); !st) return st;
+  return write_exr(out, maps);
 }
 
 }  // namespace
+
+Expected<ProtectedInputs> comparison_inputs(const ComparisonSetup& setup) {
+  ProtectedInputs inputs;
+  auto ref = SequencePattern::parse(setup.reference);
+  if (!ref) return ref.error();
+  auto frames = resolve_frames(*ref, setup.frames);
+  if (!frames) return frames.error();
+  std::vector<SequencePattern> patterns = {*ref};
+  for (const auto& t : setup.tests) {
+    auto p = SequencePattern::parse(t);
+    if (!p) return p.error();
+    patterns.push_back(*p);
+  }
+  if (!setup.gbuffer.empty()) {
+    auto g = SequencePattern::parse(setup.gbuffer);
+    if (!g) return g.error();
+    patterns.push_back(*g);
+  }
+  for (const auto& p : patterns)
+    for (const int f : *frames) inputs.add(p.path(f));
+  return inputs;
+}
 
 std::string sequence_name(const std::string& pattern) {
   std::string name = fs::path(pattern).filename().string();
@@ -532,6 +589,13 @@ MetricSummary summarize(const SequenceReport& sequence, std::string_view metric,
   return s;
 }
 
+std::vector<double> metric_series(const SequenceReport& sequence, std::string_view metric, std::size_t column) {
+  std::vector<double> v;
+  v.reserve(sequence.frames.size());
+  for (const auto& f : sequence.frames) v.push_back(f.value(metric, column));
+  return v;
+}
+
 std::optional<double> mean_compute_ms(const SequenceReport& sequence) {
   double sum = 0.0;
   std::size_t count = 0;
@@ -551,6 +615,7 @@ std::optional<double> mean_compute_ms(const SequenceReport& sequence) {
 }
 
 std::string ThresholdFailure::message() const {
+  if (!text.empty()) return sequence + ": " + text;
   const MetricDefinition* d = find_metric(metric);
   const char* unit = d ? d->unit.c_str() : "";
   const bool higher = d ? d->higher_is_better : true;
@@ -581,7 +646,22 @@ std::vector<ThresholdFailure> check_thresholds(const ComparisonReport& report, c
       if (!s.count) continue;  // no value (e.g. flicker of a one-frame sequence): nothing to judge
       const double v = th.worst_frame ? s.worst() : s.mean;
       const bool fail = s.higher_is_better ? v < limit->second : v > limit->second;
-      if (fail) failures.push_back({seq.name, name, v, limit->second});
+      if (fail) failures.push_back({seq.name, name, v, limit->second, {}});
+    }
+  if (th.nonfinite)
+    for (const auto& seq : report.sequences) {
+      std::size_t frames = 0, pixels = 0;
+      for (const auto& f : seq.frames) {
+        bool bad = f.nonfinite_test > 0;
+        for (const auto& sample : f.metrics)
+          bad = bad || (!sample.values.empty() && std::isinf(sample.values.front()) && sample.values.front() < 0);
+        frames += bad ? 1 : 0;
+        pixels += f.nonfinite_test;
+      }
+      if (frames > 0)
+        failures.push_back({seq.name, "nonfinite", double(frames), 0.0,
+                            std::to_string(frames) + " frames with NaN/Inf pixels (" + std::to_string(pixels) +
+                                " pixels) or an overflowing error (--fail-nonfinite)"});
     }
   return failures;
 }

@@ -1,8 +1,11 @@
 // CSV, JSON and chart descriptions of a comparison (temporal/metrics/comparison.h). Formats in docs/compare.md.
 #include "temporal/metrics/comparison.h"
 
+#include "temporal/core/atomic_file.h"
+
 #include <nlohmann/json.hpp>
 
+#include <charconv>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -16,39 +19,21 @@ namespace {
 
 namespace fs = std::filesystem;
 
-Status write_text_atomic(const std::string& path, const std::string& text) {
-  std::error_code ec;
-  const fs::path p(path);
-  if (p.has_parent_path()) fs::create_directories(p.parent_path(), ec);
-  const std::string tmp = path + ".tmp";
-  {
-    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-    if (!out) return Error::output(path, "cannot create the file: check that its folder exists and is writable");
-    out << text;
-    out.flush();
-    if (!out) {
-      out.close();
-      fs::remove(tmp, ec);
-      return Error::output(path, "cannot write the file (disk full?)");
-    }
-  }
-  fs::rename(tmp, path, ec);
-  if (ec) {
-    fs::remove(tmp, ec);
-    return Error::output(path, "cannot move the temporary file into place: " + ec.message());
-  }
-  return {};
-}
-
-// CSV field: empty for "no value", `inf` / `-inf` for infinities, else %.*g.
-std::string field(double v, int digits = 8) {
+// CSV field: empty for "no value", `inf` / `-inf` for infinities, else the shortest text that reads back as the
+// same double (std::to_chars): per-shard CSVs then merge into exactly the single run's means (read_comparison_csv).
+// `digits` > 0 rounds instead (timings, whose last digits mean nothing).
+std::string field(double v, int digits = 0) {
   if (std::isnan(v)) return "";
   if (std::isinf(v)) return v > 0 ? "inf" : "-inf";
   char text[64];
-  std::snprintf(text, sizeof text, "%.*g", digits, v);
-  return text;
+  if (digits > 0) {
+    std::snprintf(text, sizeof text, "%.*g", digits, v);
+    return text;
+  }
+  const auto r = std::to_chars(text, text + sizeof text, v);
+  return std::string(text, r.ptr);
 }
-std::string field(const std::optional<double>& v, int digits = 8) { return v ? field(*v, digits) : std::string(); }
+std::string field(const std::optional<double>& v, int digits = 0) { return v ? field(*v, digits) : std::string(); }
 
 std::string csv_quote(const std::string& s) {
   if (s.find_first_of(",\"\n") == std::string::npos) return s;
@@ -131,7 +116,7 @@ std::vector<CsvColumn> csv_layout(const ComparisonReport& report) {
   cols.push_back({"nonfinite_test", [](const SequenceReport&, const FrameMetrics& f) { return std::to_string(f.nonfinite_test); }});
   cols.push_back({"nonfinite_reference",
                   [](const SequenceReport&, const FrameMetrics& f) { return std::to_string(f.nonfinite_reference); }});
-  cols.push_back({"compute_ms", [](const SequenceReport&, const FrameMetrics& f) { return field(f.compute_ms); }});
+  cols.push_back({"compute_ms", [](const SequenceReport&, const FrameMetrics& f) { return field(f.compute_ms, 8); }});
   cols.push_back({"metrics_ms", [](const SequenceReport&, const FrameMetrics& f) { return field(f.metrics_ms, 5); }});
   if (mask) {
     cols.push_back({"mask_fraction", [](const SequenceReport&, const FrameMetrics& f) { return field(f.mask_fraction); }});
@@ -175,9 +160,29 @@ namespace {
 
 // A metric's JSON summary: the primary value's {mean, min, max, min_frame, max_frame, frames}, and the mean over
 // frames of each other column that names a JSON key.
-nlohmann::ordered_json metric_json(const SequenceReport& s, const MetricDefinition& d) {
+nlohmann::ordered_json jinterval(const Interval& ci) { return nlohmann::ordered_json::array({jnum(ci.low), jnum(ci.high)}); }
+
+// Mean, interval and counts of part of a series (temporal/metrics/statistics.h).
+nlohmann::ordered_json jmean(std::span<const double> series, const BootstrapOptions& o) {
+  const MeanInterval m = bootstrap_mean(series, o);
+  nlohmann::ordered_json j = {{"frames", m.count}, {"mean", jnum(m.mean)}, {"ci95", jinterval(m.ci)}};
+  if (m.infinite) j["infinite_frames"] = m.infinite;
+  return j;
+}
+
+nlohmann::ordered_json metric_json(const ComparisonReport& report, const SequenceReport& s, const MetricDefinition& d) {
   auto j = jsummary(summarize(s, d.name));
   if (j.is_null()) return j;
+  // Intervals: the whole sequence, and with --warmup the steady state apart from the warm-up frames.
+  const auto series = metric_series(s, d.name);
+  const auto all = jmean(series, report.bootstrap);
+  j["ci95"] = all["ci95"];
+  if (all.contains("infinite_frames")) j["infinite_frames"] = all["infinite_frames"];
+  const std::size_t warm = std::min(series.size(), std::size_t(std::max(0, report.warmup_frames)));
+  if (warm > 0) {
+    j["warmup"] = jmean(std::span<const double>(series).first(warm), report.bootstrap);
+    j["steady"] = jmean(std::span<const double>(series).subspan(warm), report.bootstrap);
+  }
   for (std::size_t k = 1; k < d.columns.size(); ++k)
     if (!d.columns[k].json.empty())
       j[d.columns[k].json] = jnum(mean_of(s, [&](const FrameMetrics& f) { return f.value(d.name, k); }));
@@ -191,7 +196,7 @@ nlohmann::ordered_json sequence_json(const ComparisonReport& report, const Seque
   js["path"] = s.pattern;
   js["frames"] = s.frames.size();
   const auto defs = definitions_of(report);
-  for (const auto* d : defs) js[d->name] = metric_json(s, *d);
+  for (const auto* d : defs) js[d->name] = metric_json(report, s, *d);
   std::size_t nf_test = 0, nf_ref = 0;
   for (const auto& f : s.frames) {
     nf_test += f.nonfinite_test;
@@ -223,6 +228,31 @@ nlohmann::ordered_json sequence_json(const ComparisonReport& report, const Seque
     }
   }
   return js;
+}
+
+// The paired difference a - b of every two test sequences for every metric, over the frames where both have a
+// value, with its interval (and the steady state apart with --warmup): the numbers behind an "A beats B".
+nlohmann::ordered_json paired_json(const ComparisonReport& report) {
+  using json = nlohmann::ordered_json;
+  json pairs = json::array();
+  for (std::size_t a = 0; a < report.sequences.size(); ++a)
+    for (std::size_t b = a + 1; b < report.sequences.size(); ++b)
+      for (const auto* d : definitions_of(report)) {
+        const auto sa = metric_series(report.sequences[a], d->name), sb = metric_series(report.sequences[b], d->name);
+        const MeanInterval m = bootstrap_paired_difference(sa, sb, report.bootstrap);
+        if (m.count == 0) continue;
+        json p = {{"a", report.sequences[a].name}, {"b", report.sequences[b].name}, {"metric", d->name},
+                  {"higher_is_better", d->higher_is_better}, {"frames", m.count}, {"mean_difference", jnum(m.mean)},
+                  {"ci95", jinterval(m.ci)}};
+        const std::size_t warm = std::min(sa.size(), std::size_t(std::max(0, report.warmup_frames)));
+        if (warm > 0) {
+          const MeanInterval st = bootstrap_paired_difference(std::span<const double>(sa).subspan(warm),
+                                                              std::span<const double>(sb).subspan(warm), report.bootstrap);
+          p["steady"] = {{"frames", st.count}, {"mean_difference", jnum(st.mean)}, {"ci95", jinterval(st.ci)}};
+        }
+        pairs.push_back(std::move(p));
+      }
+  return pairs;
 }
 
 }  // namespace
@@ -272,6 +302,7 @@ Status write_comparison_json(const ComparisonReport& report, const Thresholds& t
   json seqs = json::array();
   for (const auto& s : report.sequences) seqs.push_back(sequence_json(report, s));
   j["sequences"] = seqs;
+  j["paired"] = paired_json(report);
   return write_text_atomic(path, j.dump(2) + "\n");
 }
 

@@ -20,6 +20,7 @@
 #include "temporal/core/sequence.h"
 
 #include <cstddef>
+#include <cstdint>
 #include <functional>
 #include <map>
 #include <optional>
@@ -128,6 +129,18 @@ Expected<RunSummary> run_sequence(const SequenceOptions& options, FrameStage& st
                                   const RunHooks& hooks = {});
 
 // --- Pieces shared with compare ----------------------------------------------------------------------------
+
+// The files a run reads, by identity (device and inode), so that no output ever replaces one of them: an output
+// pattern equal to an input pattern, another spelling of the same path, a hard or symbolic link to an input.
+class ProtectedInputs {
+ public:
+  void add(const std::string& path);  // ignored when the file does not exist
+  // Usage error when `path` exists and is one of the inputs; `what` names the option ("--out").
+  Status check(const std::string& path, const std::string& what) const;
+
+ private:
+  std::set<std::pair<std::uint64_t, std::uint64_t>> ids_;
+};
 
 // The output compression of a data sequence: `none`, `zip`, `piz`; `dwaa` is refused (lossy on data).
 Expected<ExrCompression> parse_data_compression(const std::string& name);

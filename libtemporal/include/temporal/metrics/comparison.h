@@ -13,14 +13,17 @@
 #pragma once
 
 #include "temporal/core/error.h"
+#include "temporal/core/runner.h"
 #include "temporal/core/sequence.h"
 #include "temporal/metrics/flip.h"
+#include "temporal/metrics/statistics.h"
 
 #include <array>
 #include <cstdint>
 #include <functional>
 #include <limits>
 #include <map>
+#include <set>
 #include <memory>
 #include <optional>
 #include <span>
@@ -53,6 +56,8 @@ struct ComparisonSetup {
   FlipMode flip = FlipMode::Off;       // off by default: FLIP costs more than PSNR and SSIM together
   FlipOptions flip_options;            // viewing condition (pixels per degree) and HDR-FLIP settings
   std::string error_maps;              // folder for <name>.####.exr error maps; empty: none
+  int warmup_frames = 0;               // the first N compared frames are summarised apart from the steady state
+  BootstrapOptions bootstrap;          // intervals of the JSON summary (temporal/metrics/statistics.h)
   std::string tool;                    // `temporal:tool` of the error maps
   std::string parameters;              // `temporal:parameters` of the error maps
 };
@@ -193,19 +198,22 @@ struct ComparisonReport {
   FlipMode flip = FlipMode::Off;
   double pixels_per_degree = kFlipDefaultPixelsPerDegree;  // FLIP's viewing condition
   std::vector<std::string> metrics;             // names of the measured metrics, registry order
+  int warmup_frames = 0;                        // ComparisonSetup::warmup_frames
+  BootstrapOptions bootstrap;                   // ComparisonSetup::bootstrap
   std::vector<SequenceReport> sequences;
 };
 
-// Observers of a running comparison (the library never prints; the tool decides what to show).
-struct ComparisonHooks {
-  std::function<void(int frame, int done, int total)> frame_done;  // after each frame (done of total)
-  std::function<void(const std::string& file, const std::string& text)> warning;  // e.g. NaN pixels found
-  std::function<void(const std::string& text)> log;                           // details for --verbose
-};
+// Observers of a running comparison (the library never prints; the tool decides what to show): the runner's
+// hooks (temporal/core/runner.h), frame_done after each frame, warnings (e.g. NaN pixels found), --verbose lines.
+using ComparisonHooks = RunHooks;
 
 // Runs the comparison. Errors: Usage (bad setup), Input (missing/corrupt files, missing layers, size or
 // channel-count mismatch, empty sequence, a layer FLIP cannot read), Output (error maps not writable).
 Expected<ComparisonReport> compare_sequences(const ComparisonSetup& setup, const ComparisonHooks& hooks = {});
+
+// Every file a comparison reads (reference, test and G-buffer frames), so that the caller can refuse an output
+// (CSV, JSON, chart) that would replace one of them; the engine itself refuses such error maps.
+Expected<ProtectedInputs> comparison_inputs(const ComparisonSetup& setup);
 
 // The name `compare` gives a test sequence without --names: the file name without folder, frame number and
 // extension (`out/taa.####.exr` -> `taa`).
@@ -224,6 +232,10 @@ struct MetricSummary {
 // Summary of a metric's primary value (or of values[column]) over the frames that have one.
 MetricSummary summarize(const SequenceReport& sequence, std::string_view metric, std::size_t column = 0);
 
+// The per-frame values of a metric's primary value (or values[column]), one per frame in order, NaN where the
+// frame has none.
+std::vector<double> metric_series(const SequenceReport& sequence, std::string_view metric, std::size_t column = 0);
+
 // Mean of `temporal:computeMs` over frames that have it (else the mean sum of the `temporal:ms:*` timings).
 std::optional<double> mean_compute_ms(const SequenceReport& sequence);
 
@@ -236,18 +248,33 @@ std::string summary_table(const ComparisonReport& report);
 struct Thresholds {
   std::map<std::string, double> limits;  // metric name -> limit; fail when the judged value is worse
   bool worst_frame = false;              // judge the worst frame instead of the sequence mean
+  bool nonfinite = false;                // fail when a test frame has NaN/Inf pixels or an overflowing error
 };
 struct ThresholdFailure {
   std::string sequence;
   std::string metric;
   double value = 0.0;
   double limit = 0.0;
+  std::string text;             // the message when it is not a metric against a limit (--fail-nonfinite)
   std::string message() const;  // "taa: psnr_rgb 28.1 dB < limit 30 dB"
 };
 // Usage error when a limit names a metric that has no threshold or that `setup` does not measure (with how to
 // turn it on).
 Status check_threshold_setup(const ComparisonSetup& setup, const Thresholds& thresholds);
 std::vector<ThresholdFailure> check_thresholds(const ComparisonReport& report, const Thresholds& thresholds);
+
+// --- Shards ---------------------------------------------------------------------------------------------------
+
+// Reads a CSV written by write_comparison_csv back into a report (per-frame values exactly as computed; the
+// inputs' metadata is not in the CSV). Input error for a file that is not such a CSV.
+Expected<ComparisonReport> read_comparison_csv(const std::string& path);
+// Joins per-shard reports of one comparison (same metrics, same sequences in the same order, disjoint frame
+// ranges) into one, frames in order. `names` (the shards' files) are for messages and the merged report's
+// `reference`. The merged summaries equal a single run's exactly (docs/compare.md, "Shards").
+Expected<ComparisonReport> merge_comparisons(const std::vector<ComparisonReport>& parts,
+                                            const std::vector<std::string>& names = {});
+// read_comparison_csv of each file, merge_comparisons, and the summary settings of `setup` (warm-up, bootstrap).
+Expected<ComparisonReport> merge_comparison_csvs(const std::vector<std::string>& csvs, const ComparisonSetup& setup);
 
 // --- Outputs (written atomically: temporary file, then rename) ---------------------------------------------
 
