@@ -8,10 +8,13 @@
 #
 # Cases (CASES, one per line "name scene render-options"; a scene path that does not exist is skipped with a note,
 # so the shared assets are optional):
-#   fence         assets/scenes/fence.glb, its own drifting camera
-#   ivy-orbit     ../shared/assets/gltf/SponzaIvy/sponza_ivy.gltf, --camera-path orbit (thin foliage edges)
-#   ivy-static    the same scene, automatic camera standing still (--camera-path fixed): no motion, so no
-#                 history resampling; only jitter and the reference convention remain
+#   fence          assets/scenes/fence.glb, its own drifting camera
+#   helmet-orbit   ../shared/assets/gltf/FlightHelmet/FlightHelmet.gltf, --camera-path orbit (straps, goggles,
+#                  fine textures: the third-party case of issue 16 item 8)
+#   helmet-static  the same scene, automatic camera standing still (--camera-path fixed): no motion, so no
+#                  history resampling; only jitter and the reference convention remain
+#   ivy-orbit      ../shared/assets/gltf/SponzaIvy/sponza_ivy.gltf, --camera-path orbit (thin foliage, small in
+#                  the frame)
 #
 # Usage: pipelines/filter-phlm-edges.sh [BUILD_DIR=build/release] [OUT_DIR=report/filter-phlm-edges]
 # Environment: SIZE (512x288), FRAMES (0-47), FPS (40), WARMUP (10), CASES, REUSE_RENDER=1, SHARED_ASSETS (the
@@ -28,8 +31,9 @@ WARMUP="${WARMUP:-10}"
 REUSE_RENDER="${REUSE_RENDER:-0}"
 shared="${SHARED_ASSETS:-$here/../shared/assets}/gltf"
 CASES="${CASES:-fence $here/assets/scenes/fence.glb
-ivy-orbit $shared/SponzaIvy/sponza_ivy.gltf --camera-path orbit
-ivy-static $shared/SponzaIvy/sponza_ivy.gltf --camera-path fixed}"
+helmet-orbit $shared/FlightHelmet/FlightHelmet.gltf --camera-path orbit
+helmet-static $shared/FlightHelmet/FlightHelmet.gltf --camera-path fixed
+ivy-orbit $shared/SponzaIvy/sponza_ivy.gltf --camera-path orbit}"
 
 case "$BUILD" in
   /*) ;;
@@ -51,6 +55,7 @@ runs=("phlm phlm"
   "phlm-nearest phlm --model-fetch nearest"
   "taa taa"
   "taa-bilinear taa --taa-history bilinear"
+  "taa-centre taa --taa-velocity centre"
   "taa-2014 taa --taa-velocity centre --taa-clip minmax --taa-alpha 0.04"
   "ema ema")
 mkdir -p "$OUT"

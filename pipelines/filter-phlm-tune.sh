@@ -28,7 +28,9 @@
 # Usage: pipelines/filter-phlm-tune.sh [BUILD_DIR=build/release] [OUT_DIR=report/filter-phlm-tune]
 # Environment: SIZE, FPS, TAA_ALPHAS, EMA_ALPHAS, FXAA_SUBPIX, PHLM_LAMBDAS, TUNE_SET (lines
 #   "name scene.glb frames render-options"), REUSE_RENDER=1 (keep existing renders), KEEP_OUTPUTS=1 (keep the
-#   filtered sequences; by default they are deleted after compare has measured them).
+#   filtered sequences; by default they are deleted after compare has measured them), APPEND=1 (add the runs to an
+#   existing OUT_DIR/tuning.csv, e.g. to extend a grid; the tables sort the settings). An empty list (TAA_ALPHAS="")
+#   skips that method.
 set -euo pipefail
 
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
@@ -36,12 +38,13 @@ BUILD="${1:-build/release}"
 OUT="${2:-report/filter-phlm-tune}"
 SIZE="${SIZE:-512x288}"
 FPS="${FPS:-40}"
-TAA_ALPHAS="${TAA_ALPHAS:-0.02 0.04 0.06 0.08 0.1 0.125 0.15 0.2 0.25 0.33}"
-EMA_ALPHAS="${EMA_ALPHAS:-0.5 0.6 0.7 0.8 0.85 0.9 0.95}"
-FXAA_SUBPIX="${FXAA_SUBPIX:-0 0.25 0.5 0.75 1}"
-PHLM_LAMBDAS="${PHLM_LAMBDAS:-0.9 0.95 0.98 0.99 0.995 0.998 0.999}"
+TAA_ALPHAS="${TAA_ALPHAS-0.02 0.04 0.06 0.08 0.1 0.125 0.15 0.2 0.25 0.33 0.4 0.5 0.6 0.75 1}"
+EMA_ALPHAS="${EMA_ALPHAS-0.2 0.3 0.4 0.5 0.6 0.7 0.8 0.85 0.9 0.95}"
+FXAA_SUBPIX="${FXAA_SUBPIX-0 0.25 0.5 0.75 1}"
+PHLM_LAMBDAS="${PHLM_LAMBDAS-0.9 0.95 0.98 0.99 0.995 0.998 0.999}"
 REUSE_RENDER="${REUSE_RENDER:-0}"
 KEEP_OUTPUTS="${KEEP_OUTPUTS:-0}"
+APPEND="${APPEND:-0}"
 TUNE_SET="${TUNE_SET:-tower-far tower.glb 240-271 --seed 101
 fence-late fence.glb 160-191 --seed 102
 walkers-late walkers.glb 100-131 --seed 103
@@ -66,14 +69,14 @@ mkdir -p "$OUT"
 # The runs: "method label filter-options" per line.
 runs=()
 for a in $TAA_ALPHAS; do
-  for clip in variance minmax; do runs+=("taa clip=$clip,alpha=$a --taa-clip $clip --taa-alpha $a"); done
+  for clip in variance minmax; do runs+=("taa clip=$clip/alpha=$a --taa-clip $clip --taa-alpha $a"); done
 done
 for a in $EMA_ALPHAS; do runs+=("ema alpha=$a --ema-alpha $a"); done
 for s in $FXAA_SUBPIX; do runs+=("fxaa subpix=$s --fxaa-subpix $s"); done
 for l in $PHLM_LAMBDAS; do runs+=("phlm lambda=$l --lambda $l"); done
 
 csv="$OUT/tuning.csv"
-echo "method,setting,sequence,psnr_rgb_db,flicker" > "$csv"
+if [[ "$APPEND" != 1 || ! -f "$csv" ]]; then echo "method,setting,sequence,psnr_rgb_db,flicker" > "$csv"; fi
 while read -r name scene frames opts; do
   [[ -z "$name" ]] && continue
   dir="$OUT/$name"
@@ -89,6 +92,7 @@ while read -r name scene frames opts; do
   tests=()
   names=""
   i=0
+  rm -rf "$dir/runs"
   for run in "${runs[@]}"; do
     read -r method label args <<< "$run"
     out="$dir/runs/$i/$method.####.exr"

@@ -18,8 +18,8 @@
 #   REFERENCE_SPP (samples per pixel of the reference, default 16),
 #   RENDERS (folder holding SCENE/render, default OUT_DIR: the ablation script reuses the Table 2 renders),
 #   REUSE_RENDER=1 (keep an existing render folder instead of rendering again, e.g. after changing only the
-#   filters), WARMUP (frames compare reports apart as warm-up, default 10 = 1 / TAA's alpha; only when compare has
-#   --warmup), PAIRS (paired differences printed, "A:B,..."; default: phlm and taa against each other, the input
+#   filters), REUSE_OUTPUTS=1 (keep existing filtered sequences: measure again only), WARMUP (frames compare
+#   reports apart as warm-up, default 10 = 1 / TAA's alpha; only when compare has --warmup), PAIRS (paired differences printed, "A:B,..."; default: phlm and taa against each other, the input
 #   and the previous TAA).
 #
 # The comparison target: render-gbuffer's `color` is the shading payload's R,G,B at one sample per pixel with
@@ -39,6 +39,7 @@ METHODS="${METHODS:-phlm taa ema fxaa}"
 RENDER_ARGS="${RENDER_ARGS:---payload direct,shadow,ssao}"
 REFERENCE_SPP="${REFERENCE_SPP:-16}"
 REUSE_RENDER="${REUSE_RENDER:-0}"
+REUSE_OUTPUTS="${REUSE_OUTPUTS:-0}"
 FILTER_ARGS="${FILTER_ARGS:-}"
 VARIANTS="${VARIANTS-taa-2014 taa --taa-velocity centre --taa-clip minmax --taa-alpha 0.04}"
 RENDERS="${RENDERS:-$OUT}"
@@ -78,7 +79,8 @@ runs=()
 for m in $METHODS; do runs+=("$m $m"); done
 while read -r line; do [[ -n "$line" ]] && runs+=("$line"); done <<< "$VARIANTS"
 compare_args=()
-if "$compare" --help 2>/dev/null | grep -q -- "--warmup"; then compare_args+=(--warmup "$WARMUP"); fi
+compare_help="$("$compare" --help 2>/dev/null || true)"
+if [[ "$compare_help" == *--warmup* ]]; then compare_args+=(--warmup "$WARMUP"); fi
 {
   echo "# filter-phlm: seed 003 Table 2 on the built-in scenes"
   echo
@@ -106,13 +108,19 @@ for scene in "${scenes[@]}"; do
   fi
 
   tests=("$render_dir/color.####.exr")
+  last_frame="$(ls "$render_dir"/color.*.exr | tail -1)"
+  last_frame="${last_frame##*/color.}"
   for run in "${runs[@]}"; do
     read -r n m args <<< "$run"
+    tests+=("$dir/$n/$n.####.exr")
+    if [[ "$REUSE_OUTPUTS" == 1 && -f "$dir/$n/$n.$last_frame" ]]; then
+      echo "== $name: reusing $dir/$n" >&2
+      continue
+    fi
     echo "== $name: $n = filter-phlm --method $m $args" >&2
     # shellcheck disable=SC2086
     "$filter" --input "$render_dir/color.####.exr" --gbuffer "$render_dir/gbuffer.####.exr" \
       --out "$dir/$n/$n.####.exr" --method "$m" $args $FILTER_ARGS
-    tests+=("$dir/$n/$n.####.exr")
   done
 
   echo "== $name: compare" >&2

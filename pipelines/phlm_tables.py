@@ -19,14 +19,14 @@ import sys
 from collections import OrderedDict, defaultdict
 
 
-def fmt(v, digits=2):
+def fmt(v, digits=2, sign=False):
     if v is None:
         return "n/a"
     if isinstance(v, str):
         return v
     if math.isinf(v):
-        return "inf"
-    return f"{v:.{digits}f}"
+        return "inf" if v > 0 else "-inf"
+    return f"{v:+.{digits}f}" if sign else f"{v:.{digits}f}"
 
 
 def tuning(path):
@@ -35,8 +35,19 @@ def tuning(path):
     for r in rows:
         methods.setdefault(r["method"], OrderedDict()).setdefault(r["setting"], OrderedDict())[r["sequence"]] = r
     seqs = list(OrderedDict((r["sequence"], 1) for r in rows))
+    def key(setting):
+        parts = []
+        for item in setting.split("/"):
+            name, _, value = item.partition("=")
+            try:
+                parts.append((name, 0, float(value), ""))
+            except ValueError:
+                parts.append((name, 1, 0.0, value))
+        return parts
+
     out = []
     for method, settings in methods.items():
+        settings = OrderedDict(sorted(settings.items(), key=lambda kv: key(kv[0])))
         out.append(f"### {method}\n")
         out.append("| setting | " + " | ".join(seqs) + " | mean PSNR | mean flicker |")
         out.append("|---|" + "---|" * (len(seqs) + 2))
@@ -69,10 +80,10 @@ def metric(seq, key):
     return mean, ci, steady.get("mean"), steady.get("ci95")
 
 
-def cell(mean, ci, digits=2):
-    s = fmt(mean, digits)
+def cell(mean, ci, digits=2, sign=False):
+    s = fmt(mean, digits, sign)
     if ci:
-        s += f" [{fmt(ci[0], digits)}, {fmt(ci[1], digits)}]"
+        s += f" [{fmt(ci[0], digits, sign)}, {fmt(ci[1], digits, sign)}]"
     return s
 
 
@@ -108,34 +119,45 @@ def scenes(out_dir, scene_list, seq_list, pair_list):
     print("\n".join(out))
     if not pair_list:
         return
-    print()
-    print("Paired differences A - B over frames, mean [95% interval] (compare's `paired`):\n")
-    print("| scene | " + " | ".join(f"{a} - {b}: PSNR dB / flicker" for a, b in pair_list) + " |")
-    print("|---|" + "---|" * len(pair_list))
-    for s in scene_list:
-        paired = data[s].get("paired")
-        cells = []
-        for a, b in pair_list:
-            if paired is None:
-                cells.append("n/a (compare without paired differences)")
-                continue
-            parts = []
-            for key, digits in (("psnr_rgb", 2), ("flicker", 4)):
-                hit = None
-                for p in paired:
-                    if p.get("metric") == key and {p.get("a"), p.get("b")} == {a, b}:
-                        hit = p
-                        break
-                if hit is None:
-                    parts.append("n/a")
+    for part, title in (("all", "all frames"), ("steady", "steady state (after compare's --warmup frames)")):
+        print()
+        print(f"Paired differences A - B, {title}: mean over frames [95% interval] (compare's `paired`):\n")
+        print("| scene | " + " | ".join(f"{a} - {b}: PSNR dB / flicker" for a, b in pair_list) + " |")
+        print("|---|" + "---|" * len(pair_list))
+        for s in scene_list:
+            paired = data[s].get("paired")
+            cells = []
+            for a, b in pair_list:
+                if paired is None:
+                    cells.append("n/a")
                     continue
-                sign = 1.0 if hit["a"] == a else -1.0
-                d = sign * hit["mean_difference"]
-                ci = hit.get("ci95")
-                ci = sorted([sign * ci[0], sign * ci[1]]) if ci else None
-                parts.append(cell(d, ci, digits))
-            cells.append(" / ".join(parts))
-        print(f"| {s} | " + " | ".join(cells) + " |")
+                parts = []
+                for key, digits in (("psnr_rgb", 2), ("flicker", 4)):
+                    hit = None
+                    for p in paired:
+                        if p.get("metric") == key and {p.get("a"), p.get("b")} == {a, b}:
+                            hit = p
+                            break
+                    if hit is not None and part == "steady":
+                        hit = hit.get("steady")
+                    if hit is None or hit.get("mean_difference") is None:
+                        parts.append("n/a")
+                        continue
+                    sign = 1.0 if (part == "all" and hit["a"] == a) or (part == "steady" and _orient(paired, key, a, b)) else -1.0
+                    d = sign * float(hit["mean_difference"])
+                    ci = hit.get("ci95")
+                    ci = sorted([sign * float(ci[0]), sign * float(ci[1])]) if ci else None
+                    parts.append(cell(d, ci, digits, sign=True))
+                cells.append(" / ".join(parts))
+            print(f"| {s} | " + " | ".join(cells) + " |")
+
+
+def _orient(paired, key, a, b):
+    """True when compare's entry for {a, b} and `key` is a - b (not b - a)."""
+    for p in paired:
+        if p.get("metric") == key and {p.get("a"), p.get("b")} == {a, b}:
+            return p["a"] == a
+    return True
 
 
 def main():

@@ -229,6 +229,18 @@ TEST(Convergence, MovingEdgesBlurWithoutShift) {
       EXPECT_LT(a.rms, input.rms) << fetch;  // blurred, still better than the aliased input (0.074)
     }
   }
+  // Printed for docs/filter-phlm.md ("Edges under camera motion"), not asserted: the running mean (no feature)
+  // and PHLM without its box test on the same circle.
+  {
+    PhlmParams p;
+    p.no_feature = true;
+    PhlmFilter mean(p);
+    print("phlm --no-feature, circle", run(&mean, 120, 40, circle));
+    p.no_feature = false;
+    p.no_box_test = true;
+    PhlmFilter no_box(p);
+    print("phlm --no-box-test, circle", run(&no_box, 120, 40, circle));
+  }
   const Averaged nearest = run(phlm("nearest").get(), 120, 30, pan_03px);
   print("phlm nearest, 0.3 px", nearest);
   EXPECT_GT(std::fabs(nearest.translation[0]), 0.5);  // measured -0.79: the models stay behind
