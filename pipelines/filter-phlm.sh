@@ -12,7 +12,8 @@
 #   SCENE      scenes to run (default: the built-in fence, tower, fan and walkers scenes of assets/scenes)
 # Environment: SIZE (default 512x288), FRAMES (default 0-47), FPS (default 40), METHODS (default
 #   "phlm taa ema fxaa"), VARIANTS (more runs, one per line "NAME METHOD filter-phlm options", e.g. the previous TAA
-#   "taa-2014 taa --taa-velocity centre --taa-clip minmax --taa-alpha 0.04", which is the default; "" for none),
+#   "taa-0.1 taa --taa-alpha 0.1" (the engine-typical blend) and "taa-2014 taa --taa-velocity centre --taa-clip
+#   minmax --taa-alpha 0.04" by default; "" for none),
 #   RENDER_ARGS (extra render-gbuffer options; default "--payload direct,shadow,ssao": the gi payload's 2000 VPLs
 #   make the 16-spp reference ~10x slower on llvmpipe), FILTER_ARGS (extra filter-phlm options for every run),
 #   REFERENCE_SPP (samples per pixel of the reference, default 16),
@@ -41,10 +42,11 @@ REFERENCE_SPP="${REFERENCE_SPP:-16}"
 REUSE_RENDER="${REUSE_RENDER:-0}"
 REUSE_OUTPUTS="${REUSE_OUTPUTS:-0}"
 FILTER_ARGS="${FILTER_ARGS:-}"
-VARIANTS="${VARIANTS-taa-2014 taa --taa-velocity centre --taa-clip minmax --taa-alpha 0.04}"
+VARIANTS="${VARIANTS-taa-0.1 taa --taa-alpha 0.1
+taa-2014 taa --taa-velocity centre --taa-clip minmax --taa-alpha 0.04}"
 RENDERS="${RENDERS:-$OUT}"
 WARMUP="${WARMUP:-10}"
-PAIRS="${PAIRS:-phlm:taa,phlm:input,taa:input,phlm:taa-2014,taa:taa-2014}"
+PAIRS="${PAIRS:-phlm:taa,phlm:taa-0.1,phlm:input,taa:input,taa:taa-0.1,phlm:fxaa,phlm:ema,taa-0.1:taa-2014}"
 
 # A relative BUILD_DIR is taken from the current folder, else from the repository root.
 case "$BUILD" in

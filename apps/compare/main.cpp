@@ -6,7 +6,6 @@
 
 #include "temporal/report/compare_run.h"
 
-#include <cmath>
 #include <cstdio>
 #include <iostream>
 #include <map>
@@ -117,14 +116,7 @@ int main(int argc, char** argv) {
       if (!range) return range.error();
       setup.frames = *range;
     }
-    if (peak == "max") {
-      setup.peak_from_data = true;
-    } else {
-      char* end = nullptr;
-      setup.peak = std::strtod(peak.c_str(), &end);
-      if (end == peak.c_str() || *end != '\0' || !(setup.peak > 0.0) || !std::isfinite(setup.peak))
-        return Error::usage("--peak '" + peak + "' is not a positive number or `max`");
-    }
+    if (auto st = set_peak(peak, setup); !st) return st;
     for (const auto& c : crops) {
       auto rect = parse_crop(c);
       if (!rect) return rect.error();

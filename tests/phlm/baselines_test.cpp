@@ -222,7 +222,9 @@ TEST(Taa, NonFiniteInputIsIgnored) {
 }
 
 TEST(Ema, FollowsEquationOne) {
-  EmaFilter ema;  // alpha = 0.9
+  EmaParams params;
+  params.alpha = 0.9f;  // eq. 1 by hand with a ten-frame memory (the default is the tuned 0.5)
+  EmaFilter ema(params);
   Image out;
   ASSERT_TRUE(ema.process(input_for(make_frame(3, 3, [](int, int, int) { return 1.0f; })), out));
   ASSERT_TRUE(ema.process(input_for(make_frame(3, 3, [](int, int, int) { return 0.0f; })), out));
@@ -232,7 +234,9 @@ TEST(Ema, FollowsEquationOne) {
 }
 
 TEST(Ema, RejectsHistoryOnIdOrDepthChange) {
-  EmaFilter ema;
+  EmaParams params;
+  params.alpha = 0.9f;
+  EmaFilter ema(params);
   Image out;
   Image g(3, 1);
   float* depth = g.add_channel("depth.Z", 5.0f);

@@ -18,6 +18,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <limits>
 
@@ -691,6 +692,20 @@ std::string ThresholdFailure::message() const {
   std::snprintf(text, sizeof text, "%s: %s %.6g%s %s limit %.6g%s", sequence.c_str(), metric.c_str(), value, unit,
                 higher ? "<" : ">", limit, unit);
   return text;
+}
+
+Status set_peak(const std::string& text, ComparisonSetup& setup) {
+  if (text == "max") {
+    setup.peak_from_data = true;
+    return {};
+  }
+  char* end = nullptr;
+  const double peak = std::strtod(text.c_str(), &end);
+  if (end == text.c_str() || *end != '\0' || !(peak > 0.0) || !std::isfinite(peak))
+    return Error::usage("--peak '" + text + "' is not a positive number or `max`");
+  setup.peak = peak;
+  setup.peak_from_data = false;
+  return {};
 }
 
 Status check_threshold_setup(const ComparisonSetup& setup, const Thresholds& thresholds) {

@@ -265,6 +265,10 @@ Expected<ComparisonReport> compare_sequences(const ComparisonSetup& setup, const
 // (CSV, JSON, chart) that would replace one of them; the engine itself refuses such error maps.
 Expected<ProtectedInputs> comparison_inputs(const ComparisonSetup& setup);
 
+// Sets the PSNR / SSIM peak from its text: a positive finite number (`peak`), or `max` (`peak_from_data`,
+// idiff's rule). Errors: Usage, naming the text.
+Status set_peak(const std::string& text, ComparisonSetup& setup);
+
 // The name `compare` gives a test sequence without --names: the file name without folder, frame number and
 // extension (`out/taa.####.exr` -> `taa`).
 std::string sequence_name(const std::string& pattern);

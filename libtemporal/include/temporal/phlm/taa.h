@@ -35,7 +35,7 @@ struct TaaParams {
   // Weight of the current frame in the exponential blend. Chosen by pipelines/filter-phlm-tune.sh on the tuning
   // set of docs/filter-phlm.md (never on an evaluation scene); UE4 ships 0.04, Salvi 2016 and most later engines
   // 0.05-0.1.
-  float alpha = 0.1f;
+  float alpha = 0.6f;
   float filter_sharpness = 2.29f;      // Blackman-Harris approximation exp(-k d^2) (Karis 2014)
   std::string velocity = "nearest";    // nearest | centre (the 3x3 closest-depth dilation, or none)
   std::string clip = "variance";       // variance | minmax (neighbourhood clipping, see above)
