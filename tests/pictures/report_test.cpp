@@ -207,7 +207,10 @@ TEST_F(Report, ChartsHaveTitlesNamesRangesAndOnlyMethodTimes) {
     const std::string f = fs::path(path).filename().string();
     const AxisRange y = chart_y_range(chart);
     if (f == "p-speed.png") {
-      ASSERT_EQ(chart.series.size(), 2u);  // input (render) and perceived (simulation) are left off
+      ASSERT_EQ(chart.series.size(), 3u);  // input (render) and perceived (simulation) are left off
+      EXPECT_EQ(chart.series[2].name, "Pareto front");  // taa is faster, phlm better: both on it, by cost
+      EXPECT_TRUE(chart.series[2].line);
+      EXPECT_EQ(chart.series[2].x, (std::vector<double>{2.0, 5.0}));
       EXPECT_EQ(chart.series[0].name, "phlm");
       EXPECT_EQ(chart.series[1].name, "taa");
       EXPECT_DOUBLE_EQ(chart.series[0].x[0], 5.0);
@@ -243,6 +246,19 @@ TEST_F(Report, ChartsHaveTitlesNamesRangesAndOnlyMethodTimes) {
   EXPECT_EQ(j["sequences"][0]["compute_kind"], "render");
   EXPECT_EQ(j["sequences"][3]["compute_kind"], "simulation");
   EXPECT_EQ(j["sequences"][0]["tool"], "render-gbuffer 0.1.0");
+}
+
+// Hand-made points (cost, score): a dominated point, a tie in cost, a tie in both, non-finite values.
+TEST(ParetoFront, HandValues) {
+  //                  0    1    2    3    4    5    6
+  const std::vector<double> cost{5.0, 2.0, 3.0, 2.0, 9.0, NAN, 1.0};
+  const std::vector<double> score{30.0, 25.0, 24.0, 26.0, 30.0, 40.0, -INFINITY};
+  // 2 is dominated by 3 (cheaper, better); 1 by 3 (same cost, better); 4 by 0 (same score, cheaper); 5 and 6
+  // are not finite. The front by cost: 3 (2 ms, 26), 0 (5 ms, 30).
+  EXPECT_EQ(pareto_front(cost, score), (std::vector<std::size_t>{3, 0}));
+  // Equal points do not dominate each other.
+  EXPECT_EQ(pareto_front({1.0, 1.0}, {2.0, 2.0}), (std::vector<std::size_t>{0, 1}));
+  EXPECT_TRUE(pareto_front({}, {}).empty());
 }
 
 TEST(ChartRange, HandValues) {

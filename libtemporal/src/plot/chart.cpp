@@ -127,11 +127,18 @@ Status write_chart(const Chart& chart, const std::string& path) {
     }
     table->AddColumn(xs);
     table->AddColumn(ys);
-    vtkPlot* plot = xy->AddPlot(chart.style == ChartStyle::Lines ? vtkChart::LINE : vtkChart::POINTS);
+    const bool as_line = chart.style == ChartStyle::Lines || series.line;
+    vtkPlot* plot = xy->AddPlot(as_line ? vtkChart::LINE : vtkChart::POINTS);
     plot->SetInputData(table, 0, 1);
     plot->SetLabel(ys->GetName());
     const std::size_t entry = series.color >= 0 ? std::size_t(series.color) : s;
     const auto* c = kPalette[entry % (sizeof kPalette / sizeof kPalette[0])];
+    if (series.line && chart.style == ChartStyle::Points) {
+      plot->SetColor(110, 110, 110, 255);  // the front: grey, thin, behind the markers' colours
+      plot->SetWidth(1.5f);
+      if (auto* points = vtkPlotPoints::SafeDownCast(plot)) points->SetMarkerStyle(vtkPlotPoints::NONE);
+      continue;
+    }
     plot->SetColor(c[0], c[1], c[2], 255);
     plot->SetWidth(chart.style == ChartStyle::Lines ? 2.0f : 1.0f);
     if (auto* points = vtkPlotPoints::SafeDownCast(plot)) {

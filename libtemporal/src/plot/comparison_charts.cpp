@@ -2,6 +2,7 @@
 #include "temporal/metrics/comparison.h"
 #include "temporal/plot/plot.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -79,8 +80,39 @@ std::vector<std::pair<std::string, Chart>> comparison_charts(const ComparisonRep
     if (!ms || !psnr.count || !std::isfinite(psnr.mean)) continue;
     speed.series.push_back({s.name, {*ms}, {psnr.mean}, int(i)});  // the colour it has in the other charts
   }
+  // The Pareto front of the methods (and of a sweep's parameter values): where a faster method costs PSNR.
+  std::vector<double> cost, score;
+  for (const auto& s : speed.series) {
+    cost.push_back(s.x.front());
+    score.push_back(s.y.front());
+  }
+  if (speed.series.size() >= 2) {
+    ChartSeries front;
+    front.name = "Pareto front";
+    front.line = true;
+    for (const std::size_t i : pareto_front(cost, score)) {
+      front.x.push_back(cost[i]);
+      front.y.push_back(score[i]);
+    }
+    speed.series.push_back(std::move(front));
+  }
   if (!speed.series.empty()) charts.emplace_back(stem + "-speed" + ext, std::move(speed));
   return charts;
+}
+
+std::vector<std::size_t> pareto_front(const std::vector<double>& cost, const std::vector<double>& score) {
+  const std::size_t n = std::min(cost.size(), score.size());
+  std::vector<std::size_t> front;
+  for (std::size_t i = 0; i < n; ++i) {
+    if (!std::isfinite(cost[i]) || !std::isfinite(score[i])) continue;
+    bool dominated = false;
+    for (std::size_t j = 0; j < n && !dominated; ++j)
+      dominated = j != i && std::isfinite(cost[j]) && std::isfinite(score[j]) && cost[j] <= cost[i] &&
+                  score[j] >= score[i] && (cost[j] < cost[i] || score[j] > score[i]);
+    if (!dominated) front.push_back(i);
+  }
+  std::stable_sort(front.begin(), front.end(), [&](std::size_t a, std::size_t b) { return cost[a] < cost[b]; });
+  return front;
 }
 
 }  // namespace temporal

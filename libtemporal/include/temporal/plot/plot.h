@@ -22,6 +22,7 @@ struct ChartSeries {
   std::vector<double> x;
   std::vector<double> y;
   int color = -1;    // palette entry (Tableau 10); -1: the series' position. A method keeps its colour across charts
+  bool line = false;  // in a Points chart: drawn as a grey line without markers (the Pareto front of the speed chart)
 };
 
 enum class ChartStyle {
@@ -100,9 +101,15 @@ class VirtualDisplay {
 // F-ssim.EXT, F-flicker.EXT (only when there are two frames or more), F-flip.EXT with --flip; F-speed.EXT: mean
 // PSNR against the mean compute time of each test whose headers time the method itself
 // (ComputeKind::Method: never a render's or a simulation's time), when there is one. Titles are the metric's,
-// after `title` ("walkers: PSNR (rgb) per frame") when given; series are the sequences' names (--names).
+// after `title` ("walkers: PSNR (rgb) per frame") when given; series are the sequences' names (--names). The speed
+// chart also draws the Pareto front of its points (pareto_front) as a line named "Pareto front" when it has two
+// points or more.
 std::vector<std::pair<std::string, Chart>> comparison_charts(const ComparisonReport& report,
                                                              const std::string& plot_path,
                                                              const std::string& title = {});
+
+// Indices of the points not dominated in (lower cost, higher score): no other point has a cost <= and a score >=
+// with one of them strictly better. Sorted by cost. Points with a non-finite cost or score are left out.
+std::vector<std::size_t> pareto_front(const std::vector<double>& cost, const std::vector<double>& score);
 
 }  // namespace temporal
