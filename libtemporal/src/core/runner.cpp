@@ -125,7 +125,11 @@ class InputWindow {
 Status check_gbuffer_size(const Image& g, const Image& input, const StageInputs& needs, const std::string& gpath,
                           const std::string& ipath) {
   int k = needs.gbuffer_scale;
-  if (k == 0) k = input.metadata().jitter_factor.value_or(1);
+  if (k == 0 && !input.metadata().jitter_factor)
+    return Error::input(ipath, "no temporal:jitterFactor in the header: the G-buffer's size is k times this input's, "
+                               "with k from that attribute (render-gbuffer --outputs shade writes it; "
+                               "docs/conventions.md, Jitter)");
+  if (k == 0) k = *input.metadata().jitter_factor;
   if (g.width() == k * input.width() && g.height() == k * input.height()) return Status::ok();
   if (k == 1)
     return Error::input(gpath, "G-buffer is " + dims(g.width(), g.height()) + " but " + ipath + " is " +

@@ -16,7 +16,7 @@
 // pattern). The cache stores one value per k x k block (its centre), so that, as in Figure 7.6, each frame
 // adds one subset of the block's samples and a static cache is never resampled; repeated resampling of a
 // jittered grid blurs it (measured: 7 px of blur at k = 4, docs/upsample-st.md).
-#include "upsample_internal.h"
+#include "method.h"
 
 #include "temporal/upsample/drobot.h"
 #include "temporal/core/parallel.h"
@@ -25,6 +25,63 @@
 
 namespace temporal::upsample {
 namespace {
+
+// drobot's parameters (seed 002; the choices are in docs/upsample-st.md).
+struct DrobotOptions {
+  std::string mode = "cache";     // cache: the framework of section 7.2; refresh: Figure 7.12
+  float normal_power = 32.0f;     // contrastCoef of Listing 7.1
+  bool depth_only = false;        // depth weights only in Listing 7.1 (the chapter's console variant)
+  float miss_threshold = 0.02f;   // IN_MissThreshold of Listing 7.2 (relative depth)
+  float convergence_time = 50.0f; // IN_ConvergenceTime of Listing 7.2
+  float max_frames = 0.0f;        // frames in the exponential history; 0 = k * k (the pattern length, Figure 7.6)
+  bool cache_point = false;       // point instead of bilinear filtering of the low-resolution cache (Figure 7.5);
+                                  // the depth test always uses bilinear depth (Listing 7.2)
+  float filter_amp = 200.0f;      // IN_BilateralFilterAmp of Listing 7.3 (per relative depth; not given there)
+
+  bool refresh() const { return mode == "refresh"; }
+  ParamList params() {
+    return {
+        Param::choice("--mode", "cache (the framework of section 7.2) or refresh (Figure 7.12)", &mode,
+                      {"cache", "refresh"}),
+        Param::real("--normal-power", "contrastCoef of Listing 7.1", &normal_power, 0.0, 1000.0),
+        Param::flag_on("--depth-only", "depth weights only in Listing 7.1 (the chapter's console variant)", &depth_only),
+        Param::real("--miss-threshold", "IN_MissThreshold of Listing 7.2, relative depth", &miss_threshold, 0.0, 10.0),
+        Param::real("--convergence-time", "IN_ConvergenceTime of Listing 7.2", &convergence_time, 1e-3, 1e6),
+        Param::real("--max-frames", "frames of the exponential history; 0 = k^2 (the pattern length, Figure 7.6)",
+                    &max_frames, 0.0, 1e6),
+        Param::flag_on("--cache-point", "point instead of bilinear filtering of the low-resolution cache (Figure 7.5)",
+                       &cache_point),
+        Param::real("--filter-amp", "IN_BilateralFilterAmp of Listing 7.3, per relative depth difference", &filter_amp,
+                    0.0, 1e6),
+    };
+  }
+};
+
+const DrobotOptions& drobot_options(const Options& o) { return method_options<DrobotOptions>(o, "drobot"); }
+
+// Everything drobot keeps between frames: the low-resolution cache (cache mode, ping-pong) or the full-resolution
+// history and depth (refresh mode), and the per-frame scratch of the filter and the cache grid.
+struct DrobotState : MethodState {
+  DrobotState(const Options& o, const Geometry& g);
+  Image& run(const FrameContext& f, bool history, FrameStats& stats) override;
+  void save(Image& state) const override;
+  Status load(const Image& state) override;
+
+  const DrobotOptions& opt;
+  OutputPair out;
+  Geometry g;
+  // cache mode: low-resolution history (value, depth, frame count), ping-pong, and filter scratch.
+  std::vector<std::vector<float>> hb_val[2];
+  std::vector<float> hb_z[2], hb_n[2];
+  std::vector<std::vector<float>> cb_val, cb_tmp;
+  std::vector<float> cb_conf, cb_hit, cb_w, cb_strength, cb_avail, cb_avail_h;
+  // cache grid: one sample per k x k block at its centre.
+  TapTable cache_cols, cache_rows;
+  std::vector<float> cz, cnx, cny, cnz, cache_table;
+  // refresh mode: the previous depth (and ids), Listing 7.1's bilinear table.
+  PreviousGeometry prev;
+  std::vector<float> bilinear_table;
+};
 
 // Listing 7.1 for full-resolution row Y from low-resolution planes src[c] with availability `avail` (0/1),
 // into out[c] (row pointers); `wsum` receives the sum of weights.
@@ -36,7 +93,7 @@ struct CoarseGrid {
   const float* table;
 };
 
-void drobot_upsample_row(const CoarseGrid& gr, const FrameContext& f, const Options& o, int Y,
+void drobot_upsample_row(const CoarseGrid& gr, const FrameContext& f, const DrobotOptions& o, int Y,
                          const std::vector<const float*>& src, const float* avail_, float* const* out, float* wsum) {
   thread_local std::vector<float> w4;
   w4.resize(std::size_t(f.W) * 4);
@@ -50,7 +107,7 @@ void drobot_upsample_row(const CoarseGrid& gr, const FrameContext& f, const Opti
   const float* __restrict table = gr.table + std::size_t(gr.rows.d[Y]) * k * 4;
   const std::size_t row = std::size_t(Y) * W;
   const float inv_range = 1.0f / f.depth_range;
-  const bool normals = o.drobot_normals;
+  const bool normals = !o.depth_only;
   const float power = o.normal_power;
   const float* __restrict lz = gr.lz;
   const float* __restrict lnx = gr.lnx;
@@ -165,7 +222,7 @@ void bilateral_pass(const float* src, const float* z, const float* strength, con
 // (k x + k/2 in full-resolution coordinates, a pixel corner for even k). Its geometry is the G-buffer at
 // pixel (k x + k/2, k y + k/2). Accumulating the jittered samples of k*k frames there is the sample-set
 // amortisation of Figure 7.6; the cache is never resampled in a static scene.
-void build_cache_grid(Upsampler::State& s, const FrameContext& f) {
+void build_cache_grid(DrobotState& s, const FrameContext& f) {
   const int k = f.grid.k, lw = f.lw, lh = f.lh;
   s.cache_cols.build(f.W, lw, k, k / 2);
   s.cache_rows.build(f.H, lh, k, k / 2);
@@ -200,10 +257,12 @@ void build_cache_grid(Upsampler::State& s, const FrameContext& f) {
     }
 }
 
-void run_cache(Upsampler::State& s, const FrameContext& f, const Options& o, FrameStats& stats) {
+Image& run_cache(DrobotState& s, const FrameContext& f, bool have_history, FrameStats& stats) {
+  const DrobotOptions& o = s.opt;
   const int C = f.C, k = f.grid.k, lw = f.lw, lh = f.lh;
   const std::size_t LN = std::size_t(lw) * lh;
-  const int cur = s.cur, prv = 1 - s.cur;
+  Image& out = s.out.next();
+  const int cur = s.out.index(), prv = 1 - cur;
   const float nmax = o.max_frames > 0 ? o.max_frames : float(k * k);
   for (auto& hv : s.hb_val) {
     hv.resize(C);
@@ -222,7 +281,7 @@ void run_cache(Upsampler::State& s, const FrameContext& f, const Options& o, Fra
   s.cb_avail.resize(LN);
   s.cb_avail_h.resize(LN);
   build_cache_grid(s, f);
-  const bool history = s.have_history && s.hb_z[prv].size() == LN;
+  const bool history = have_history && s.hb_z[prv].size() == LN;
   std::atomic<std::size_t> hits{0};
 
   // Steps 3-5: CB from this frame's samples and the reprojected HB (Listing 7.2).
@@ -245,7 +304,7 @@ void run_cache(Upsampler::State& s, const FrameContext& f, const Options& o, Fra
           v = (py - 0.5f * float(k)) / float(k);
           const float zc = bilerp(s.hb_z[prv].data(), lw, lh, u, v);  // bilinear depth at discontinuities
           conf = drobot_cache_confidence(z > 0 ? (z - zc) / z : 1.0f, o.miss_threshold, o.convergence_time, inside);
-          if (!o.cache_bilinear) {  // point sampling of the cache: the nearest previous texel
+          if (o.cache_point) {  // point sampling of the cache: the nearest previous texel
             u = std::round(u);
             v = std::round(v);
           }
@@ -258,7 +317,7 @@ void run_cache(Upsampler::State& s, const FrameContext& f, const Options& o, Fra
         // the block's surface (same relative-depth test as the cache), so a block straddling a silhouette
         // does not mix the two surfaces. A non-finite sample never enters the history.
         const float zs = f.z[std::size_t(k * y + f.grid.sy) * f.W + (k * x + f.grid.sx)];
-        const bool finite = s.lvalid[j] > 0;
+        const bool finite = f.lvalid[j] > 0;
         const bool valid = finite && z > 0 && std::abs(zs - z) <= o.miss_threshold * z;
         const float n = valid ? n_new : n_prev * conf;
         for (int c = 0; c < C; ++c) {
@@ -286,15 +345,13 @@ void run_cache(Upsampler::State& s, const FrameContext& f, const Options& o, Fra
   }
 
   // Step 7: Listing 7.1 upsampling of the filtered CB.
-  Image& out = s.result[cur];
-  std::vector<float*> planes;
-  for (const auto& c : s.channels) planes.push_back(out.plane(c));
+  const std::vector<float*> planes = payload_planes(out, s.g.channels);
   std::vector<const float*> src;
   for (int c = 0; c < C; ++c) src.push_back(s.hb_val[cur][c].data());
-  float* dbg_conf = o.debug_layers ? out.add_channel("debug.confidence") : nullptr;
-  float* dbg_disocc = o.debug_layers ? out.add_channel("debug.disocclusion") : nullptr;
-  float* dbg_conv = o.debug_layers ? out.add_channel("debug.convergence") : nullptr;
-  float* dbg_hw = o.debug_layers ? out.add_channel("debug.historyWeight") : nullptr;
+  float* dbg_conf = f.debug ? out.add_channel("debug.confidence") : nullptr;
+  float* dbg_disocc = f.debug ? out.add_channel("debug.disocclusion") : nullptr;
+  float* dbg_conv = f.debug ? out.add_channel("debug.convergence") : nullptr;
+  float* dbg_hw = f.debug ? out.add_channel("debug.historyWeight") : nullptr;
   const CoarseGrid grid{s.cache_cols, s.cache_rows, s.cz.data(), s.cnx.data(), s.cny.data(), s.cnz.data(),
                         s.cache_table.data()};
   parallel_rows(f.H, [&](int y0, int y1) {
@@ -316,25 +373,22 @@ void run_cache(Upsampler::State& s, const FrameContext& f, const Options& o, Fra
   });
   stats.history_pixels = hits * std::size_t(k) * k;
   stats.hole_pixels = (LN - hits) * std::size_t(k) * k;
+  return out;
 }
 
-void run_refresh(Upsampler::State& s, const FrameContext& f, const Options& o, FrameStats& stats) {
+Image& run_refresh(DrobotState& s, const FrameContext& f, bool have_history, FrameStats& stats) {
+  const DrobotOptions& o = s.opt;
   const int C = f.C;
-  Image& out = s.result[s.cur];
-  const Image& prev = s.result[1 - s.cur];
-  std::vector<float*> planes;
-  std::vector<const float*> prev_planes;
-  for (const auto& c : s.channels) {
-    planes.push_back(out.plane(c));
-    prev_planes.push_back(prev.plane(c));
-  }
-  const bool history = s.have_history && s.prev_z.size() == std::size_t(f.W) * f.H;
-  float* dbg_conf = o.debug_layers ? out.add_channel("debug.confidence") : nullptr;
-  float* dbg_disocc = o.debug_layers ? out.add_channel("debug.disocclusion") : nullptr;
-  float* dbg_conv = o.debug_layers ? out.add_channel("debug.convergence") : nullptr;
+  Image& out = s.out.next();
+  const std::vector<float*> planes = payload_planes(out, s.g.channels);
+  const std::vector<const float*> prev_planes = payload_planes(s.out.previous(), s.g.channels);
+  const bool history = have_history && s.prev.z.size() == std::size_t(f.W) * f.H;
+  float* dbg_conf = f.debug ? out.add_channel("debug.confidence") : nullptr;
+  float* dbg_disocc = f.debug ? out.add_channel("debug.disocclusion") : nullptr;
+  float* dbg_conv = f.debug ? out.add_channel("debug.convergence") : nullptr;
   std::atomic<std::size_t> holes{0}, hits{0};
   // The refresh buffer's samples sit at this frame's jittered positions.
-  const CoarseGrid grid{s.cols, s.rows, s.lz.data(), s.lnx.data(), s.lny.data(), s.lnz.data(),
+  const CoarseGrid grid{f.cols, f.rows, f.lz.data(), f.lnx.data(), f.lny.data(), f.lnz.data(),
                         s.bilinear_table.data()};
   parallel_rows(f.H, [&](int y0, int y1) {
     std::vector<float*> rows(C);
@@ -343,22 +397,22 @@ void run_refresh(Upsampler::State& s, const FrameContext& f, const Options& o, F
       const std::size_t row = std::size_t(Y) * f.W;
       for (int c = 0; c < C; ++c) rows[c] = planes[c] + row;
       // Bilateral upsampling of the refresh buffer everywhere first (Listing 7.1) ...
-      drobot_upsample_row(grid, f, o, Y, f.low, s.lvalid.data(), rows.data(), dbg_conf ? dbg_conf + row : nullptr);
-      const bool row_computed = s.rows.d[Y] == 0;
-      const std::size_t lrow = std::size_t(s.rows.i0[Y]) * f.lw;
+      drobot_upsample_row(grid, f, o, Y, f.low, f.lvalid.data(), rows.data(), dbg_conf ? dbg_conf + row : nullptr);
+      const bool row_computed = f.rows.d[Y] == 0;
+      const std::size_t lrow = std::size_t(f.rows.i0[Y]) * f.lw;
       for (int X = 0; X < f.W; ++X) {
         const std::size_t i = row + X;
         float conf = 0.0f;
-        if (row_computed && s.cols.d[X] == 0 && s.lvalid[lrow + s.cols.i0[X]] > 0) {
+        if (row_computed && f.cols.d[X] == 0 && f.lvalid[lrow + f.cols.i0[X]] > 0) {
           // ... the refresh buffer where it has the pixel ...
-          for (int c = 0; c < C; ++c) planes[c][i] = f.low[c][lrow + s.cols.i0[X]];
+          for (int c = 0; c < C; ++c) planes[c][i] = f.low[c][lrow + f.cols.i0[X]];
           conf = 1.0f;
         } else if (history && std::abs(f.mx[i]) < 1e6f && std::abs(f.my[i]) < 1e6f) {
           // ... and the history where the reprojection cache hits (Listing 7.2 test, bilinear depth).
           const float px = float(X) + 0.5f + f.mx[i], py = float(Y) + 0.5f + f.my[i];
           const bool inside = px >= 0 && py >= 0 && px < float(f.W) && py < float(f.H);
           const float u = px - 0.5f, v = py - 0.5f;
-          const float zc = bilerp(s.prev_z.data(), f.W, f.H, u, v);
+          const float zc = bilerp(s.prev.z.data(), f.W, f.H, u, v);
           const float z = f.z[i];
           conf = drobot_cache_confidence(z > 0 ? (z - zc) / z : 1.0f, o.miss_threshold, o.convergence_time, inside);
           if (conf > 0) {
@@ -384,16 +438,86 @@ void run_refresh(Upsampler::State& s, const FrameContext& f, const Options& o, F
   });
   stats.hole_pixels = holes;
   stats.history_pixels = hits;
+  s.prev.store(f);
+  return out;
 }
+
+DrobotState::DrobotState(const Options& o, const Geometry& geometry)
+    : opt(drobot_options(o)), out(geometry), g(geometry) {}
+
+Image& DrobotState::run(const FrameContext& f, bool history, FrameStats& stats) {
+  if (bilinear_table.size() != std::size_t(f.grid.k) * f.grid.k * 4) bilinear_table = drobot_bilinear_table(f.grid.k);
+  return opt.refresh() ? run_refresh(*this, f, history, stats) : run_cache(*this, f, history, stats);
+}
+
+// Cache mode: the low-resolution cache (values, depth, frame count) of the last frame; refresh mode: the output
+// (the history) and the depth.
+void DrobotState::save(Image& state) const {
+  if (opt.refresh()) {
+    for (const auto& c : g.channels) put_plane(state, "history." + c, out.current().plane(c), g.W, g.H);
+    put_previous(state, prev, g.W, g.H);
+    return;
+  }
+  const int cur = out.index();
+  for (std::size_t c = 0; c < g.channels.size(); ++c)
+    put_plane(state, "cache." + g.channels[c], hb_val[cur][c].data(), g.lw, g.lh);
+  put_plane(state, "cache.depth", hb_z[cur].data(), g.lw, g.lh);
+  put_plane(state, "cache.frames", hb_n[cur].data(), g.lw, g.lh);
+}
+
+Status DrobotState::load(const Image& state) {
+  Image& img = out.next();  // the next run() reads it (or the cache of this slot) as the previous frame's
+  if (opt.refresh()) {
+    for (const auto& c : g.channels)
+      if (Status s = get_plane(state, "history." + c, img.plane(c), g.W, g.H); !s) return s;
+    return get_previous(state, prev, g.W, g.H);
+  }
+  const int cur = out.index();
+  const std::size_t LN = std::size_t(g.lw) * g.lh;
+  hb_val[cur].resize(g.channels.size());
+  for (std::size_t c = 0; c < g.channels.size(); ++c) {
+    hb_val[cur][c].resize(LN);
+    if (Status s = get_plane(state, "cache." + g.channels[c], hb_val[cur][c].data(), g.lw, g.lh); !s) return s;
+  }
+  hb_z[cur].resize(LN);
+  hb_n[cur].resize(LN);
+  if (Status s = get_plane(state, "cache.depth", hb_z[cur].data(), g.lw, g.lh); !s) return s;
+  return get_plane(state, "cache.frames", hb_n[cur].data(), g.lw, g.lh);
+}
+
+std::vector<LayerNeed> layers(const Options&) { return {{"depth"}, {"N"}, {"motion"}}; }
+
+std::size_t streamed_bytes(const Options& o, int W, int H, int k, int C) {
+  const std::size_t full = std::size_t(W) * H * 4, low = full / (std::size_t(k) * k);
+  std::size_t b = 4 * full + C * low + C * full;  // depth + N, payload in, payload out
+  if (drobot_options(o).refresh())
+    b += 2 * full + 2 * full + C * full;  // motion, previous depth read and written, history read
+  else
+    b += 2 * full / (std::size_t(k) * k) + 2 * (C + 2) * low;  // motion at the blocks, low-res cache read and written
+  return b;
+}
+
+// The state holds either the low-resolution cache or the full-resolution history.
+std::string state_layout(const Options& o) { return "mode " + drobot_options(o).mode; }
 
 }  // namespace
 
-void run_drobot(Upsampler::State& s, const FrameContext& f, const Options& o, FrameStats& stats) {
-  if (s.bilinear_table.size() != std::size_t(f.grid.k) * f.grid.k * 4) s.bilinear_table = drobot_bilinear_table(f.grid.k);
-  if (o.drobot_mode == DrobotMode::Refresh)
-    run_refresh(s, f, o, stats);
-  else
-    run_cache(s, f, o, stats);
+const MethodEntry& drobot_method() {
+  static const MethodEntry entry{
+      {"drobot",
+       "spatiotemporal coherence framework (seed 002, Listings 7.1-7.3): low-resolution reprojection cache with "
+       "convergence, bilateral filter, bilateral upsampling",
+       true,
+       {{"drobot-refresh", "drobot", {"--mode", "refresh"}, "the refresh-buffer reconstruction of Figure 7.12"}}},
+      OptionsOf<DrobotOptions>::make,
+      layers,
+      [](const Options& o, const Geometry& g) -> std::unique_ptr<MethodState> {
+        return std::make_unique<DrobotState>(o, g);
+      },
+      streamed_bytes,
+      state_layout,
+      [](const Options& o) { return "drobot-" + drobot_options(o).mode; }};
+  return entry;
 }
 
 }  // namespace temporal::upsample
