@@ -73,11 +73,13 @@ struct DrobotState : MethodState {
   // cache mode: low-resolution history (value, depth, frame count), ping-pong, and filter scratch.
   std::vector<std::vector<float>> hb_val[2];
   std::vector<float> hb_z[2], hb_n[2];
+  std::vector<std::uint32_t> hb_id[2];  // the blocks' material ids (empty without ids)
   std::vector<std::vector<float>> cb_val, cb_tmp;
   std::vector<float> cb_conf, cb_hit, cb_w, cb_strength, cb_avail, cb_avail_h;
-  // cache grid: one sample per k x k block at its centre.
+  // cache grid: one sample per k x k block at its centre: geometry, id, and motion in cache texels.
   TapTable cache_cols, cache_rows;
-  std::vector<float> cz, cnx, cny, cnz, cache_table;
+  std::vector<float> cz, cnx, cny, cnz, cmx, cmy, cache_table;
+  std::vector<std::uint32_t> cid;
   // refresh mode: the previous depth (and ids), Listing 7.1's bilinear table.
   PreviousGeometry prev;
   std::vector<float> bilinear_table;
@@ -169,17 +171,6 @@ void drobot_upsample_row(const CoarseGrid& gr, const FrameContext& f, const Drob
     for (int X = 0; X < W; ++X) wsum[X] = w00[X] + w01[X] + w10[X] + w11[X];
 }
 
-// Bilinear clamp-to-edge sample; texel centres at integer coordinates.
-inline float bilerp(const float* p, int w, int h, float u, float v) {
-  u = std::clamp(u, 0.0f, float(w - 1));
-  v = std::clamp(v, 0.0f, float(h - 1));
-  const int x0 = std::min(int(u), w - 1), y0 = std::min(int(v), h - 1);
-  const int x1 = std::min(x0 + 1, w - 1), y1 = std::min(y0 + 1, h - 1);
-  const float ax = u - float(x0), ay = v - float(y0);
-  return (1 - ay) * ((1 - ax) * p[std::size_t(y0) * w + x0] + ax * p[std::size_t(y0) * w + x1]) +
-         ay * ((1 - ax) * p[std::size_t(y1) * w + x0] + ax * p[std::size_t(y1) * w + x1]);
-}
-
 // One direction of Listing 7.3 over a w x h low-resolution plane. Taps at +-1.5 and +-3.5 texels read
 // the mean of two texels, as the hardware linear filter does; depth is filtered the same way.
 // `strength` in [0, 1] scales the four side taps (0 leaves the pixel unchanged). Texels are counted by
@@ -246,6 +237,10 @@ void build_cache_grid(DrobotState& s, const FrameContext& f) {
   s.cnx.resize(LN);
   s.cny.resize(LN);
   s.cnz.resize(LN);
+  s.cmx.resize(LN);
+  s.cmy.resize(LN);
+  s.cid.resize(f.id ? LN : 0);
+  const float inv_k = 1.0f / float(k);
   for (int y = 0; y < lh; ++y)
     for (int x = 0; x < lw; ++x) {
       const std::size_t j = std::size_t(y) * lw + x;
@@ -254,97 +249,109 @@ void build_cache_grid(DrobotState& s, const FrameContext& f) {
       s.cnx[j] = f.nx[i];
       s.cny[j] = f.ny[i];
       s.cnz[j] = f.nz[i];
+      // The block centre moves with the motion of its representative pixel: p_prev = p + motion is, in cache
+      // texels (centres at integers), x + motion / k.
+      s.cmx[j] = f.mx[i] * inv_k;
+      s.cmy[j] = f.my[i] * inv_k;
+      if (f.id) s.cid[j] = f.id[i];
     }
 }
 
-Image& run_cache(DrobotState& s, const FrameContext& f, bool have_history, FrameStats& stats) {
+// Listing 7.2's cache-miss test, the paper's own validity test, on top of the reprojection module's rules: 0 where
+// the module's fetch misses (off screen, or no tap of the same surface), else the confidence of the listing: the
+// cache's bilinearly filtered depth at the fetch position (x + mx, y + my) of a w x h depth plane (all four taps,
+// as the listing's hardware filter reads them; reproject::bilinear) against the current depth z, relative.
+inline float cache_confidence(float hit, float z, const float* cached_depth, float x, float y, float mx, float my,
+                              int w, int h, float threshold, float convergence_time) {
+  if (!(hit > 0)) return 0.0f;
+  const float zc = reproject::bilinear(x + mx, y + my, w, h)(cached_depth);
+  return drobot_cache_confidence(z > 0 ? (z - zc) / z : 1.0f, threshold, convergence_time, true);
+}
+
+// Steps 3-5 of the framework for cache row y: this frame's samples accumulated into the reprojected cache HB
+// (Listing 7.2 on the reprojection module's fetch in the cache grid, exponential history with the running
+// convergence). Returns the blocks whose cache hit.
+std::size_t accumulate_cache_row(DrobotState& s, const FrameContext& f, bool history, int y, HistoryRow& h,
+                                 std::vector<float>& fetched) {
   const DrobotOptions& o = s.opt;
-  const int C = f.C, k = f.grid.k, lw = f.lw, lh = f.lh;
-  const std::size_t LN = std::size_t(lw) * lh;
-  Image& out = s.out.next();
-  const int cur = s.out.index(), prv = 1 - cur;
+  const int C = f.C, k = f.grid.k, lw = f.lw, cur = s.out.index(), prv = 1 - cur;
   const float nmax = o.max_frames > 0 ? o.max_frames : float(k * k);
-  for (auto& hv : s.hb_val) {
-    hv.resize(C);
-    for (auto& v : hv) v.resize(LN, 0.0f);
-  }
-  for (auto& v : s.hb_z) v.resize(LN, 0.0f);
-  for (auto& v : s.hb_n) v.resize(LN, 0.0f);
-  s.cb_val.resize(C);
-  s.cb_tmp.resize(C);
-  for (auto& v : s.cb_val) v.resize(LN);
-  for (auto& v : s.cb_tmp) v.resize(LN);
-  s.cb_conf.resize(LN);
-  s.cb_hit.resize(LN);
-  s.cb_w.resize(LN);
-  s.cb_strength.resize(LN);
-  s.cb_avail.resize(LN);
-  s.cb_avail_h.resize(LN);
-  build_cache_grid(s, f);
-  const bool history = have_history && s.hb_z[prv].size() == LN;
-  std::atomic<std::size_t> hits{0};
-
-  // Steps 3-5: CB from this frame's samples and the reprojected HB (Listing 7.2).
-  parallel_rows(lh, [&](int y0, int y1) {
-    std::size_t band_hits = 0;
-    for (int y = y0; y < y1; ++y)
+  const std::size_t row = std::size_t(y) * lw;
+  // The module's fetch in the cache grid: off-screen rule, bilinear taps, per-tap depth / id test; the frame
+  // count and the values are read from the surviving taps.
+  fetched.resize(std::size_t(1 + C) * lw);
+  float* nc = fetched.data();
+  auto fetched_value = [&](int c) { return fetched.data() + std::size_t(1 + c) * lw; };
+  if (history) {
+    reproject::Frames fr;
+    fr.width = lw;
+    fr.height = f.lh;
+    fr.motion_x = s.cmx.data();
+    fr.motion_y = s.cmy.data();
+    fr.z = s.cz.data();
+    fr.prev_z = s.hb_z[prv].data();
+    fr.id = s.cid.empty() ? nullptr : s.cid.data();
+    fr.prev_id = s.hb_id[prv].empty() ? nullptr : s.hb_id[prv].data();
+    fr.test = f.options->surface_test();
+    reproject::reproject_row(fr, y, h);
+    if (o.cache_point) {  // Figure 7.5's point filtering: the surviving tap with the largest weight
       for (int x = 0; x < lw; ++x) {
-        const std::size_t j = std::size_t(y) * lw + x;
-        const int PX = std::min(f.W - 1, k * x + k / 2), PY = std::min(f.H - 1, k * y + k / 2);
-        const std::size_t i = std::size_t(PY) * f.W + PX;
-        const float z = s.cz[j];
-        float conf = 0.0f, n_prev = 0.0f;
-        float u = 0, v = 0;
-        if (history && std::abs(f.mx[i]) < 1e6f && std::abs(f.my[i]) < 1e6f) {
-          // Block centre moved by the motion at its representative pixel, in the previous cache grid.
-          const float cx = float(k * x) + 0.5f * float(k), cy = float(k * y) + 0.5f * float(k);
-          const float px = cx + f.mx[i], py = cy + f.my[i];
-          const bool inside = px >= 0 && py >= 0 && px < float(f.W) && py < float(f.H);
-          u = (px - 0.5f * float(k)) / float(k);
-          v = (py - 0.5f * float(k)) / float(k);
-          const float zc = bilerp(s.hb_z[prv].data(), lw, lh, u, v);  // bilinear depth at discontinuities
-          conf = drobot_cache_confidence(z > 0 ? (z - zc) / z : 1.0f, o.miss_threshold, o.convergence_time, inside);
-          if (o.cache_point) {  // point sampling of the cache: the nearest previous texel
-            u = std::round(u);
-            v = std::round(v);
-          }
-          if (conf > 0) n_prev = bilerp(s.hb_n[prv].data(), lw, lh, u, v);
-        }
-        if (conf > 0) ++band_hits;
-        float n_new = 0.0f;
-        const float w = drobot_convergence_weight(n_prev, conf, nmax, &n_new);
-        // This frame's sample lies at sub-pixel (sx, sy) of the block: it is accumulated only when it shows
-        // the block's surface (same relative-depth test as the cache), so a block straddling a silhouette
-        // does not mix the two surfaces. A non-finite sample never enters the history.
-        const float zs = f.z[std::size_t(k * y + f.grid.sy) * f.W + (k * x + f.grid.sx)];
-        const bool finite = f.lvalid[j] > 0;
-        const bool valid = finite && z > 0 && std::abs(zs - z) <= o.miss_threshold * z;
-        const float n = valid ? n_new : n_prev * conf;
-        for (int c = 0; c < C; ++c) {
-          const float hist = conf > 0 ? bilerp(s.hb_val[prv][c].data(), lw, lh, u, v) : 0.0f;
-          float value = valid ? exponential_history(hist, f.low[c][j], w) : hist;
-          if (n <= 0.0f) value = finite ? f.low[c][j] : 0.0f;  // nothing of this surface yet (filter fills it)
-          s.cb_val[c][j] = value;
-        }
-        s.hb_n[cur][j] = n;
-        s.hb_z[cur][j] = z;
-        s.cb_hit[j] = conf;
-        s.cb_w[j] = n > 0 ? 1.0f : 0.0f;
-        s.cb_conf[j] = std::min(1.0f, n / nmax);  // convergence factor (step 5)
-        s.cb_strength[j] = 1.0f - s.cb_conf[j];
+        int best = 0;
+        for (int t = 1; t < 4; ++t) best = h.w[t][x] > h.w[best][x] ? t : best;
+        const int q = h.q[best][x];
+        nc[x] = s.hb_n[prv][q];
+        for (int c = 0; c < C; ++c) fetched_value(c)[x] = s.hb_val[prv][c][q];
       }
-    hits += band_hits;
-  });
-
-  // Step 6: Listing 7.3, horizontal then vertical, strength 1 - convergence; result is the new HB (step 8).
-  for (int c = 0; c < C; ++c) {
-    bilateral_pass(s.cb_val[c].data(), s.hb_z[cur].data(), s.cb_strength.data(), s.cb_w.data(), lw, lh, true,
-                   o.filter_amp, s.cb_tmp[c].data(), s.cb_avail_h.data());
-    bilateral_pass(s.cb_tmp[c].data(), s.hb_z[cur].data(), s.cb_strength.data(), s.cb_avail_h.data(), lw, lh, false,
-                   o.filter_amp, s.hb_val[cur][c].data(), s.cb_avail.data());
+    } else {
+      const float* src[1 + 16] = {s.hb_n[prv].data()};
+      float* dst[1 + 16] = {nc};
+      for (int c = 0; c < C; ++c) {
+        src[1 + c] = s.hb_val[prv][c].data();
+        dst[1 + c] = fetched_value(c);
+      }
+      reproject::gather_row(h, src, dst, 1 + C, lw);
+    }
+  } else {
+    h.resize(lw);
+    std::fill(h.hit.begin(), h.hit.end(), 0.0f);
   }
+  std::size_t hits = 0;
+  for (int x = 0; x < lw; ++x) {
+    const std::size_t j = row + x;
+    const float z = s.cz[j];
+    const float conf = cache_confidence(h.hit[x], z, s.hb_z[prv].data(), float(x), float(y), s.cmx[j], s.cmy[j], lw,
+                                        f.lh, o.miss_threshold, o.convergence_time);
+    const float n_prev = conf > 0 ? nc[x] : 0.0f;
+    hits += conf > 0 ? 1 : 0;
+    float n_new = 0.0f;
+    const float w = drobot_convergence_weight(n_prev, conf, nmax, &n_new);
+    // This frame's sample lies at sub-pixel (sx, sy) of the block: it is accumulated only when it shows the
+    // block's surface (same relative-depth test as the cache), so a block straddling a silhouette does not mix
+    // the two surfaces. A non-finite sample never enters the history.
+    const float zs = f.z[std::size_t(k * y + f.grid.sy) * f.W + (k * x + f.grid.sx)];
+    const bool finite = f.lvalid[j] > 0;
+    const bool valid = finite && z > 0 && std::abs(zs - z) <= o.miss_threshold * z;
+    const float n = valid ? n_new : n_prev * conf;
+    for (int c = 0; c < C; ++c) {
+      const float hist = conf > 0 ? fetched_value(c)[x] : 0.0f;
+      float value = valid ? exponential_history(hist, f.low[c][j], w) : hist;
+      if (n <= 0.0f) value = finite ? f.low[c][j] : 0.0f;  // nothing of this surface yet (filter fills it)
+      s.cb_val[c][j] = value;
+    }
+    s.hb_n[cur][j] = n;
+    s.hb_z[cur][j] = z;
+    if (!s.cid.empty()) s.hb_id[cur][j] = s.cid[j];
+    s.cb_hit[j] = conf;
+    s.cb_w[j] = n > 0 ? 1.0f : 0.0f;
+    s.cb_conf[j] = std::min(1.0f, n / nmax);  // convergence factor (step 5)
+    s.cb_strength[j] = 1.0f - s.cb_conf[j];
+  }
+  return hits;
+}
 
-  // Step 7: Listing 7.1 upsampling of the filtered CB.
+// Step 7: Listing 7.1 upsampling of the filtered CB (now the cache) from the block centres, and the debug layers.
+void upsample_cache(DrobotState& s, const FrameContext& f, Image& out) {
+  const int C = f.C, k = f.grid.k, lw = f.lw, lh = f.lh, cur = s.out.index();
   const std::vector<float*> planes = payload_planes(out, s.g.channels);
   std::vector<const float*> src;
   for (int c = 0; c < C; ++c) src.push_back(s.hb_val[cur][c].data());
@@ -359,25 +366,107 @@ Image& run_cache(DrobotState& s, const FrameContext& f, bool have_history, Frame
     for (int Y = y0; Y < y1; ++Y) {
       const std::size_t row = std::size_t(Y) * f.W;
       for (int c = 0; c < C; ++c) rows[c] = planes[c] + row;
-      drobot_upsample_row(grid, f, o, Y, src, s.cb_avail.data(), rows.data(), dbg_conf ? dbg_conf + row : nullptr);
-      if (dbg_disocc) {
-        const int ly = std::clamp(Y / k, 0, lh - 1);  // the block the pixel lies in
-        for (int X = 0; X < f.W; ++X) {
-          const std::size_t j = std::size_t(ly) * lw + std::clamp(X / k, 0, lw - 1);
-          dbg_disocc[row + X] = s.cb_hit[j] > 0 ? 0.0f : 1.0f;
-          dbg_conv[row + X] = s.cb_conf[j];
-          dbg_hw[row + X] = s.hb_n[cur][j];
-        }
+      drobot_upsample_row(grid, f, s.opt, Y, src, s.cb_avail.data(), rows.data(), dbg_conf ? dbg_conf + row : nullptr);
+      if (!dbg_disocc) continue;
+      const int ly = std::clamp(Y / k, 0, lh - 1);  // the block the pixel lies in
+      for (int X = 0; X < f.W; ++X) {
+        const std::size_t j = std::size_t(ly) * lw + std::clamp(X / k, 0, lw - 1);
+        dbg_disocc[row + X] = s.cb_hit[j] > 0 ? 0.0f : 1.0f;
+        dbg_conv[row + X] = s.cb_conf[j];
+        dbg_hw[row + X] = s.hb_n[cur][j];
       }
     }
   });
+}
+
+Image& run_cache(DrobotState& s, const FrameContext& f, bool have_history, FrameStats& stats) {
+  const int C = f.C, k = f.grid.k, lw = f.lw, lh = f.lh;
+  const std::size_t LN = std::size_t(lw) * lh;
+  Image& out = s.out.next();
+  const int cur = s.out.index(), prv = 1 - cur;
+  for (auto& hv : s.hb_val) {
+    hv.resize(C);
+    for (auto& v : hv) v.resize(LN, 0.0f);
+  }
+  for (auto& v : s.hb_z) v.resize(LN, 0.0f);
+  for (auto& v : s.hb_n) v.resize(LN, 0.0f);
+  for (auto& v : s.hb_id) v.resize(f.id ? LN : 0, 0u);
+  for (auto* v : {&s.cb_val, &s.cb_tmp}) {
+    v->resize(C);
+    for (auto& p : *v) p.resize(LN);
+  }
+  for (auto* v : {&s.cb_conf, &s.cb_hit, &s.cb_w, &s.cb_strength, &s.cb_avail, &s.cb_avail_h}) v->resize(LN);
+  build_cache_grid(s, f);
+  const bool history = have_history && s.hb_z[prv].size() == LN;
+  std::atomic<std::size_t> hits{0};
+  parallel_rows(lh, [&](int y0, int y1) {
+    thread_local HistoryRow h;
+    thread_local std::vector<float> fetched;
+    std::size_t band_hits = 0;
+    for (int y = y0; y < y1; ++y) band_hits += accumulate_cache_row(s, f, history, y, h, fetched);
+    hits += band_hits;
+  });
+  // Step 6: Listing 7.3, horizontal then vertical, strength 1 - convergence; result is the new HB (step 8).
+  for (int c = 0; c < C; ++c) {
+    bilateral_pass(s.cb_val[c].data(), s.hb_z[cur].data(), s.cb_strength.data(), s.cb_w.data(), lw, lh, true,
+                   s.opt.filter_amp, s.cb_tmp[c].data(), s.cb_avail_h.data());
+    bilateral_pass(s.cb_tmp[c].data(), s.hb_z[cur].data(), s.cb_strength.data(), s.cb_avail_h.data(), lw, lh, false,
+                   s.opt.filter_amp, s.hb_val[cur][c].data(), s.cb_avail.data());
+  }
+  upsample_cache(s, f, out);
   stats.history_pixels = hits * std::size_t(k) * k;
   stats.hole_pixels = (LN - hits) * std::size_t(k) * k;
   return out;
 }
 
-Image& run_refresh(DrobotState& s, const FrameContext& f, bool have_history, FrameStats& stats) {
+// Figure 7.12 for full-resolution row Y: the Listing 7.1 upsampling of the refresh buffer, this frame's samples
+// where it has them, and the history where the reprojection module's fetch hits and Listing 7.2's test passes,
+// blended by its confidence. Returns {holes, hits}.
+std::pair<std::size_t, std::size_t> refresh_row(DrobotState& s, const FrameContext& f, bool history, int Y,
+                                                float* const* rows, const std::vector<const float*>& prev_planes,
+                                                HistoryRow& h, std::vector<float>& fetched, float* dbg_conf,
+                                                float* dbg_disocc, float* dbg_conv) {
   const DrobotOptions& o = s.opt;
+  const int C = f.C, W = f.W;
+  const std::size_t row = std::size_t(Y) * W;
+  // The refresh buffer's samples sit at this frame's jittered positions.
+  const CoarseGrid grid{f.cols, f.rows, f.lz.data(), f.lnx.data(), f.lny.data(), f.lnz.data(),
+                        s.bilinear_table.data()};
+  drobot_upsample_row(grid, f, o, Y, f.low, f.lvalid.data(), rows, dbg_conf ? dbg_conf + row : nullptr);
+  fetched.resize(std::size_t(C) * W);
+  if (history) {
+    history_row(f, s.prev, Y, h);
+    float* dst[16];
+    for (int c = 0; c < C; ++c) dst[c] = fetched.data() + std::size_t(c) * W;
+    reproject::gather_row(h, prev_planes.data(), dst, C, W);
+  } else {
+    h.resize(W);
+    std::fill(h.hit.begin(), h.hit.end(), 0.0f);
+  }
+  const bool row_computed = f.rows.d[Y] == 0;
+  const std::size_t lrow = std::size_t(f.rows.i0[Y]) * f.lw;
+  std::size_t holes = 0, hits = 0;
+  for (int X = 0; X < W; ++X) {
+    float conf = 1.0f;
+    if (row_computed && f.cols.d[X] == 0 && f.lvalid[lrow + f.cols.i0[X]] > 0) {
+      for (int c = 0; c < C; ++c) rows[c][X] = f.low[c][lrow + f.cols.i0[X]];
+    } else {
+      conf = cache_confidence(h.hit[X], f.z[row + X], s.prev.z.data(), float(X), float(Y), f.mx[row + X],
+                              f.my[row + X], W, f.H, o.miss_threshold, o.convergence_time);
+      for (int c = 0; c < C; ++c)
+        if (conf > 0) rows[c][X] += (fetched[std::size_t(c) * W + X] - rows[c][X]) * conf;
+      hits += conf > 0 ? 1 : 0;
+      holes += conf > 0 ? 0 : 1;
+    }
+    if (dbg_disocc) {
+      dbg_disocc[row + X] = conf > 0 ? 0.0f : 1.0f;
+      dbg_conv[row + X] = conf;
+    }
+  }
+  return {holes, hits};
+}
+
+Image& run_refresh(DrobotState& s, const FrameContext& f, bool have_history, FrameStats& stats) {
   const int C = f.C;
   Image& out = s.out.next();
   const std::vector<float*> planes = payload_planes(out, s.g.channels);
@@ -387,51 +476,17 @@ Image& run_refresh(DrobotState& s, const FrameContext& f, bool have_history, Fra
   float* dbg_disocc = f.debug ? out.add_channel("debug.disocclusion") : nullptr;
   float* dbg_conv = f.debug ? out.add_channel("debug.convergence") : nullptr;
   std::atomic<std::size_t> holes{0}, hits{0};
-  // The refresh buffer's samples sit at this frame's jittered positions.
-  const CoarseGrid grid{f.cols, f.rows, f.lz.data(), f.lnx.data(), f.lny.data(), f.lnz.data(),
-                        s.bilinear_table.data()};
   parallel_rows(f.H, [&](int y0, int y1) {
+    thread_local HistoryRow h;
+    thread_local std::vector<float> fetched;
     std::vector<float*> rows(C);
     std::size_t band_holes = 0, band_hits = 0;
     for (int Y = y0; Y < y1; ++Y) {
-      const std::size_t row = std::size_t(Y) * f.W;
-      for (int c = 0; c < C; ++c) rows[c] = planes[c] + row;
-      // Bilateral upsampling of the refresh buffer everywhere first (Listing 7.1) ...
-      drobot_upsample_row(grid, f, o, Y, f.low, f.lvalid.data(), rows.data(), dbg_conf ? dbg_conf + row : nullptr);
-      const bool row_computed = f.rows.d[Y] == 0;
-      const std::size_t lrow = std::size_t(f.rows.i0[Y]) * f.lw;
-      for (int X = 0; X < f.W; ++X) {
-        const std::size_t i = row + X;
-        float conf = 0.0f;
-        if (row_computed && f.cols.d[X] == 0 && f.lvalid[lrow + f.cols.i0[X]] > 0) {
-          // ... the refresh buffer where it has the pixel ...
-          for (int c = 0; c < C; ++c) planes[c][i] = f.low[c][lrow + f.cols.i0[X]];
-          conf = 1.0f;
-        } else if (history && std::abs(f.mx[i]) < 1e6f && std::abs(f.my[i]) < 1e6f) {
-          // ... and the history where the reprojection cache hits (Listing 7.2 test, bilinear depth).
-          const float px = float(X) + 0.5f + f.mx[i], py = float(Y) + 0.5f + f.my[i];
-          const bool inside = px >= 0 && py >= 0 && px < float(f.W) && py < float(f.H);
-          const float u = px - 0.5f, v = py - 0.5f;
-          const float zc = bilerp(s.prev.z.data(), f.W, f.H, u, v);
-          const float z = f.z[i];
-          conf = drobot_cache_confidence(z > 0 ? (z - zc) / z : 1.0f, o.miss_threshold, o.convergence_time, inside);
-          if (conf > 0) {
-            ++band_hits;
-            for (int c = 0; c < C; ++c) {
-              const float hist = bilerp(prev_planes[c], f.W, f.H, u, v);
-              planes[c][i] += (hist - planes[c][i]) * conf;
-            }
-          } else {
-            ++band_holes;
-          }
-        } else {
-          ++band_holes;
-        }
-        if (dbg_disocc) {
-          dbg_disocc[i] = conf > 0 ? 0.0f : 1.0f;
-          dbg_conv[i] = conf;
-        }
-      }
+      for (int c = 0; c < C; ++c) rows[c] = planes[c] + std::size_t(Y) * f.W;
+      const auto [ho, hi] =
+          refresh_row(s, f, history, Y, rows.data(), prev_planes, h, fetched, dbg_conf, dbg_disocc, dbg_conv);
+      band_holes += ho;
+      band_hits += hi;
     }
     holes += band_holes;
     hits += band_hits;
@@ -463,6 +518,7 @@ void DrobotState::save(Image& state) const {
     put_plane(state, "cache." + g.channels[c], hb_val[cur][c].data(), g.lw, g.lh);
   put_plane(state, "cache.depth", hb_z[cur].data(), g.lw, g.lh);
   put_plane(state, "cache.frames", hb_n[cur].data(), g.lw, g.lh);
+  if (!hb_id[cur].empty()) put_uint_plane(state, "cache.id", hb_id[cur].data(), g.lw, g.lh);
 }
 
 Status DrobotState::load(const Image& state) {
@@ -482,18 +538,27 @@ Status DrobotState::load(const Image& state) {
   hb_z[cur].resize(LN);
   hb_n[cur].resize(LN);
   if (Status s = get_plane(state, "cache.depth", hb_z[cur].data(), g.lw, g.lh); !s) return s;
-  return get_plane(state, "cache.frames", hb_n[cur].data(), g.lw, g.lh);
+  if (Status s = get_plane(state, "cache.frames", hb_n[cur].data(), g.lw, g.lh); !s) return s;
+  hb_id[cur].clear();
+  if (!state.uint_plane("cache.id")) return Status::ok();
+  hb_id[cur].resize(LN);
+  return get_uint_plane(state, "cache.id", hb_id[cur].data(), g.lw, g.lh);
 }
 
-std::vector<LayerNeed> layers(const Options&) { return {{"depth"}, {"N"}, {"motion"}}; }
+// The history fetch's disocclusion test compares material ids unless --no-ids.
+std::vector<LayerNeed> layers(const Options& o) {
+  std::vector<LayerNeed> l = {{"depth"}, {"N"}, {"motion"}};
+  if (!o.no_ids) l.push_back({"id"});
+  return l;
+}
 
 std::size_t streamed_bytes(const Options& o, int W, int H, int k, int C) {
   const std::size_t full = std::size_t(W) * H * 4, low = full / (std::size_t(k) * k);
   std::size_t b = 4 * full + C * low + C * full;  // depth + N, payload in, payload out
   if (drobot_options(o).refresh())
-    b += 2 * full + 2 * full + C * full;  // motion, previous depth read and written, history read
+    b += 2 * full + full + 2 * (2 * full) + C * full;  // motion, id; previous depth and id read and written; history
   else
-    b += 2 * full / (std::size_t(k) * k) + 2 * (C + 2) * low;  // motion at the blocks, low-res cache read and written
+    b += 3 * low + 2 * (C + 3) * low;  // motion and id at the blocks; low-res cache (values, depth, count, id) r+w
   return b;
 }
 
