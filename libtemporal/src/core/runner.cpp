@@ -169,6 +169,7 @@ Status check_gbuffer_layers(const Image& g, const std::vector<LayerNeed>& needs,
     if (!ok) {
       std::string how = "; render the G-buffer with render-gbuffer --outputs gbuffer";
       if (need.layer == "id" && g.has_channel("id")) how = "; `id` must be stored as uint32 (render-gbuffer writes it so)";
+      if (!need.alternative.empty()) how += " (" + need.alternative + ")";
       return Error::input(path, "no layer '" + need.layer + "' (have: " + join(g.channel_names()) + ")" + how);
     }
   }

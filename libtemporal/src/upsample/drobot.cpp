@@ -548,7 +548,7 @@ Status DrobotState::load(const Image& state) {
 // The history fetch's disocclusion test compares material ids unless --no-ids.
 std::vector<LayerNeed> layers(const Options& o) {
   std::vector<LayerNeed> l = {{"depth"}, {"N"}, {"motion"}};
-  if (!o.no_ids) l.push_back({"id"});
+  if (!o.no_ids) l.push_back({"id", true, "or pass --no-ids"});
   return l;
 }
 

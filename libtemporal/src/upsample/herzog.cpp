@@ -915,7 +915,7 @@ Image& HerzogState::run(const FrameContext& f, bool history, FrameStats& stats) 
 
 std::vector<LayerNeed> layers(const Options& o) {
   std::vector<LayerNeed> l = {{"depth"}, {"N"}, {"motion"}};
-  if (!o.no_ids) l.push_back({"id"});
+  if (!o.no_ids) l.push_back({"id", true, "or pass --no-ids"});
   return l;
 }
 

@@ -24,7 +24,7 @@ UpsampleStage::UpsampleStage(Options options) : upsampler_(std::move(options)) {
   const Options& o = upsampler_.options();
   inputs_.input_layers = split_layers(o.layer);
   if (const MethodEntry* e = find_entry(o.method)) inputs_.gbuffer_layers = e->layers(o);
-  if (o.demodulate) inputs_.gbuffer_layers.push_back({"albedo"});
+  if (o.demodulate) inputs_.gbuffer_layers.push_back({"albedo", true, "needed by --demodulate"});
   inputs_.gbuffer_required = true;
   inputs_.gbuffer_purpose = "the geometry of the joint-bilateral weights and the motion of the history fetch";
   inputs_.gbuffer_scale = 0;  // k from the input's temporal:jitterFactor

@@ -143,7 +143,7 @@ class TemporalState : public MethodState {
 
 std::vector<LayerNeed> layers(const Options& o) {
   std::vector<LayerNeed> l = {{"depth"}, {"N"}, {"motion"}};
-  if (!o.no_ids) l.push_back({"id"});
+  if (!o.no_ids) l.push_back({"id", true, "or pass --no-ids"});
   return l;
 }
 

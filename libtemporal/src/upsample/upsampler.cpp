@@ -80,18 +80,10 @@ Status Upsampler::Impl::validate(const Image& gbuffer, const Image& low, std::sp
   const Options& o = options;
   const std::string& gname = names.gbuffer;
   const std::string& lname = names.input;
-  for (const std::string& layer : gbuffer_layers(o)) {
-    bool ok = false;
-    if (layer == "id") ok = gbuffer.uint_plane("id") != nullptr;
-    else if (layer == "depth") ok = gbuffer.plane("depth.Z") != nullptr;
-    else if (layer == "N") ok = gbuffer.plane("N.X") && gbuffer.plane("N.Y") && gbuffer.plane("N.Z");
-    else if (layer == "albedo") ok = gbuffer.plane("albedo.R") && gbuffer.plane("albedo.G") && gbuffer.plane("albedo.B");
-    else ok = gbuffer.plane("motion.X") && gbuffer.plane("motion.Y");
-    if (!ok)
-      return Error::input(gname, "no layer '" + layer + "' (have: " + join(gbuffer.channel_names()) +
-                                     "); render the G-buffer with render-gbuffer --outputs gbuffer" +
-                                     (layer == "id" ? " (or pass --no-ids)" : ""));
-  }
+  // The runner's checks and messages (temporal/core/runner.h), for callers of the library too.
+  std::vector<LayerNeed> needs = entry->layers(o);
+  if (o.demodulate) needs.push_back({"albedo", true, "needed by --demodulate"});
+  if (Status s = check_gbuffer_layers(gbuffer, needs, gname); !s) return s;
   if (channels.empty()) return Error::input(lname, "no payload channels selected");
   if (channels.size() > 16)
     return Error::usage("at most 16 payload channels per run (" + std::to_string(channels.size()) +
