@@ -129,6 +129,13 @@ TEST(UpsampleCli, StateFilesResumeBitIdentically) {
       // The resumed run does not restart its history: the header says so.
       EXPECT_FALSE(b->metadata().camera_cut.value_or(false)) << v.name << " frame " << frame;
     }
+    // A state resumed at a frame other than the next one is refused (its history belongs to frame 2).
+    EXPECT_EQ(temporal::test::run_command(base + args + " --out " + (dir / "x.####.exr").string() +
+                                              " --frames 4-5 --state-in " + state,
+                                          &output),
+              1)
+        << output;
+    EXPECT_NE(output.find("--frames 3-"), std::string::npos) << output;
     // A state of another method is refused with exit code 1 and names both methods.
     const std::string other = v.method == "temporal" ? "herzog" : "temporal";
     EXPECT_EQ(temporal::test::run_command(base + " --method " + other + " --out " + (dir / "x.####.exr").string() +

@@ -122,8 +122,8 @@ double max_difference(const up::Options& o, const std::vector<Frame>& frames) {
 // Payload values are in [0, 1]. The fast kernels differ from the plain loops by float rounding only: reordered
 // sums and products, FMA, fast_exp2 for herzog's kernel powers (relative error < 2e-6), pow(dot, 32) by squaring and
 // a division instead of a reciprocal in drobot's Listing 7.1. Measured on this project's AVX-512 machine (GCC 12,
-// -march=native): at most 3.6e-7 for spatial, temporal and herzog, and 3.6e-6 for drobot, whose Listing 7.2
-// confidence multiplies depth roundings by IN_ConvergenceTime (50); the tolerances leave a factor of 14-30 for other
+// -march=native): at most 3.6e-7 for spatial, temporal and herzog, and 5.2e-6 for drobot, whose Listing 7.2
+// confidence multiplies depth roundings by IN_ConvergenceTime (50); the tolerances leave a factor of 10-30 for other
 // CPUs and compilers. A wrong weight, tap or rule gives differences of 1e-3 to 1 (the payload is random): drobot's
 // fetch before it used the reprojection module differed from this plain version by up to 0.94.
 double tolerance(const std::string& method) {

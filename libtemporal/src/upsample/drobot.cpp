@@ -257,15 +257,31 @@ void build_cache_grid(DrobotState& s, const FrameContext& f) {
     }
 }
 
-// Listing 7.2's cache-miss test, the paper's own validity test, on top of the reprojection module's rules: 0 where
-// the module's fetch misses (off screen, or no tap of the same surface), else the confidence of the listing: the
-// cache's bilinearly filtered depth at the fetch position (x + mx, y + my) of a w x h depth plane (all four taps,
-// as the listing's hardware filter reads them; reproject::bilinear) against the current depth z, relative.
-inline float cache_confidence(float hit, float z, const float* cached_depth, float x, float y, float mx, float my,
-                              int w, int h, float threshold, float convergence_time) {
-  if (!(hit > 0)) return 0.0f;
-  const float zc = reproject::bilinear(x + mx, y + my, w, h)(cached_depth);
-  return drobot_cache_confidence(z > 0 ? (z - zc) / z : 1.0f, threshold, convergence_time, true);
+// Listing 7.2's cache-miss test, the paper's own validity test, on top of the reprojection module's rules. First
+// the listing's cached depth for one row of n pixels: the bilinear filter of the previous depth plane at the fetch
+// position (x + mx, y + my) over all four taps, edges repeated (reproject::bilinear's value: the listing's hardware
+// filter reads every tap, whatever surface it shows). The taps are those of `h` (reproject_row: the same clamped
+// indices); a loop that vectorises. Pixels whose fetch missed get a value that is not used.
+void listing72_depth_row(const HistoryRow& h, const float* __restrict prev_z, const float* __restrict mx,
+                         const float* __restrict my, int y, int n, float* __restrict out) {
+  const int* __restrict q0 = h.q[0].data();
+  const int* __restrict q1 = h.q[1].data();
+  const int* __restrict q2 = h.q[2].data();
+  const int* __restrict q3 = h.q[3].data();
+  const float fy = float(y);
+#pragma GCC ivdep
+  for (int x = 0; x < n; ++x) {
+    const float u = float(x) + mx[x], v = fy + my[x];
+    const float tx = u - reproject::floor_vec(u), ty = v - reproject::floor_vec(v);
+    out[x] = (1.0f - tx) * (1.0f - ty) * prev_z[q0[x]] + tx * (1.0f - ty) * prev_z[q1[x]] +
+             (1.0f - tx) * ty * prev_z[q2[x]] + tx * ty * prev_z[q3[x]];
+  }
+}
+
+// Then the confidence: 0 where the module's fetch misses (off screen, or no tap of the same surface), else
+// 1 - saturate((|z - zc| / z - threshold) * convergenceTime) (drobot.h).
+inline float cache_confidence(float hit, float z, float zc, float threshold, float convergence_time) {
+  return hit > 0 ? drobot_cache_confidence(z > 0 ? (z - zc) / z : 1.0f, threshold, convergence_time, true) : 0.0f;
 }
 
 // Steps 3-5 of the framework for cache row y: this frame's samples accumulated into the reprojected cache HB
@@ -279,9 +295,10 @@ std::size_t accumulate_cache_row(DrobotState& s, const FrameContext& f, bool his
   const std::size_t row = std::size_t(y) * lw;
   // The module's fetch in the cache grid: off-screen rule, bilinear taps, per-tap depth / id test; the frame
   // count and the values are read from the surviving taps.
-  fetched.resize(std::size_t(1 + C) * lw);
+  fetched.resize(std::size_t(2 + C) * lw);
   float* nc = fetched.data();
-  auto fetched_value = [&](int c) { return fetched.data() + std::size_t(1 + c) * lw; };
+  float* zc = nc + lw;
+  auto fetched_value = [&](int c) { return fetched.data() + std::size_t(2 + c) * lw; };
   if (history) {
     reproject::Frames fr;
     fr.width = lw;
@@ -311,6 +328,7 @@ std::size_t accumulate_cache_row(DrobotState& s, const FrameContext& f, bool his
       }
       reproject::gather_row(h, src, dst, 1 + C, lw);
     }
+    listing72_depth_row(h, s.hb_z[prv].data(), s.cmx.data() + row, s.cmy.data() + row, y, lw, zc);
   } else {
     h.resize(lw);
     std::fill(h.hit.begin(), h.hit.end(), 0.0f);
@@ -319,8 +337,7 @@ std::size_t accumulate_cache_row(DrobotState& s, const FrameContext& f, bool his
   for (int x = 0; x < lw; ++x) {
     const std::size_t j = row + x;
     const float z = s.cz[j];
-    const float conf = cache_confidence(h.hit[x], z, s.hb_z[prv].data(), float(x), float(y), s.cmx[j], s.cmy[j], lw,
-                                        f.lh, o.miss_threshold, o.convergence_time);
+    const float conf = cache_confidence(h.hit[x], z, zc[x], o.miss_threshold, o.convergence_time);
     const float n_prev = conf > 0 ? nc[x] : 0.0f;
     hits += conf > 0 ? 1 : 0;
     float n_new = 0.0f;
@@ -433,12 +450,14 @@ std::pair<std::size_t, std::size_t> refresh_row(DrobotState& s, const FrameConte
   const CoarseGrid grid{f.cols, f.rows, f.lz.data(), f.lnx.data(), f.lny.data(), f.lnz.data(),
                         s.bilinear_table.data()};
   drobot_upsample_row(grid, f, o, Y, f.low, f.lvalid.data(), rows, dbg_conf ? dbg_conf + row : nullptr);
-  fetched.resize(std::size_t(C) * W);
+  fetched.resize(std::size_t(1 + C) * W);
+  float* zc = fetched.data();
   if (history) {
     history_row(f, s.prev, Y, h);
     float* dst[16];
-    for (int c = 0; c < C; ++c) dst[c] = fetched.data() + std::size_t(c) * W;
+    for (int c = 0; c < C; ++c) dst[c] = fetched.data() + std::size_t(1 + c) * W;
     reproject::gather_row(h, prev_planes.data(), dst, C, W);
+    listing72_depth_row(h, s.prev.z.data(), f.mx + row, f.my + row, Y, W, zc);
   } else {
     h.resize(W);
     std::fill(h.hit.begin(), h.hit.end(), 0.0f);
@@ -451,10 +470,9 @@ std::pair<std::size_t, std::size_t> refresh_row(DrobotState& s, const FrameConte
     if (row_computed && f.cols.d[X] == 0 && f.lvalid[lrow + f.cols.i0[X]] > 0) {
       for (int c = 0; c < C; ++c) rows[c][X] = f.low[c][lrow + f.cols.i0[X]];
     } else {
-      conf = cache_confidence(h.hit[X], f.z[row + X], s.prev.z.data(), float(X), float(Y), f.mx[row + X],
-                              f.my[row + X], W, f.H, o.miss_threshold, o.convergence_time);
+      conf = cache_confidence(h.hit[X], f.z[row + X], zc[X], o.miss_threshold, o.convergence_time);
       for (int c = 0; c < C; ++c)
-        if (conf > 0) rows[c][X] += (fetched[std::size_t(c) * W + X] - rows[c][X]) * conf;
+        if (conf > 0) rows[c][X] += (fetched[std::size_t(1 + c) * W + X] - rows[c][X]) * conf;
       hits += conf > 0 ? 1 : 0;
       holes += conf > 0 ? 0 : 1;
     }

@@ -30,8 +30,19 @@ UpsampleStage::UpsampleStage(Options options) : upsampler_(std::move(options)) {
   inputs_.gbuffer_scale = 0;  // k from the input's temporal:jitterFactor
 }
 
+Status UpsampleStage::load_state(const Image& state) {
+  if (Status s = upsampler_.load_state(state); !s) return s;
+  resume_after_ = state.metadata().frame;
+  return Status::ok();
+}
+
 Status UpsampleStage::process(const StageFrame& frame, std::vector<StageOutput>& out) {
   const Options& o = upsampler_.options();
+  if (resume_after_ && frame.index == 0 && frame.frame != *resume_after_ + 1)
+    return Error::usage("the state of --state-in was written after frame " + std::to_string(*resume_after_) +
+                        ", but this run starts at frame " + std::to_string(frame.frame) + ": resume with --frames " +
+                        std::to_string(*resume_after_ + 1) + "-..., or drop --state-in");
+  resume_after_.reset();
   auto channels = select_channels(*frame.input, o.layer, frame.input_path);
   if (!channels) return channels.error();
   auto result = upsampler_.process(*frame.gbuffer, *frame.input, *channels, frame.cut, &last_,

@@ -1,7 +1,9 @@
-// Regression helper for optimisation work (not a test): runs every upsampling method on synthetic sequences
-// (the benchmark's 1280x1024 pan; small scenes with a moving object and per-frame G-buffers, debug layers on,
-// k = 4, 3 (odd width) and 2 (gradient scale 4)) and writes every output float to FILE (`write FILE`), or compares against FILE
-// (`check FILE`), printing the largest absolute and relative differences per method.
+// Regression helper for optimisation work on one machine (not a test: float bits differ across CPUs with
+// -march=native and FMA; tests/upsample/reference_test.cpp is the check CTest runs): runs the variants of kNames
+// (the method table's, in the order of the file) on synthetic sequences (the benchmark's 1280x1024 pan; small
+// scenes with a moving object and per-frame G-buffers, debug layers on, k = 4, 3 (odd width) and 2 (gradient
+// scale 4)) and writes every output float to FILE (`write FILE`), or compares against FILE (`check FILE`), printing
+// the largest absolute and relative differences per variant ("max abs 0": bit-identical).
 #include "synthetic.h"
 #include "upsample_variants.h"
 

@@ -7,6 +7,7 @@
 #include "temporal/core/runner.h"
 #include "temporal/upsample/upsample.h"
 
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -24,7 +25,8 @@ class UpsampleStage : public FrameStage {
   Status process(const StageFrame& frame, std::vector<StageOutput>& out) override;
   bool has_state() const override { return upsampler_.has_state(); }
   Expected<Image> save_state() const override { return upsampler_.save_state(); }
-  Status load_state(const Image& state) override { return upsampler_.load_state(state); }
+  // Also remembers the frame the state was written after: the first frame of the run must be the next one.
+  Status load_state(const Image& state) override;
   std::string frame_summary() const override;
 
   // Sums over the frames processed so far.
@@ -33,6 +35,7 @@ class UpsampleStage : public FrameStage {
  private:
   Upsampler upsampler_;
   StageInputs inputs_;
+  std::optional<int> resume_after_;  // frame of a loaded state, until the first frame is processed
   FrameStats last_, totals_;
 };
 
