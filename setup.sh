@@ -15,6 +15,8 @@ PACKAGES=(
   libvtk9-dev xvfb xauth
   libtbb-dev libcli11-dev libfmt-dev
   libgtest-dev libgmock-dev libbenchmark-dev
+  snakemake slurm-wlm munge python3
+  clang-14 libclang-rt-14-dev
 )
 
 say() { printf 'setup.sh: %s\n' "$*" >&2; }

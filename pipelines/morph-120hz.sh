@@ -10,8 +10,8 @@
 # Usage: pipelines/morph-120hz.sh [BUILD_DIR] [OUT_DIR] [SCENE.glb ...]
 #   BUILD_DIR  default build/release;  OUT_DIR  default report/morph-120hz
 #   SCENE      default: every assets/scenes/*.glb
-# Environment: SIZE (default 256x256), FRAMES (rendered 40 Hz frames, default 8), METHODS (default
-#   "didyk repeat blend warp"), FFMPEG=0 to skip minterpolate.
+# Environment: SIZE (default 256x256), FRAMES (rendered 40 Hz frames, default 8), METHODS (default: every
+#   method of the registry, `morph-120hz --list-methods`), FFMPEG=0 to skip minterpolate.
 set -euo pipefail
 
 ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
@@ -20,7 +20,6 @@ OUT=${2:-report/morph-120hz}
 shift $(( $# >= 2 ? 2 : $# ))
 SIZE=${SIZE:-256x256}
 FRAMES=${FRAMES:-8}
-METHODS=${METHODS:-"didyk repeat blend warp"}
 FACTOR=3
 
 case "$BUILD" in /*) ;; *) BUILD="$ROOT/$BUILD" ;; esac
@@ -34,6 +33,8 @@ for t in "$RENDER" "$MORPH" "$COMPARE"; do
   fi
 done
 if (( FRAMES < 2 )); then echo "morph-120hz.sh: FRAMES must be at least 2" >&2; exit 1; fi
+# The methods come from the tool's registry (one name and a tab-separated summary per line).
+METHODS=${METHODS:-$("$MORPH" --list-methods | cut -f1 | tr '\n' ' ')}
 
 if (( $# > 0 )); then SCENES=("$@"); else SCENES=("$ROOT"/assets/scenes/*.glb); fi
 if [[ ! -e "${SCENES[0]}" ]]; then

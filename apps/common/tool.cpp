@@ -1,9 +1,13 @@
 #include "tool.h"
 
+#include "temporal/core/atomic_file.h"
 #include "temporal/core/parallel.h"
+
+#include <signal.h>
 
 #include <unistd.h>
 
+#include <csignal>
 #include <cstdio>
 #include <iostream>
 #include <optional>
@@ -14,6 +18,16 @@
 #endif
 
 namespace temporal::tool {
+
+namespace {
+// SIGINT / SIGTERM: remove the temporary files of outputs being written (they would otherwise stay behind as
+// hidden `.NAME.tmpPID.exr` files), then die of the same signal.
+extern "C" void on_termination(int sig) {
+  remove_temporary_files();
+  std::signal(sig, SIG_DFL);
+  std::raise(sig);
+}
+}  // namespace
 
 int exit_code_for(const Error& error) {
   switch (error.kind) {
@@ -28,7 +42,8 @@ int exit_code_for(const Error& error) {
 Tool::Tool(std::string name, std::string description) : name_(std::move(name)), app_(std::move(description), name_) {
   app_.option_defaults()->always_capture_default();
   app_.set_version_flag("--version", std::string(name_) + " " TEMPORAL_VERSION);
-  app_.add_option("--threads", threads_, "Worker threads; 0 uses every core")->check(CLI::NonNegativeNumber);
+  app_.add_option("--threads", threads_, "Worker threads; 0 uses every core")
+      ->check(CLI::Range(0, 1024).description("in 0..1024"));
   app_.add_flag("--verbose", verbose_, "Print what the tool does to stderr");
   app_.footer(
       "Exit codes: 0 success, 1 usage error, 2 input error, 3 threshold failed, 4 output error, 5 internal error.\n"
@@ -44,10 +59,14 @@ void Tool::add_params(const ParamList& params) {
     std::visit(
         [&](auto* v) {
           using T = std::remove_pointer_t<decltype(v)>;
-          if constexpr (std::is_same_v<T, bool>)
-            app_.add_flag(p.flag, *v, help);
-          else
+          if constexpr (std::is_same_v<T, bool>) {
+            if (p.inverted)
+              app_.add_flag_callback(p.flag, [v] { *v = false; }, help);  // --no-snap: clears a default-on field
+            else
+              app_.add_flag(p.flag, *v, help);
+          } else {
             app_.add_option(p.flag, *v, help);
+          }
         },
         p.value);
     params_.push_back(p);
@@ -104,6 +123,12 @@ int Tool::run(int argc, char** argv, const std::function<Status()>& body) {
     print_error(s.error());
     std::cerr << name_ << ": run `" << name_ << " --help` for the options\n";
     return kExitUsage;
+  }
+  for (int sig : {SIGINT, SIGTERM, SIGHUP}) {
+    struct sigaction action {};
+    action.sa_handler = on_termination;
+    sigemptyset(&action.sa_mask);
+    sigaction(sig, &action, nullptr);
   }
   std::optional<ThreadLimit> limit;
   if (threads_ > 0) limit.emplace(threads_);

@@ -1,6 +1,6 @@
-// compare: per-frame PSNR, SSIM and flicker of test sequences against a reference, as CSV, JSON, error-map EXRs
-// and VTK plots, with pass/fail thresholds for pipelines. The metrics live in libtemporal (temporal/metrics/comparison.h);
-// docs/compare.md defines them.
+// compare: per-frame PSNR, SSIM, flicker and (with --flip) FLIP of test sequences against a reference, as CSV,
+// JSON, error-map EXRs and VTK plots, with pass/fail thresholds for pipelines. The metrics and their registry
+// live in libtemporal (temporal/metrics/comparison.h); docs/compare.md defines them. This file binds options.
 #include "tool.h"
 
 #include "temporal/metrics/comparison.h"
@@ -9,54 +9,40 @@
 #include <cmath>
 #include <cstdio>
 #include <iostream>
+#include <map>
 #include <optional>
-#include <sstream>
 #include <string>
 #include <vector>
-
-namespace {
-
-std::vector<std::string> split_names(const std::string& text) {
-  std::vector<std::string> names;
-  std::stringstream in(text);
-  std::string item;
-  while (std::getline(in, item, ',')) names.push_back(item);
-  return names;
-}
-
-std::string show(double v, const char* format) {
-  if (std::isnan(v)) return "-";
-  if (std::isinf(v)) return v > 0 ? "inf" : "-inf";
-  char text[64];
-  std::snprintf(text, sizeof text, format, v);
-  return text;
-}
-
-}  // namespace
 
 int main(int argc, char** argv) {
   using namespace temporal;
   tool::Tool tool("compare",
                   "Measures test sequences against a reference, frame by frame: PSNR (all compared channels and "
-                  "luminance), SSIM (Wang et al. 2004, on luminance) and temporal instability (flicker: RMS "
+                  "luminance), SSIM (Wang et al. 2004, on luminance), temporal instability (flicker: RMS "
                   "difference between the test's and the reference's frame-to-frame change, motion-compensated "
-                  "with --gbuffer). Writes a per-frame CSV, a JSON summary, error-map EXRs and PNG charts.\n"
+                  "with --gbuffer) and, with --flip, FLIP (Andersson et al. 2020, 2021). Writes a per-frame CSV, a "
+                  "JSON summary, error-map EXRs and PNG charts.\n"
                   "Typical use: compare --reference REF.####.exr TEST.####.exr [TEST2.####.exr ...] [--names a,b] "
                   "--csv F.csv --json F.json --plot F.png");
   auto& app = tool.app();
 
   ComparisonSetup setup;
-  std::string names, csv, json, plot, frames, peak = "1";
-  std::optional<double> fail_psnr, fail_ssim, fail_flicker;
+  std::string csv, json, plot, frames, peak = "1";
   std::string fail_on = "mean";
-  app.add_option("--reference", setup.reference, "Reference sequence, e.g. ref.####.exr")->required();
-  app.add_option("tests", setup.tests, "Test sequences (one or more), e.g. taa.####.exr phlm.####.exr")->required();
-  app.add_option("--names", names, "Comma-separated names of the test sequences (default: file names)");
+  std::vector<std::string> merge;
+  app.add_option("--reference", setup.reference, "Reference sequence, e.g. ref.####.exr (not with --merge)");
+  app.add_option("tests", setup.tests, "Test sequences (one or more), e.g. taa.####.exr phlm.####.exr");
+  app.add_option("--merge", merge,
+                 "Instead of comparing: merge per-shard CSVs of one comparison (disjoint --frames ranges) into "
+                 "--csv/--json/--plot; the means and intervals equal a single run's exactly")
+      ->excludes("--reference");
+  app.add_option("--names", setup.names, "Comma-separated names of the test sequences (default: file names)")
+      ->delimiter(',')->default_str("");
   app.add_option("--csv", csv, "Per-frame metrics CSV to write");
   app.add_option("--json", json, "JSON summary to write (mean/min/max per sequence, thresholds)");
   app.add_option("--plot", plot,
-                 "PNG charts: F.png (PSNR per frame), F-psnr-y.png, F-ssim.png, F-flicker.png, F-speed.png "
-                 "(PSNR against the compute time found in the test headers)");
+                 "PNG charts: F.png (PSNR per frame), F-psnr-y.png, F-ssim.png, F-flicker.png, F-flip.png (with "
+                 "--flip), F-speed.png (PSNR against the compute time found in the test headers)");
   app.add_option("--gbuffer", setup.gbuffer,
                  "G-buffer sequence with `motion` (at the reference's size): motion-compensated flicker");
   app.add_option("--mask", setup.mask,
@@ -66,22 +52,44 @@ int main(int argc, char** argv) {
   app.add_option("--reference-layer", setup.reference_layer,
                  "Layer of the reference to compare with (default: same as --layer), e.g. reference");
   app.add_option("--error-maps", setup.error_maps,
-                 "Folder for error-map EXRs NAME.####.exr (error.R/G/B/Y, error.ssim, error.flicker, error.invalid)");
+                 "Folder for error-map EXRs NAME.####.exr (error.R/G/B/Y, error.ssim, error.flicker, error.flip "
+                 "with --flip, error.invalid)");
   app.add_option("--frames", frames, "Frames A-B (default: every reference frame on disk)");
+  app.add_option("--warmup", setup.warmup_frames,
+                 "The first N frames are summarised apart from the steady state (JSON `warmup`, `steady`)")
+      ->check(CLI::Range(0, 1000000));
   app.add_option("--peak", peak,
                  "Peak value L for PSNR and SSIM, in pixel units; `max` = idiff's rule per frame (largest value, "
                  "at least 1)");
-  app.add_option("--fail-psnr", fail_psnr, "Exit 3 when a sequence's PSNR (dB) is below this");
-  app.add_option("--fail-ssim", fail_ssim, "Exit 3 when a sequence's SSIM is below this");
-  app.add_option("--fail-flicker", fail_flicker, "Exit 3 when a sequence's flicker is above this");
+  const std::map<std::string, FlipMode> flip_modes = {{"off", FlipMode::Off}, {"ldr", FlipMode::Ldr}, {"hdr", FlipMode::Hdr}};
+  app.add_option("--flip", setup.flip,
+                 "FLIP per frame: off; ldr = LDR-FLIP of the display-encoded frames (sRGB of the values clamped to "
+                 "[0,1]); hdr = HDR-FLIP of the scene-linear values (ACES, automatic exposures). Off by default: it "
+                 "costs about as much as PSNR and SSIM together (LDR) or more (HDR)")
+      ->transform(CLI::CheckedTransformer(flip_modes).description(""))
+      ->type_name("off|ldr|hdr")
+      ->default_str(flip_mode_name(setup.flip));
+  app.add_option("--ppd", setup.flip_options.pixels_per_degree,
+                 "FLIP's viewing condition in pixels per degree of visual angle (default: 0.7 m from a 0.7 m wide "
+                 "3840-pixel screen)");
+  // One --fail-<option> per registry metric that has a threshold.
+  std::map<std::string, std::optional<double>> fail;
+  std::string fail_list;
+  for (const auto& d : metric_registry()) {
+    if (d.threshold_option.empty()) continue;
+    app.add_option("--fail-" + d.threshold_option, fail[d.name], d.threshold_help);
+    fail_list += (fail_list.empty() ? "--fail-" : ", --fail-") + d.threshold_option;
+  }
+  bool fail_nonfinite = false;
+  app.add_flag("--fail-nonfinite", fail_nonfinite,
+               "Exit 3 when a test frame holds NaN/Inf pixels or values whose squared error overflows (PSNR -inf)");
   app.add_option("--fail-on", fail_on, "What the thresholds judge: each sequence's mean over frames, or its worst frame")
       ->check(CLI::IsMember({"mean", "worst"}));
-  app.footer(
-      "Exit codes: 0 success (thresholds passed), 1 usage error, 2 input error (missing, corrupt or mismatched "
-      "files, missing layers), 3 a threshold (--fail-psnr, --fail-ssim, --fail-flicker) failed, 4 output error (including plots that cannot be "
-      "drawn: CSV and JSON are still written), 5 internal error.\n"
-      "Without DISPLAY, compare starts its own Xvfb for the plots (--verbose says so). Definitions: "
-      "docs/compare.md; conventions: docs/conventions.md");
+  app.footer("Exit codes: 0 success (thresholds passed), 1 usage error, 2 input error (missing, corrupt or mismatched "
+             "files, missing layers), 3 a threshold (" + fail_list + ") failed, 4 output error (including plots that "
+             "cannot be drawn: CSV and JSON are still written), 5 internal error.\n"
+             "Without DISPLAY, compare starts its own Xvfb for the plots (--verbose says so). Definitions: "
+             "docs/compare.md; conventions: docs/conventions.md");
 
   bool threshold_failed = false;
   const int code = tool.run(argc, argv, [&]() -> Status {
@@ -98,22 +106,30 @@ int main(int argc, char** argv) {
       if (end == peak.c_str() || *end != '\0' || !(setup.peak > 0.0) || !std::isfinite(setup.peak))
         return Error::usage("--peak '" + peak + "' is not a positive number or `max`");
     }
-    if (!names.empty()) setup.names = split_names(names);
     setup.tool = tool.signature();
     setup.parameters = tool.command_line();
+    Thresholds thresholds;
+    thresholds.worst_frame = fail_on == "worst";
+    thresholds.nonfinite = fail_nonfinite;
+    for (const auto& [metric, limit] : fail)
+      if (limit) thresholds.limits[metric] = *limit;
+    if (auto st = check_threshold_setup(setup, thresholds); !st) return st;
 
-    ComparisonHooks hooks;
-    std::optional<tool::Progress> progress;
-    hooks.frame_done = [&](int frame, int, int total) {
-      if (!progress) progress.emplace("compare", total);
-      progress->step(frame);
-    };
-    hooks.warning = [&](const std::string& file, const std::string& text) { tool.print_warning(file, text); };
-    hooks.log = [&](const std::string& text) { tool.log(text); };
-    auto report = compare_sequences(setup, hooks);
+    if (merge.empty() && (setup.reference.empty() || setup.tests.empty()))
+      return Error::usage("give --reference REF.####.exr and at least one test sequence (or --merge A.csv B.csv ...)");
+    // No output may replace a file this run reads (error maps are checked by the engine).
+    ProtectedInputs inputs;
+    if (merge.empty()) {
+      auto found = comparison_inputs(setup);
+      if (!found) return found.error();
+      inputs = std::move(*found);
+    }
+    for (const auto& m : merge) inputs.add(m);
+    for (const auto& [path, option] : {std::pair{csv, "--csv"}, std::pair{json, "--json"}, std::pair{plot, "--plot"}})
+      if (!path.empty())
+        if (auto st = inputs.check(path, option); !st) return st;
+    auto report = merge.empty() ? compare_sequences(setup, tool.hooks()) : merge_comparison_csvs(merge, setup);
     if (!report) return report.error();
-
-    Thresholds thresholds{fail_psnr, fail_ssim, fail_flicker, fail_on == "worst"};
     const auto failures = check_thresholds(*report, thresholds);
 
     std::optional<Error> output_error;
@@ -124,19 +140,7 @@ int main(int argc, char** argv) {
     if (!csv.empty()) keep(write_comparison_csv(*report, csv));
     if (!json.empty())
       keep(write_comparison_json(*report, thresholds, failures, tool.signature(), tool.command_line(), json));
-
-    // Summary table on stdout.
-    std::printf("%-20s %7s %10s %10s %9s %11s %11s\n", "sequence", "frames", "psnr_rgb", "psnr_y", "ssim", "flicker",
-                "compute_ms");
-    for (const auto& s : report->sequences) {
-      const auto ms = mean_compute_ms(s);
-      std::printf("%-20s %7zu %10s %10s %9s %11s %11s\n", s.name.c_str(), s.frames.size(),
-                  show(summarize(s, Metric::PsnrRgb).mean, "%.3f").c_str(),
-                  show(summarize(s, Metric::PsnrY).mean, "%.3f").c_str(),
-                  show(summarize(s, Metric::Ssim).mean, "%.5f").c_str(),
-                  show(summarize(s, Metric::Flicker).mean, "%.5g").c_str(),
-                  ms ? show(*ms, "%.3f").c_str() : "-");
-    }
+    std::fputs(summary_table(*report).c_str(), stdout);
     std::fflush(stdout);
 
     if (!plot.empty()) {
@@ -146,6 +150,7 @@ int main(int argc, char** argv) {
       } else {
         if (display->started()) tool.log("DISPLAY is not usable: started Xvfb on " + display->display() + " for the plots");
         for (const auto& [path, chart] : comparison_charts(*report, plot)) {
+          if (auto st = inputs.check(path, "--plot"); !st) return st;
           keep(write_chart_png(chart, path));
           tool.log("wrote " + path);
         }

@@ -237,7 +237,7 @@ void GltfBuilder::animate(int node, const std::string& path, const std::vector<f
   animation_.channels.push_back(ch);
 }
 
-std::vector<unsigned char> GltfBuilder::glb() {
+tinygltf::Model GltfBuilder::model() const {
   tinygltf::Model model = model_;
   if (!animation_.channels.empty()) {
     tinygltf::Animation a = animation_;
@@ -245,6 +245,11 @@ std::vector<unsigned char> GltfBuilder::glb() {
     model.animations.push_back(a);
   }
   model.buffers[0].data = buffer_;
+  return model;
+}
+
+std::vector<unsigned char> GltfBuilder::glb() {
+  tinygltf::Model model = this->model();
   std::ostringstream out;
   tinygltf::TinyGLTF writer;
   writer.WriteGltfSceneToStream(&model, out, false, true);

@@ -91,6 +91,8 @@ class GltfBuilder {
                const std::string& interpolation = "LINEAR");
   void set_clip_name(const std::string& name) { clip_name_ = name; }
 
+  // The assembled model (animation and buffer included), as .glb() writes it.
+  tinygltf::Model model() const;
   // Serialises to .glb bytes.
   std::vector<unsigned char> glb();
 

@@ -1,9 +1,11 @@
-// scene-generator: writes the project's built-in scenes (assets/scenes/*.glb).
-//   scene-generator OUT_DIR [NAME...]   writes OUT_DIR/NAME.glb for the named scenes (all when none)
+// scene-generator: writes the project's built-in scenes (assets/scenes), each as glTF and as text USD.
+//   scene-generator OUT_DIR [NAME...]   writes OUT_DIR/NAME.glb, OUT_DIR/NAME.usda and OUT_DIR/textures/NAME.*.png
+//                                       for the named scenes (all when none)
 //   scene-generator --list              lists the scenes
 // The output is byte-for-byte reproducible (see gltf_builder.h); tests/scene checks that the committed
 // files are what this program writes.
 #include "scenes.h"
+#include "usda_writer.h"
 
 #include <algorithm>
 #include <cstdio>
@@ -11,6 +13,27 @@
 #include <fstream>
 #include <string>
 #include <vector>
+
+namespace {
+
+// Writes through a temporary file and a rename, so an interrupted run leaves no truncated file.
+bool write_file(const std::filesystem::path& path, const void* data, std::size_t size) {
+  const auto tmp = std::filesystem::path(path.string() + ".tmp");
+  {
+    std::ofstream out(tmp, std::ios::binary);
+    out.write(static_cast<const char*>(data), static_cast<std::streamsize>(size));
+    if (!out) {
+      std::fprintf(stderr, "scene-generator: %s: cannot write\n", tmp.string().c_str());
+      return false;
+    }
+  }
+  std::error_code ec;
+  std::filesystem::rename(tmp, path, ec);
+  if (ec) std::fprintf(stderr, "scene-generator: %s: %s\n", path.string().c_str(), ec.message().c_str());
+  return !ec;
+}
+
+}  // namespace
 
 int main(int argc, char** argv) {
   const std::vector<std::string> args(argv + 1, argv + argc);
@@ -24,7 +47,7 @@ int main(int argc, char** argv) {
   }
   const std::filesystem::path out_dir = args[0];
   std::error_code ec;
-  std::filesystem::create_directories(out_dir, ec);
+  std::filesystem::create_directories(out_dir / "textures", ec);
   std::vector<std::string> wanted(args.begin() + 1, args.end());
   for (const auto& name : wanted) {
     bool known = false;
@@ -39,23 +62,19 @@ int main(int argc, char** argv) {
     scenegen::GltfBuilder builder;
     r.build(builder);
     const std::vector<unsigned char> bytes = builder.glb();
-    const auto path = out_dir / (r.name + ".glb");
-    const auto tmp = out_dir / (r.name + ".glb.tmp");
-    {
-      std::ofstream out(tmp, std::ios::binary);
-      out.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
-      if (!out) {
-        std::fprintf(stderr, "scene-generator: %s: cannot write\n", tmp.string().c_str());
-        return 4;
-      }
+    if (!write_file(out_dir / (r.name + ".glb"), bytes.data(), bytes.size())) return 4;
+    std::vector<scenegen::TextureFile> textures;
+    std::string error;
+    const std::string usda = scenegen::write_usda(builder.model(), r.name, textures, error);
+    if (usda.empty()) {
+      std::fprintf(stderr, "scene-generator: %s: cannot write it as USD: %s\n", r.name.c_str(), error.c_str());
+      return 5;
     }
-    std::filesystem::rename(tmp, path, ec);
-    if (ec) {
-      std::fprintf(stderr, "scene-generator: %s: %s\n", path.string().c_str(), ec.message().c_str());
-      return 4;
-    }
-    std::printf("%-11s %7zu triangles %8zu bytes  %s\n", r.name.c_str(), builder.triangle_count(), bytes.size(),
-                path.string().c_str());
+    if (!write_file(out_dir / (r.name + ".usda"), usda.data(), usda.size())) return 4;
+    for (const auto& t : textures)
+      if (!write_file(out_dir / t.path, t.png.data(), t.png.size())) return 4;
+    std::printf("%-11s %7zu triangles %8zu bytes .glb %8zu bytes .usda + %zu textures  %s\n", r.name.c_str(),
+                builder.triangle_count(), bytes.size(), usda.size(), textures.size(), (out_dir / r.name).string().c_str());
   }
   return 0;
 }

@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Whole-tool regression check for refactors (not run by CTest: it takes a few minutes). Renders two built-in
 # scenes at 128x96, runs every method of every tool on them, and writes every output under DIR (`record`),
-# or runs the same commands again and requires the pixels of every EXR (all parts, idiff -a, tolerance 0) and
+# or runs the same commands again (into a temporary folder) and requires the pixels of every EXR (all parts, idiff -a, tolerance 0) and
 # every metric of compare's CSV (timing columns dropped) to equal the recorded ones (`check`).
 #
 # Usage: tests/golden/tool_outputs.sh record|check DIR [BUILD_DIR]     (BUILD_DIR default: build/ci)
@@ -14,9 +14,14 @@ case "$build" in /*) ;; *) build="$PWD/$build" ;; esac
 case "$dir" in /*) ;; *) dir="$PWD/$dir" ;; esac
 bin="$build/apps"
 out="$dir"
-[[ "$mode" == check ]] && out="$dir.check"
-rm -rf "$out"
-mkdir -p "$out"
+if [[ "$mode" == check ]]; then
+  # A fresh folder per run: several checks may run at once on one machine.
+  out="$(mktemp -d "${TMPDIR:-/tmp}/tool_outputs.XXXXXX")"
+  trap 'rm -rf "$out"' EXIT
+else
+  rm -rf "$out"
+  mkdir -p "$out"
+fi
 
 render() { "$bin/render-gbuffer/render-gbuffer" "$@" >/dev/null; }
 up() { "$bin/upsample-st/upsample-st" "$@"; }
@@ -67,8 +72,13 @@ strip_csv() {
 import csv, sys
 rows = list(csv.reader(open(sys.argv[1])))
 keep = [i for i, h in enumerate(rows[0]) if not (h.endswith("_ms") or h.startswith("ms_") or h == "metrics_ms")]
+def norm(x):  # 8 significant digits: compare wrote %.8g before it wrote round-trip digits
+    try:
+        return x if x in ("", "inf", "-inf") else "%.8g" % float(x)
+    except ValueError:
+        return x
 for r in rows:
-    print(",".join(r[i] for i in keep if i < len(r)))
+    print(",".join(norm(r[i]) for i in keep if i < len(r)))
 PY
 }
 

@@ -12,6 +12,7 @@
 #include <array>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <random>
 #include <sstream>
 
@@ -93,11 +94,11 @@ TEST_F(CompareCli, WritesCsvJsonAndPngWithoutDisplay) {
   const bool have_xvfb = test::run_command("command -v Xvfb >/dev/null") == 0;
   std::string out;
   const int code = run("--reference ref.####.exr a.####.exr b.####.exr --names good,noisy --csv m.csv --json m.json "
-                       "--plot plots/p.png --verbose", &out);
+                       "--plot plots/p.png --verbose --flip ldr", &out);
   if (have_xvfb) {
     EXPECT_EQ(code, 0) << out;
     EXPECT_NE(out.find("started Xvfb"), std::string::npos) << out;  // said only with --verbose
-    for (const char* name : {"p.png", "p-psnr-y.png", "p-ssim.png", "p-flicker.png", "p-speed.png"})
+    for (const char* name : {"p.png", "p-psnr-y.png", "p-ssim.png", "p-flicker.png", "p-flip.png", "p-speed.png"})
       EXPECT_TRUE(is_png(dir_ / "plots" / name, 1280, 720)) << out;
   } else {
     // No Xvfb: a clear error and exit 4, but CSV and JSON are written.
@@ -120,7 +121,7 @@ TEST_F(CompareCli, WritesCsvJsonAndPngWithoutDisplay) {
     EXPECT_TRUE(j.contains(key)) << key;
   ASSERT_EQ(j["sequences"].size(), 2u);
   EXPECT_EQ(j["sequences"][0]["name"], "good");
-  for (const char* key : {"psnr_rgb", "psnr_y", "ssim", "flicker"}) {
+  for (const char* key : {"psnr_rgb", "psnr_y", "ssim", "flicker", "flip"}) {
     EXPECT_TRUE(j["sequences"][1][key].contains("mean")) << key;
     EXPECT_TRUE(j["sequences"][1][key].contains("min")) << key;
   }
@@ -155,6 +156,19 @@ TEST_F(CompareCli, ThresholdsGiveExitThree) {
   EXPECT_EQ(j["failures"][0]["sequence"], "b");
   EXPECT_EQ(run("--reference ref.####.exr a.####.exr --fail-ssim 0.9999", &out), 3) << out;
   EXPECT_EQ(run("--reference ref.####.exr b.####.exr --fail-flicker 0.001 --fail-on worst", &out), 3) << out;
+  // FLIP: noise of 0.1 is clearly visible, 0.02 much less; the stdout table gains a flip column.
+  EXPECT_EQ(run("--reference ref.####.exr a.####.exr b.####.exr --flip ldr --fail-flip 0.9", &out), 0) << out;
+  EXPECT_NE(out.find("flip"), std::string::npos) << out;
+  EXPECT_EQ(run("--reference ref.####.exr a.####.exr b.####.exr --flip hdr --ppd 30 --fail-flip 0.001", &out), 3) << out;
+  EXPECT_NE(out.find("b: flip"), std::string::npos) << out;
+}
+
+TEST_F(CompareCli, FlipOptionErrorsAreUsageErrors) {
+  std::string out;
+  EXPECT_EQ(run("--reference ref.####.exr a.####.exr --fail-flip 0.1", &out), 1) << out;  // FLIP is off
+  EXPECT_NE(out.find("--flip ldr"), std::string::npos) << out;
+  EXPECT_EQ(run("--reference ref.####.exr a.####.exr --flip sometimes", &out), 1) << out;
+  EXPECT_EQ(run("--reference ref.####.exr a.####.exr --flip ldr --ppd 0", &out), 1) << out;
 }
 
 TEST_F(CompareCli, ExitCodesForUsageErrors) {
@@ -185,12 +199,12 @@ TEST_F(CompareCli, HelpListsEveryOptionAndEachIsAccepted) {
   ASSERT_EQ(run("--version", &version), 0);
   EXPECT_NE(version.find("compare "), std::string::npos);
   // Every option documented in --help, fed to the parser in one run (without --plot to stay fast).
-  const std::array<std::pair<const char*, const char*>, 19> options = {{
+  const std::array<std::pair<const char*, const char*>, 22> options = {{
       {"--reference", "ref.####.exr"}, {"--names", "one"}, {"--csv", "all.csv"}, {"--json", "all.json"},
       {"--gbuffer", "g.####.exr"}, {"--mask", "R"}, {"--layer", "rgb"}, {"--reference-layer", "rgb"},
-      {"--error-maps", "maps"}, {"--frames", "1-2"}, {"--peak", "max"}, {"--fail-psnr", "1"},
-      {"--fail-ssim", "0"}, {"--fail-flicker", "100"}, {"--fail-on", "worst"}, {"--threads", "1"},
-      {"--verbose", ""}, {"--plot", ""}, {"--help", ""}}};
+      {"--error-maps", "maps"}, {"--frames", "1-2"}, {"--peak", "max"}, {"--flip", "ldr"}, {"--ppd", "50"},
+      {"--fail-psnr", "1"}, {"--fail-ssim", "0"}, {"--fail-flicker", "100"}, {"--fail-flip", "1"},
+      {"--fail-on", "worst"}, {"--threads", "1"}, {"--verbose", ""}, {"--plot", ""}, {"--help", ""}}};
   std::string args;
   for (const auto& [name, value] : options) {
     EXPECT_NE(help.find(name), std::string::npos) << name << " is not in --help";
@@ -199,12 +213,93 @@ TEST_F(CompareCli, HelpListsEveryOptionAndEachIsAccepted) {
   }
   EXPECT_NE(help.find("Exit codes"), std::string::npos);
   EXPECT_NE(help.find("--peak TEXT=1"), std::string::npos) << "--peak default not shown";
+  EXPECT_NE(help.find("=off"), std::string::npos) << "--flip default not shown";
+  EXPECT_NE(help.find("67.0206"), std::string::npos) << "--ppd default not shown";
   std::string out;
   EXPECT_EQ(run(args + " a.####.exr", &out), 0) << args << "\n" << out;
   EXPECT_TRUE(fs::exists(dir_ / "maps" / "one.0002.exr"));
   EXPECT_FALSE(fs::exists(dir_ / "maps" / "one.0003.exr"));  // --frames 1-2
   const auto csv = read_text(dir_ / "all.csv");
   EXPECT_NE(csv.find("psnr_rgb_in_db"), std::string::npos);  // --mask columns
+  EXPECT_NE(csv.find("flip_in"), std::string::npos);         // FLIP's, with --flip and --mask
+  auto maps = read_exr((dir_ / "maps" / "one.0002.exr").string());
+  ASSERT_TRUE(maps) << maps.error().message;
+  EXPECT_NE(maps->plane("error.flip"), nullptr);
+}
+
+// Issue 11: no output replaces an input (exit 1, nothing changed), overflowing values are reported and can fail
+// the run, non-finite thresholds are usage errors; and the JSON carries intervals and paired differences.
+TEST_F(CompareCli, BadRunsLoseNothingAndOverflowIsReported) {
+  auto checksum = [&] {
+    std::string all;
+    for (const char* f : {"ref.0001.exr", "a.0001.exr", "a.0002.exr", "b.0003.exr", "g.0001.exr"}) all += read_text(dir_ / f);
+    return std::hash<std::string>{}(all);
+  };
+  const auto before = checksum();
+  std::string out;
+  for (const std::string args : {"--csv ref.0001.exr", "--json a.0002.exr", "--plot a.0003.exr",
+                                 "--error-maps . --names a", "--error-maps ./ --names x,b"}) {
+    const std::string tests = args.find("x,b") != std::string::npos ? " a.####.exr b.####.exr" : " a.####.exr";
+    EXPECT_EQ(run("--reference ref.####.exr" + tests + " --gbuffer g.####.exr " + args, &out), 1) << args << out;
+    EXPECT_NE(out.find("one of this run's inputs"), std::string::npos) << out;
+  }
+  EXPECT_EQ(run("--reference ref.####.exr a.####.exr --fail-psnr nan", &out), 1) << out;
+  EXPECT_EQ(checksum(), before);
+  // A broken output with huge finite values: PSNR -inf, said per frame; --fail-nonfinite turns it into exit 3.
+  auto a2 = read_exr((dir_ / "a.0002.exr").string());
+  ASSERT_TRUE(a2);
+  a2->plane("G")[100] = 1e30f;
+  ASSERT_TRUE(write_exr((dir_ / "c.0001.exr").string(), *a2));
+  ASSERT_TRUE(write_exr((dir_ / "c.0002.exr").string(), *a2));
+  ASSERT_TRUE(write_exr((dir_ / "c.0003.exr").string(), *a2));
+  EXPECT_EQ(run("--reference ref.####.exr c.####.exr", &out), 0) << out;
+  EXPECT_NE(out.find("is -inf"), std::string::npos) << out;
+  EXPECT_EQ(run("--reference ref.####.exr c.####.exr --fail-nonfinite", &out), 3) << out;
+  EXPECT_NE(out.find("3 frames"), std::string::npos) << out;
+  // Intervals and paired differences in the JSON.
+  ASSERT_EQ(run("--reference ref.####.exr a.####.exr b.####.exr --warmup 1 --json s.json", &out), 0) << out;
+  const auto j = nlohmann::json::parse(read_text(dir_ / "s.json"));
+  const auto& psnr = j["sequences"][0]["psnr_rgb"];
+  ASSERT_TRUE(psnr["ci95"].is_array());
+  EXPECT_LE(psnr["ci95"][0].get<double>(), psnr["mean"].get<double>());
+  EXPECT_GE(psnr["ci95"][1].get<double>(), psnr["mean"].get<double>());
+  EXPECT_EQ(psnr["steady"]["frames"].get<int>(), 2);
+  bool found = false;
+  for (const auto& p : j["paired"])
+    if (p["a"] == "a" && p["b"] == "b" && p["metric"] == "psnr_rgb") {
+      found = true;
+      EXPECT_GT(p["mean_difference"].get<double>(), 5.0);  // noise 0.02 against 0.1: about 14 dB apart
+      EXPECT_GT(p["ci95"][0].get<double>(), 0.0);
+    }
+  EXPECT_TRUE(found);
+}
+
+// Issue 14: a comparison run as shards (disjoint --frames ranges) and merged gives exactly the single run's
+// means and intervals; each shard primes its first frame's flicker from the frame before it.
+TEST_F(CompareCli, ShardsMergeIntoTheSingleRunExactly) {
+  std::string out;
+  const std::string common = "--reference ref.####.exr a.####.exr b.####.exr --gbuffer g.####.exr --warmup 1";
+  ASSERT_EQ(run(common + " --json whole.json --csv whole.csv", &out), 0) << out;
+  ASSERT_EQ(run(common + " --frames 1-1 --csv s1.csv", &out), 0) << out;
+  ASSERT_EQ(run(common + " --frames 2-3 --csv s2.csv", &out), 0) << out;
+  const auto s2 = read_text(dir_ / "s2.csv");  // shown when a mean differs
+  ASSERT_EQ(run("--merge s2.csv s1.csv --warmup 1 --json merged.json --csv merged.csv", &out), 0) << out;
+  const auto whole = nlohmann::json::parse(read_text(dir_ / "whole.json"));
+  const auto merged = nlohmann::json::parse(read_text(dir_ / "merged.json"));
+  ASSERT_EQ(whole["sequences"].size(), merged["sequences"].size());
+  for (std::size_t s = 0; s < whole["sequences"].size(); ++s)
+    for (const char* m : {"psnr_rgb", "psnr_y", "ssim", "flicker"}) {
+      const auto& w = whole["sequences"][s][m];
+      const auto& g = merged["sequences"][s][m];
+      EXPECT_EQ(w["frames"], g["frames"]) << m;
+      EXPECT_EQ(w["mean"], g["mean"]) << m << " " << s2;  // exactly, not approximately
+      EXPECT_EQ(w["ci95"], g["ci95"]) << m;
+      EXPECT_EQ(w["steady"], g["steady"]) << m;
+    }
+  EXPECT_EQ(whole["paired"], merged["paired"]);
+  // Overlapping shards are refused.
+  EXPECT_EQ(run("--merge s1.csv whole.csv --json x.json", &out), 2) << out;
+  EXPECT_NE(out.find("two shards"), std::string::npos) << out;
 }
 
 }  // namespace

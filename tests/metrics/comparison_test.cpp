@@ -3,6 +3,7 @@
 #include "temporal/metrics/comparison.h"
 #include "temporal/core/exr.h"
 #include "temporal/core/image.h"
+#include "temporal/metrics/flip.h"
 
 #include "test_support.h"
 
@@ -15,6 +16,7 @@
 #include <filesystem>
 #include <fstream>
 #include <random>
+#include <set>
 #include <sstream>
 
 namespace temporal {
@@ -80,7 +82,7 @@ TEST(Comparison, PsnrMatchesIdiffWithinUnitRange) {
   setup.tests = {pattern(dir, "test")};
   auto report = compare_sequences(setup);
   ASSERT_TRUE(report) << report.error().message;
-  const double ours = report->sequences[0].frames[0].psnr_rgb;
+  const double ours = report->sequences[0].frames[0].value("psnr_rgb");
   const double theirs = idiff_psnr(rp, tp);
   ASSERT_FALSE(std::isnan(theirs));
   EXPECT_GT(ours, 20.0);
@@ -102,12 +104,12 @@ TEST(Comparison, PeakMaxMatchesIdiffOnHdrData) {
   ASSERT_TRUE(report);
   const auto& f = report->sequences[0].frames[0];
   EXPECT_GT(f.peak, 3.9);
-  EXPECT_NEAR(f.psnr_rgb, idiff_psnr(rp, tp), 1e-3);
+  EXPECT_NEAR(f.value("psnr_rgb"), idiff_psnr(rp, tp), 1e-3);
   // The default fixed peak of 1 gives 20 log10(peak) dB less.
   setup.peak_from_data = false;
   auto fixed = compare_sequences(setup);
   ASSERT_TRUE(fixed);
-  EXPECT_NEAR(f.psnr_rgb - fixed->sequences[0].frames[0].psnr_rgb, 20.0 * std::log10(f.peak), 1e-6);
+  EXPECT_NEAR(f.value("psnr_rgb") - fixed->sequences[0].frames[0].value("psnr_rgb"), 20.0 * std::log10(f.peak), 1e-6);
 }
 
 TEST(Comparison, HandComputedPsnrAndFlicker) {
@@ -129,15 +131,14 @@ TEST(Comparison, HandComputedPsnrAndFlicker) {
   ASSERT_TRUE(report) << report.error().message;
   const auto& frames = report->sequences[0].frames;
   ASSERT_EQ(frames.size(), 3u);
-  EXPECT_NEAR(frames[0].psnr_rgb, 10.0 * std::log10(300.0), 1e-4);
-  EXPECT_NEAR(frames[0].psnr_y, -20.0 * std::log10(0.1 * 0.2126), 1e-4);
-  EXPECT_FALSE(frames[0].flicker.has_value());  // no previous frame
-  ASSERT_TRUE(frames[1].flicker.has_value());
-  EXPECT_NEAR(*frames[1].flicker, 0.2 * 0.2126, 1e-6);
-  EXPECT_NEAR(*frames[2].flicker, 0.2 * 0.2126, 1e-6);
+  EXPECT_NEAR(frames[0].value("psnr_rgb"), 10.0 * std::log10(300.0), 1e-4);
+  EXPECT_NEAR(frames[0].value("psnr_y"), -20.0 * std::log10(0.1 * 0.2126), 1e-4);
+  EXPECT_TRUE(std::isnan(frames[0].value("flicker")));  // no previous frame
+  EXPECT_NEAR(frames[1].value("flicker"), 0.2 * 0.2126, 1e-6);
+  EXPECT_NEAR(frames[2].value("flicker"), 0.2 * 0.2126, 1e-6);
   // Constant images: SSIM is the luminance term of Wang et al. eq. 13 for Y_test vs Y_ref = 0.5.
   const double yt = 0.5 + 0.1 * 0.2126, yr = 0.5, c1 = 1e-4;
-  EXPECT_NEAR(frames[0].ssim, (2 * yt * yr + c1) / (yt * yt + yr * yr + c1), 1e-6);
+  EXPECT_NEAR(frames[0].value("ssim"), (2 * yt * yr + c1) / (yt * yt + yr * yr + c1), 1e-6);
 }
 
 TEST(Comparison, IdenticalSequencesGiveInfinitePsnrZeroFlickerAndNoNan) {
@@ -153,12 +154,11 @@ TEST(Comparison, IdenticalSequencesGiveInfinitePsnrZeroFlickerAndNoNan) {
   auto report = compare_sequences(setup);
   ASSERT_TRUE(report);
   for (const auto& f : report->sequences[0].frames) {
-    EXPECT_TRUE(std::isinf(f.psnr_rgb) && f.psnr_rgb > 0);
-    EXPECT_TRUE(std::isinf(f.psnr_y) && f.psnr_y > 0);
-    EXPECT_NEAR(f.ssim, 1.0, 1e-9);
+    EXPECT_TRUE(std::isinf(f.value("psnr_rgb")) && f.value("psnr_rgb") > 0);
+    EXPECT_TRUE(std::isinf(f.value("psnr_y")) && f.value("psnr_y") > 0);
+    EXPECT_NEAR(f.value("ssim"), 1.0, 1e-9);
     if (f.frame > 0) {
-      ASSERT_TRUE(f.flicker.has_value());
-      EXPECT_EQ(*f.flicker, 0.0);
+      EXPECT_EQ(f.value("flicker"), 0.0);
     }
   }
   const auto csv = (dir / "m.csv").string(), json = (dir / "m.json").string();
@@ -200,15 +200,18 @@ TEST(Comparison, MaskSplitsInsideAndOutside) {
   const auto& f = report->sequences[0].frames[1];
   EXPECT_TRUE(f.has_mask);
   EXPECT_NEAR(f.mask_fraction, 0.5, 1e-12);
-  EXPECT_TRUE(std::isinf(f.psnr_rgb_outside));
-  EXPECT_NEAR(f.psnr_rgb_inside, 10.0 * std::log10(300.0), 1e-3);  // MSE 0.01 / 3 inside
-  EXPECT_NEAR(f.psnr_rgb, 10.0 * std::log10(600.0), 1e-3);         // half the pixels: MSE halves
+  const MetricSample& psnr = *f.sample("psnr_rgb");
+  const MetricSample& ssim = *f.sample("ssim");
+  const MetricSample& flicker = *f.sample("flicker");
+  EXPECT_TRUE(std::isinf(psnr.outside));
+  EXPECT_NEAR(psnr.inside, 10.0 * std::log10(300.0), 1e-3);     // MSE 0.01 / 3 inside
+  EXPECT_NEAR(psnr.values[0], 10.0 * std::log10(600.0), 1e-3);  // half the pixels: MSE halves
   // Windows centred outside but reaching into the mask see some error; those inside all do.
-  EXPECT_GT(f.ssim_outside, 0.999);
-  EXPECT_LT(f.ssim_outside, 1.0);
-  EXPECT_LT(f.ssim_inside, 1.0 - 1e-4);
-  ASSERT_TRUE(f.flicker_inside && f.flicker_outside);
-  EXPECT_NEAR(*f.flicker_inside, 0.0, 1e-6);  // a stable error does not flicker
+  EXPECT_GT(ssim.outside, 0.999);
+  EXPECT_LT(ssim.outside, 1.0);
+  EXPECT_LT(ssim.inside, 1.0 - 1e-4);
+  ASSERT_FALSE(std::isnan(flicker.inside) || std::isnan(flicker.outside));
+  EXPECT_NEAR(flicker.inside, 0.0, 1e-6);  // a stable error does not flicker
 }
 
 TEST(Comparison, MotionCompensatedFlickerWithGbuffer) {
@@ -246,13 +249,12 @@ TEST(Comparison, MotionCompensatedFlickerWithGbuffer) {
   auto comp = compare_sequences(setup);
   ASSERT_TRUE(comp) << comp.error().message;
   EXPECT_TRUE(comp->motion_compensated);
-  ASSERT_TRUE(comp->sequences[0].frames[2].flicker);
-  EXPECT_NEAR(*comp->sequences[0].frames[2].flicker, 0.0, 1e-6);
-  EXPECT_EQ(comp->sequences[0].frames[2].flicker_pixels, std::size_t((w - 2) * h));
+  EXPECT_NEAR(comp->sequences[0].frames[2].value("flicker"), 0.0, 1e-6);
+  EXPECT_EQ(comp->sequences[0].frames[2].sample("flicker")->count, std::size_t((w - 2) * h));
   setup.gbuffer.clear();
   auto plain = compare_sequences(setup);
   ASSERT_TRUE(plain);
-  EXPECT_GT(*plain->sequences[0].frames[2].flicker, 0.02);
+  EXPECT_GT(plain->sequences[0].frames[2].value("flicker"), 0.02);
 }
 
 TEST(Comparison, ReferenceLayerAndCameraCut) {
@@ -275,10 +277,9 @@ TEST(Comparison, ReferenceLayerAndCameraCut) {
   ASSERT_TRUE(report) << report.error().message;
   EXPECT_EQ(report->reference_channels, (std::vector<std::string>{"reference.R", "reference.G", "reference.B"}));
   const auto& frames = report->sequences[0].frames;
-  EXPECT_NEAR(frames[0].psnr_rgb, 10.0 * std::log10(300.0), 1e-4);  // R differs by 0.1, G and B agree
-  EXPECT_FALSE(frames[1].flicker.has_value());
-  ASSERT_TRUE(frames[2].flicker.has_value());
-  EXPECT_EQ(*frames[2].flicker, 0.0);
+  EXPECT_NEAR(frames[0].value("psnr_rgb"), 10.0 * std::log10(300.0), 1e-4);  // R differs by 0.1, G and B agree
+  EXPECT_TRUE(std::isnan(frames[1].value("flicker")));
+  EXPECT_EQ(frames[2].value("flicker"), 0.0);
   // A layer with another channel count is an input error naming both layers.
   setup.reference_layer.clear();
   setup.layer = "rgb";
@@ -323,10 +324,9 @@ TEST(Comparison, NonFinitePixelsAreCountedAndExcluded) {
   const auto& f = report->sequences[0].frames[1];
   EXPECT_EQ(f.nonfinite_test, 2u);
   EXPECT_EQ(f.valid_pixels, 254u);
-  EXPECT_NEAR(f.psnr_rgb, 10.0 * std::log10(300.0), 1e-4);  // the remaining pixels: error 0.1 on G
-  EXPECT_TRUE(std::isfinite(f.ssim));
-  ASSERT_TRUE(f.flicker);
-  EXPECT_NEAR(*f.flicker, 0.0, 1e-7);
+  EXPECT_NEAR(f.value("psnr_rgb"), 10.0 * std::log10(300.0), 1e-4);  // the remaining pixels: error 0.1 on G
+  EXPECT_TRUE(std::isfinite(f.value("ssim")));
+  EXPECT_NEAR(f.value("flicker"), 0.0, 1e-7);
   // The error map marks the excluded pixels and holds no NaN.
   auto map = read_exr((dir / "maps" / "t.0001.exr").string());
   ASSERT_TRUE(map) << map.error().message;
@@ -344,26 +344,210 @@ TEST(Comparison, ThresholdsJudgeMeanOrWorstFrame) {
   for (int f = 0; f < 3; ++f) {
     FrameMetrics m;
     m.frame = f;
-    m.psnr_rgb = f == 1 ? 25.0 : 35.0;  // mean 31.67, worst 25
-    m.ssim = 0.9;
-    if (f > 0) m.flicker = 0.01 * f;  // mean 0.015, worst 0.02
+    m.ensure_sample("psnr_rgb").values = {f == 1 ? 25.0 : 35.0};  // mean 31.67, worst 25
+    m.ensure_sample("ssim").values = {0.9};
+    m.ensure_sample("flicker").values = {f > 0 ? 0.01 * f : kNoValue};  // mean 0.015, worst 0.02
     s.frames.push_back(m);
   }
   report.sequences.push_back(s);
+  report.metrics = {"psnr_rgb", "psnr_y", "ssim", "flicker"};
   Thresholds th;
-  th.psnr = 30.0;
+  th.limits["psnr_rgb"] = 30.0;
   EXPECT_TRUE(check_thresholds(report, th).empty());
   th.worst_frame = true;
   auto fails = check_thresholds(report, th);
   ASSERT_EQ(fails.size(), 1u);
-  EXPECT_EQ(fails[0].metric, Metric::PsnrRgb);
+  EXPECT_EQ(fails[0].metric, "psnr_rgb");
+  EXPECT_EQ(fails[0].message(), "taa: psnr_rgb 25 dB < limit 30 dB");
   EXPECT_EQ(fails[0].value, 25.0);
   th = {};
-  th.flicker = 0.012;
-  th.ssim = 0.95;
+  th.limits["flicker"] = 0.012;
+  th.limits["ssim"] = 0.95;
   fails = check_thresholds(report, th);
   ASSERT_EQ(fails.size(), 2u);
+  EXPECT_EQ(fails[0].metric, "ssim");  // registry order
   EXPECT_NEAR(fails[1].value, 0.015, 1e-12);
+  EXPECT_EQ(fails[1].message(), "taa: flicker 0.015 > limit 0.012");
+}
+
+// --- The metric registry and FLIP in the engine ---------------------------------------------------------
+
+TEST(MetricRegistry, EntriesAreCompleteAndUnique) {
+  const auto& registry = metric_registry();
+  ASSERT_GE(registry.size(), 5u);
+  // The four historical metrics first, in their CSV order.
+  const char* historical[] = {"psnr_rgb", "psnr_y", "ssim", "flicker"};
+  std::set<std::string> names, columns, options;
+  for (std::size_t i = 0; i < registry.size(); ++i) {
+    const auto& d = registry[i];
+    if (i < 4) {
+      EXPECT_EQ(d.name, historical[i]);
+    }
+    EXPECT_EQ(d.historical_csv, i < 4) << d.name;
+    EXPECT_TRUE(names.insert(d.name).second) << d.name;
+    ASSERT_FALSE(d.columns.empty()) << d.name;
+    for (const auto& c : d.columns) EXPECT_TRUE(columns.insert(c.csv).second) << c.csv;
+    for (const auto& c : d.mask_columns) EXPECT_TRUE(columns.insert(c).second) << c;
+    if (!d.threshold_option.empty()) {
+      EXPECT_TRUE(options.insert(d.threshold_option).second) << d.threshold_option;
+    }
+    EXPECT_TRUE(d.make) << d.name;
+    EXPECT_EQ(find_metric(d.name), &d);
+  }
+  EXPECT_EQ(find_metric("no such metric"), nullptr);
+  EXPECT_EQ(options, (std::set<std::string>{"psnr", "ssim", "flicker", "flip"}));
+  // FLIP only when asked for.
+  ComparisonSetup setup;
+  EXPECT_EQ(enabled_metrics(setup).size(), 4u);
+  setup.flip = FlipMode::Ldr;
+  EXPECT_EQ(enabled_metrics(setup).back()->name, "flip");
+}
+
+// Frames 0-1 of a reference and a noisy test (with a mask layer in the test), for the FLIP engine tests.
+ComparisonSetup flip_sequences(const fs::path& dir) {
+  for (int f = 0; f < 2; ++f) {
+    Image ref = noise_image(40, 32, unsigned(30 + f), 0.0f, 1.2f);
+    Image t = ref;
+    std::mt19937 rng(unsigned(40 + f));
+    std::normal_distribution<float> noise(0.0f, 0.05f);
+    for (const char* c : {"R", "G", "B"}) {
+      float* p = t.plane(c);
+      for (std::size_t i = 0; i < t.pixel_count(); ++i) p[i] += noise(rng);
+    }
+    float* m = t.add_channel("debug.mask");
+    for (std::size_t i = 0; i < t.pixel_count(); ++i) m[i] = (i % 40) < 20 ? 1.0f : 0.0f;
+    write_frame(dir, "ref", f, ref);
+    write_frame(dir, "t", f, t);
+  }
+  ComparisonSetup setup;
+  setup.reference = pattern(dir, "ref");
+  setup.tests = {pattern(dir, "t")};
+  return setup;
+}
+
+TEST(Comparison, FlipIsTheLibraryFlipOfTheClampedFrames) {
+  const auto dir = test::scratch_dir("comparison-flip");
+  ComparisonSetup setup = flip_sequences(dir);
+  setup.flip = FlipMode::Ldr;
+  setup.flip_options.pixels_per_degree = 40.0;
+  setup.error_maps = (dir / "maps").string();
+  setup.mask = "debug.mask";
+  auto report = compare_sequences(setup);
+  ASSERT_TRUE(report) << report.error().message;
+  EXPECT_EQ(report->metrics.back(), "flip");
+  // The same frame through the library: LDR-FLIP of the linear values clamped to [0, 1] (the display-encoded
+  // frame, linearised again), at 40 pixels per degree.
+  auto ref = read_exr((dir / "ref.0001.exr").string());
+  auto test = read_exr((dir / "t.0001.exr").string());
+  ASSERT_TRUE(ref && test);
+  FlipOptions o;
+  o.pixels_per_degree = 40.0;
+  o.ldr_input = FlipLdrInput::Linear;
+  std::vector<float> map(ref->pixel_count());
+  ASSERT_TRUE(FlipEvaluator(o).ldr({test->plane("R"), test->plane("G"), test->plane("B")},
+                                   {ref->plane("R"), ref->plane("G"), ref->plane("B")}, 40, 32, nullptr, map.data()));
+  const FlipStats want = flip_statistics(map);
+  const auto& f = report->sequences[0].frames[1];
+  const MetricSample& flip = *f.sample("flip");
+  ASSERT_EQ(flip.values.size(), 4u);
+  EXPECT_DOUBLE_EQ(flip.values[0], want.mean);
+  EXPECT_DOUBLE_EQ(flip.values[1], want.weighted_median);
+  EXPECT_DOUBLE_EQ(flip.values[2], want.weighted_quartile_1);
+  EXPECT_DOUBLE_EQ(flip.values[3], want.weighted_quartile_3);
+  EXPECT_GT(want.mean, 0.01);
+  // Inside / outside the mask (left half of each row): plain means of the map.
+  double in = 0, out = 0;
+  for (std::size_t i = 0; i < map.size(); ++i) ((i % 40) < 20 ? in : out) += map[i];
+  EXPECT_NEAR(flip.inside, in / (map.size() / 2), 1e-12);
+  EXPECT_NEAR(flip.outside, out / (map.size() / 2), 1e-12);
+  // The map is the error.flip layer.
+  auto maps = read_exr((dir / "maps" / "t.0001.exr").string());
+  ASSERT_TRUE(maps) << maps.error().message;
+  ASSERT_NE(maps->plane("error.flip"), nullptr);
+  for (std::size_t i = 0; i < map.size(); ++i) ASSERT_EQ(maps->plane("error.flip")[i], map[i]) << i;
+  // CSV: the historical columns first, FLIP's after the mask columns; JSON: the summary with the quartiles.
+  const auto csv = (dir / "m.csv").string(), json = (dir / "m.json").string();
+  ASSERT_TRUE(write_comparison_csv(*report, csv));
+  ASSERT_TRUE(write_comparison_json(*report, {}, {}, "compare test", "", json));
+  const auto header = read_text(csv).substr(0, read_text(csv).find('\n'));
+  EXPECT_EQ(header,
+            "frame,sequence,psnr_rgb_db,psnr_y_db,ssim,flicker,mse_rgb,peak,valid_pixels,nonfinite_test,"
+            "nonfinite_reference,compute_ms,metrics_ms,mask_fraction,psnr_rgb_in_db,psnr_rgb_out_db,psnr_y_in_db,"
+            "psnr_y_out_db,ssim_in,ssim_out,flicker_in,flicker_out,flip,flip_weighted_median,flip_weighted_q1,"
+            "flip_weighted_q3,flip_in,flip_out");
+  const auto j = nlohmann::json::parse(read_text(json));
+  EXPECT_EQ(j["flip"]["mode"], "ldr");
+  EXPECT_EQ(j["flip"]["pixels_per_degree"], 40.0);
+  const auto& js = j["sequences"][0]["flip"];
+  for (const char* key : {"mean", "min", "max", "weighted_median", "weighted_quartile_1", "weighted_quartile_3"})
+    EXPECT_TRUE(js.contains(key)) << key;
+  EXPECT_EQ(js["frames"], 2);
+  EXPECT_TRUE(j["sequences"][0]["inside_mask"].contains("flip"));
+  EXPECT_TRUE(j["thresholds"].contains("flip"));
+}
+
+TEST(Comparison, FlipOffLeavesTheOutputsAsTheyWere) {
+  const auto dir = test::scratch_dir("comparison-flip-off");
+  const ComparisonSetup setup = flip_sequences(dir);
+  auto report = compare_sequences(setup);
+  ASSERT_TRUE(report);
+  EXPECT_EQ(report->metrics, (std::vector<std::string>{"psnr_rgb", "psnr_y", "ssim", "flicker"}));
+  const auto csv = (dir / "m.csv").string(), json = (dir / "m.json").string();
+  ASSERT_TRUE(write_comparison_csv(*report, csv));
+  ASSERT_TRUE(write_comparison_json(*report, {}, {}, "compare test", "", json));
+  EXPECT_EQ(read_text(csv).substr(0, read_text(csv).find('\n')),
+            "frame,sequence,psnr_rgb_db,psnr_y_db,ssim,flicker,mse_rgb,peak,valid_pixels,nonfinite_test,"
+            "nonfinite_reference,compute_ms,metrics_ms");
+  const auto j = nlohmann::json::parse(read_text(json));
+  EXPECT_FALSE(j.contains("flip"));
+  EXPECT_FALSE(j["sequences"][0].contains("flip"));
+  EXPECT_EQ(j["thresholds"].size(), 4u);  // psnr_rgb, ssim, flicker, judged_on
+  // The table's header as compare printed it before the registry (printf with fixed widths).
+  char header[160];
+  std::snprintf(header, sizeof header, "%-20s %7s %10s %10s %9s %11s %11s\n", "sequence", "frames", "psnr_rgb",
+                "psnr_y", "ssim", "flicker", "compute_ms");
+  const std::string table = summary_table(*report);
+  EXPECT_EQ(table.rfind(header, 0), 0u) << table;
+}
+
+TEST(Comparison, HdrFlipAndItsErrors) {
+  const auto dir = test::scratch_dir("comparison-flip-hdr");
+  ComparisonSetup setup = flip_sequences(dir);
+  setup.flip = FlipMode::Hdr;
+  auto report = compare_sequences(setup);
+  ASSERT_TRUE(report) << report.error().message;
+  const double v = report->sequences[0].frames[0].value("flip");
+  EXPECT_GT(v, 0.0);
+  EXPECT_LT(v, 1.0);
+  // A threshold on FLIP needs FLIP; a bad viewing condition and a layer FLIP cannot read are errors.
+  Thresholds th;
+  th.limits["flip"] = 0.1;
+  EXPECT_TRUE(check_threshold_setup(setup, th));
+  setup.flip = FlipMode::Off;
+  const Status off = check_threshold_setup(setup, th);
+  ASSERT_FALSE(off);
+  EXPECT_EQ(off.error().kind, ErrorKind::Usage);
+  EXPECT_NE(off.error().message.find("--flip ldr"), std::string::npos) << off.error().message;
+  setup.flip = FlipMode::Ldr;
+  setup.flip_options.pixels_per_degree = -1.0;
+  auto bad_ppd = compare_sequences(setup);
+  ASSERT_FALSE(bad_ppd);
+  EXPECT_EQ(bad_ppd.error().kind, ErrorKind::Usage);
+  setup.flip_options.pixels_per_degree = 30.0;
+  for (int f = 0; f < 2; ++f) {
+    Image two(16, 16);
+    two.add_channel("motion.X", 0.5f);
+    two.add_channel("motion.Y", 0.25f);
+    write_frame(dir, "two", f, two);
+  }
+  setup.reference = pattern(dir, "two");
+  setup.tests = {pattern(dir, "two")};
+  setup.layer = "motion";
+  auto two = compare_sequences(setup);
+  ASSERT_FALSE(two);
+  EXPECT_EQ(two.error().kind, ErrorKind::Input);
+  EXPECT_NE(two.error().file.find("two.0000.exr"), std::string::npos) << two.error().file;
+  EXPECT_NE(two.error().message.find("2 channels"), std::string::npos) << two.error().message;
 }
 
 TEST(Comparison, SequenceNames) {

@@ -3,7 +3,7 @@
 #include "temporal/metrics/flicker.h"
 #include "temporal/core/image.h"
 #include "temporal/metrics/metrics.h"
-#include "temporal/metrics/warp.h"
+#include "temporal/core/reproject.h"
 
 #include <gtest/gtest.h>
 
@@ -203,6 +203,18 @@ TEST(Ssim, TooSmallImageIsAnInputError) {
   auto r = ssim(x.data(), x.data(), 10, 10, nullptr, nullptr, SsimOptions{});
   ASSERT_FALSE(r);
   EXPECT_EQ(r.error().kind, ErrorKind::Input);
+}
+
+// The motion-compensated fetch of the flicker metric: the shared reprojection (temporal/core/reproject.h).
+void warp_bilinear(const float* prev, int w, int h, const float* mx, const float* my, float* out) {
+  reproject::Frames fr;
+  fr.width = w;
+  fr.height = h;
+  fr.motion_x = mx;
+  fr.motion_y = my;
+  const float* p[] = {prev};
+  float* o[] = {out};
+  reproject::warp_planes(fr, p, o);
 }
 
 TEST(Warp, FollowsConventionSignAndMarksOutside) {

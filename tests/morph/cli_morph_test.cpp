@@ -1,5 +1,6 @@
 // The morph-120hz command line: frame numbering and timing of the output, metadata, bad input exit codes.
 #include "temporal/core/exr.h"
+#include "temporal/morph/methods.h"
 
 #include "synthetic.h"
 #include "test_support.h"
@@ -77,6 +78,53 @@ TEST_F(MorphCli, BadInputExitCodes) {
   EXPECT_EQ(test::run_command(tool() + " --input " + in("color") + " --out " + (dir_ / "x" / "o.####.exr").string() +
                                   " --method didyk", &out), 1) << out;
   EXPECT_NE(out.find("--gbuffer"), std::string::npos) << out;
+}
+
+// An inverted flag clears its default-on field: with every in-between frame fully blurred (--min-blur 1) the
+// rendered slot carries the compensating high frequencies, unless --no-compensation turns them off (then slot 0 is
+// the input, bit for bit).
+TEST_F(MorphCli, NoCompensationFlagClearsTheDefaultOnField) {
+  auto slot0_differs_from_input = [&](const std::string& extra, const std::string& name) {
+    std::string out;
+    const std::string cmd = tool() + " --input " + in("color") + " --gbuffer " + in("gbuffer") + " --frames 0-0 --out " +
+                            (dir_ / name / "o.####.exr").string() + " --min-blur 1" + extra;
+    EXPECT_EQ(test::run_command(cmd, &out), 0) << out;
+    auto a = read_exr((dir_ / name / "o.0000.exr").string());
+    auto b = read_exr((dir_ / "color.000.exr").string());
+    if (!a || !b) return -1;
+    int differ = 0;
+    for (std::size_t i = 0; i < b->pixel_count(); ++i) differ += a->plane("R")[i] != b->plane("R")[i];
+    return differ;
+  };
+  EXPECT_GT(slot0_differs_from_input("", "compensated"), 0);
+  EXPECT_EQ(slot0_differs_from_input(" --no-compensation", "plain"), 0);
+}
+
+// The method list scripts read (pipelines/morph-120hz.sh) is the registry's, one `name<TAB>summary` per line.
+TEST_F(MorphCli, ListMethodsPrintsTheRegistry) {
+  std::string out;
+  ASSERT_EQ(test::run_command(tool() + " --list-methods 2>/dev/null", &out), 0) << out;
+  std::string expected;
+  for (const auto& m : morph_methods()) expected += m.name + "\t" + m.summary + "\n";
+  EXPECT_EQ(out, expected);
+}
+
+TEST_F(MorphCli, OutOfRangeAndNonFiniteParametersAreUsageErrors) {
+  const std::string base = tool() + " --input " + in("color") + " --gbuffer " + in("gbuffer") + " --out " +
+                           (dir_ / "x" / "o.####.exr").string();
+  std::string out;
+  EXPECT_EQ(test::run_command(base + " --min-blur 2", &out), 1) << out;
+  EXPECT_NE(out.find("--min-blur 2 is out of range: it must be [0, 1]"), std::string::npos) << out;
+  EXPECT_EQ(test::run_command(base + " --gamma nan", &out), 1) << out;
+  EXPECT_NE(out.find("--gamma"), std::string::npos) << out;
+  EXPECT_EQ(test::run_command(base + " --method bilinear", &out), 1) << out;
+  EXPECT_EQ(test::run_command(base + " --grid 6", &out), 1) << out;
+  EXPECT_NE(out.find("power of two"), std::string::npos) << out;
+  // Debug layers are data: DWA (lossy on `*.Y`) is refused like in every sequence tool.
+  EXPECT_EQ(test::run_command(base + " --compression dwaa", &out), 1) << out;
+  EXPECT_NE(out.find("dwaa"), std::string::npos) << out;
+  EXPECT_EQ(test::run_command(base + " --gamma 2.4 --display srgb_display", &out), 1) << out;
+  EXPECT_FALSE(std::filesystem::exists(dir_ / "x")) << "nothing is written on a usage error";
 }
 
 }  // namespace

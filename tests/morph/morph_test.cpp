@@ -246,14 +246,14 @@ TEST(MorphBaselines, RepeatBlendAndWarp) {
   Image gb = test::make_gbuffer(w, h, [](int, int, float& mx, float& my, float& d) { mx = -3.0f; my = 0.0f; d = 1.0f; });
   std::vector<Image> out;
   MorphOptions o;
-  o.method = MorphMethod::Repeat;
+  o.method = "repeat";
   ASSERT_TRUE(Morpher(o).process(a, nullptr, nullptr, out));
   EXPECT_EQ(out[2].plane("G")[100], a.plane("G")[100]);
-  o.method = MorphMethod::Blend;
+  o.method = "blend";
   ASSERT_TRUE(Morpher(o).process(a, nullptr, &b, out));
   EXPECT_NEAR(out[1].plane("R")[77], (2.0f * a.plane("R")[77] + b.plane("R")[77]) / 3.0f, 1e-6f);
   EXPECT_NEAR(out[2].plane("R")[77], (a.plane("R")[77] + 2.0f * b.plane("R")[77]) / 3.0f, 1e-6f);
-  o.method = MorphMethod::Warp;
+  o.method = "warp";
   ASSERT_TRUE(Morpher(o).process(a, &gb, nullptr, out));
   // Integer shifts: slot k moves every pixel k px right; the first k columns are holes (black).
   for (int k = 1; k < 3; ++k)

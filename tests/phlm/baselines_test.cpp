@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 #include <functional>
 #include <random>
 
@@ -166,15 +167,21 @@ TEST(Fxaa, FlatRegionsAreUntouchedAndStaircasesSmoothed) {
   EXPECT_GE(blended, 16);  // at least one blended pixel per row along the edge
 }
 
-TEST(Fxaa, ConstantAndNonFinitePixelsPassThrough) {
-  Image frame = make_frame(6, 6, [](int, int, int) { return 0.3f; });
-  frame.plane("B")[8] = NAN;
+TEST(Fxaa, ConstantPassesThroughAndNonFinitePixelsAreFilledFromNeighbours) {
+  Image frame = make_frame(6, 6, [](int x, int, int) { return 0.1f * float(x); });
+  frame.plane("B")[8] = NAN;                        // pixel (2, 1): neighbours x = 1, 3 (0.1, 0.3) and (2, 0), (2, 2) (0.2)
+  frame.plane("R")[0] = std::numeric_limits<float>::infinity();  // corner (0, 0): neighbours (1, 0) = 0.1, (0, 1) = 0
   Image out;
   FilterStats stats;
   ASSERT_TRUE(fxaa(input_for(frame), out, {}, &stats));
-  EXPECT_EQ(stats.non_finite, 1u);
-  EXPECT_TRUE(std::isnan(out.plane("B")[8]));
-  EXPECT_EQ(out.plane("R")[20], 0.3f);
+  EXPECT_EQ(stats.non_finite, 2u);
+  for (const char* c : {"R", "G", "B"})
+    for (std::size_t i = 0; i < out.pixel_count(); ++i) EXPECT_TRUE(std::isfinite(out.plane(c)[i])) << c << i;
+  EXPECT_FLOAT_EQ(out.plane("B")[8], (0.1f + 0.3f + 0.2f + 0.2f) / 4.0f);  // the pixel's other channels are the same
+  EXPECT_FLOAT_EQ(out.plane("R")[0], 0.05f);
+  Image flat = make_frame(6, 6, [](int, int, int) { return 0.3f; });
+  ASSERT_TRUE(fxaa(input_for(flat), out, {}, &stats));
+  EXPECT_EQ(out.plane("R")[20], 0.3f);  // no contrast: unchanged
 }
 
 }  // namespace

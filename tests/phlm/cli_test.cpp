@@ -8,6 +8,8 @@
 
 #include <cmath>
 #include <cstring>
+#include <fstream>
+#include <functional>
 #include <random>
 
 namespace {
@@ -151,6 +153,47 @@ TEST(FilterPhlmCli, ErrorsAndExitCodes) {
   EXPECT_EQ(test::run_command(tool() + in + " --gbuffer " + (dir / "bad.####.exr").string() + " --out " +
                                   (dir / "o.####.exr").string(), &out), 2);
   EXPECT_NE(out.find("motion"), std::string::npos) << out;
+}
+
+// Issue 11: no output replaces an input, non-finite and out-of-range options are usage errors, a state that is
+// not positive definite is refused, and no input file changes in any of these runs.
+TEST(FilterPhlmCli, BadRunsLoseNothing) {
+  const auto dir = test::scratch_dir("filter-phlm-cli-lose-nothing");
+  write_sequence(dir, 3);
+  const auto checksum = [&] {
+    std::string all;
+    for (const char* f : {"color.0000.exr", "color.0001.exr", "color.0002.exr", "gbuffer.0001.exr"}) {
+      std::ifstream in(dir / f, std::ios::binary);
+      all += std::string(std::istreambuf_iterator<char>(in), {});
+    }
+    return std::hash<std::string>{}(all);
+  };
+  const auto before = checksum();
+  const std::string in = " --input " + (dir / "color.####.exr").string();
+  const std::string g = " --gbuffer " + (dir / "gbuffer.####.exr").string();
+  std::string out;
+  for (const char* m : {"phlm", "taa", "ema", "fxaa"}) {
+    EXPECT_EQ(test::run_command(tool() + in + g + " --method " + std::string(m) + " --out " + (dir / "color.####.exr").string(),
+                                &out), 1) << m << out;
+    EXPECT_NE(out.find("one of this run's inputs"), std::string::npos) << out;
+  }
+  EXPECT_EQ(test::run_command(tool() + in + g + " --out " + (dir / "gbuffer.%04d.exr").string(), &out), 1) << out;
+  for (const char* bad : {"--lambda nan", "--lambda inf", "--p-init -1", "--taa-alpha 2", "--ema-alpha nan",
+                                 "--feature-a nan", "--threads -1"}) {
+    EXPECT_EQ(test::run_command(tool() + in + " --out " + (dir / "o.####.exr").string() + " " + std::string(bad), &out), 1) << bad;
+    EXPECT_LT(out.size(), 400u) << out;  // a readable range, never a 309-digit bound
+  }
+  // A state with a P that is not positive definite: refused before it can turn the next frame into NaN.
+  ASSERT_EQ(test::run_command(tool() + in + g + " --frames 0-0 --out " + (dir / "s.####.exr").string() +
+                                  " --state-out " + (dir / "state.exr").string(), &out), 0) << out;
+  auto state = read_exr((dir / "state.exr").string());
+  ASSERT_TRUE(state);
+  state->plane("P.D0")[3] = -1e30f;
+  ASSERT_TRUE(write_exr((dir / "bad_state.exr").string(), *state));
+  EXPECT_EQ(test::run_command(tool() + in + g + " --frames 1-2 --out " + (dir / "r.####.exr").string() +
+                                  " --state-in " + (dir / "bad_state.exr").string(), &out), 2) << out;
+  EXPECT_NE(out.find("positive definite"), std::string::npos) << out;
+  EXPECT_EQ(checksum(), before);
 }
 
 }  // namespace

@@ -339,7 +339,8 @@ TEST(Phlm, ResumedRunEqualsUninterruptedRunBitForBit) {
   ASSERT_TRUE(loaded);
   EXPECT_TRUE(loaded->plane("Pmat.P00"));  // the symmetric P is written for inspection
   PhlmFilter resumed;
-  ASSERT_TRUE(resumed.set_state(*loaded, 3));
+  const Status resumed_ok = resumed.set_state(*loaded, 3);
+  ASSERT_TRUE(resumed_ok) << resumed_ok.error().message;
   Image out_resumed;
   for (int t = split; t < frames; ++t) step(resumed, t, out_resumed);
   for (const auto& c : kRgb)

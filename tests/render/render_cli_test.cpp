@@ -122,6 +122,32 @@ TEST(RenderCli, MissingBufferAndUnsupportedExtensionAreInputErrors) {
   EXPECT_FALSE(fs::exists(dir / "o" / "gbuffer.0000.exr"));
 }
 
+TEST(RenderCli, UsdScenesRenderAndBadUsdIsRefusedWithItsPosition) {
+  const auto dir = test::scratch_dir("render_cli_usd");
+  std::string output;
+  // The USD copy of a built-in scene renders (one frame; frames come from its timeline as for glTF).
+  const std::string usda = (test::source_dir() / "assets" / "scenes" / "morph_test.usda").string();
+  ASSERT_EQ(test::run_command(tool() + " " + usda + " --out " + (dir / "ok").string() +
+                                  " --size 32x24 --frames 3-3 --outputs gbuffer --verbose",
+                              &output),
+            0)
+      << output;
+  EXPECT_TRUE(fs::exists(dir / "ok" / "gbuffer.0003.exr"));
+  // Malformed text: exit 2, `render-gbuffer: file:line:column: what is wrong`.
+  std::ofstream(dir / "bad.usda") << "#usda 1.0\ndef Mesh \"M\" {\n    float x = \"text\"\n}\n";
+  EXPECT_EQ(test::run_command(tool() + " " + (dir / "bad.usda").string() + " --out " + (dir / "o").string(), &output), 2)
+      << output;
+  EXPECT_NE(output.find("render-gbuffer: " + (dir / "bad.usda").string() + ":3:15: "), std::string::npos) << output;
+  // A crate file: exit 2 with the command that converts it.
+  std::ofstream(dir / "crate.usd") << "PXR-USDC" << std::string(88, '\0');
+  EXPECT_EQ(test::run_command(tool() + " " + (dir / "crate.usd").string() + " --out " + (dir / "o").string(), &output), 2)
+      << output;
+  EXPECT_NE(output.find("usdcat -o file.usda crate.usd"), std::string::npos) << output;
+  // USD scenes have one timeline: a named clip is a usage error.
+  EXPECT_EQ(test::run_command(tool() + " " + usda + " --out " + (dir / "o").string() + " --clip wave", &output), 1) << output;
+  EXPECT_FALSE(fs::exists(dir / "o" / "gbuffer.0000.exr"));
+}
+
 TEST(RenderCli, MissingSceneIsAnInputError) {
   const auto dir = test::scratch_dir("render_cli_missing");
   std::string output;
@@ -221,6 +247,133 @@ TEST(RenderCli, SameCommandTwiceGivesBitIdenticalPixels) {
       EXPECT_EQ(std::memcmp(pa, pb, a->pixel_count() * 4), 0) << file << " " << c;
     }
   }
+}
+
+// True when every channel of the two files holds the same bits (float or uint), `skip` left out.
+::testing::AssertionResult same_pixels(const fs::path& a_path, const fs::path& b_path,
+                                       const std::vector<std::string>& skip = {}) {
+  auto a = read_exr(a_path.string());
+  auto b = read_exr(b_path.string());
+  if (!a || !b) return ::testing::AssertionFailure() << "cannot read " << a_path << " or " << b_path;
+  for (const auto& c : a->channel_names()) {
+    if (std::find(skip.begin(), skip.end(), c) != skip.end()) continue;
+    if (!b->has_channel(c)) return ::testing::AssertionFailure() << b_path << " has no " << c;
+    const void* pa = a->channel_type(c) == ChannelType::UInt ? (const void*)a->uint_plane(c) : (const void*)a->plane(c);
+    const void* pb = b->channel_type(c) == ChannelType::UInt ? (const void*)b->uint_plane(c) : (const void*)b->plane(c);
+    if (std::memcmp(pa, pb, a->pixel_count() * 4) != 0)
+      return ::testing::AssertionFailure() << a_path.filename() << " " << c << " differs";
+  }
+  return ::testing::AssertionSuccess();
+}
+
+// Issue 14: a sequence rendered as two shards (--frames 0-2, 3-5) gives exactly the files of one run (pixels and
+// the camera-cut flag: only frame 0 starts the sequence).
+TEST(RenderCli, ShardedRenderEqualsOneRun) {
+  const auto dir = test::scratch_dir("render_cli_shards");
+  const auto scene = write_test_scene(dir).string();
+  const std::string common = tool() + " " + scene + " --size 32x24 --reference-spp 2 --vpls 64 --shadow-map-size 256";
+  std::string out;
+  ASSERT_EQ(test::run_command(common + " --frames 0-5 --out " + (dir / "one").string(), &out), 0) << out;
+  ASSERT_EQ(test::run_command(common + " --frames 0-2 --out " + (dir / "two").string(), &out), 0) << out;
+  ASSERT_EQ(test::run_command(common + " --frames 3-5 --out " + (dir / "two").string(), &out), 0) << out;
+  for (const char* name : {"gbuffer", "shade", "reference", "color"})
+    for (const char* f : {".0002.exr", ".0003.exr", ".0005.exr"}) {
+      const std::string file = std::string(name) + f;
+      EXPECT_TRUE(same_pixels(dir / "one" / file, dir / "two" / file)) << file;
+      auto a = read_exr_info((dir / "one" / file).string());
+      auto b = read_exr_info((dir / "two" / file).string());
+      ASSERT_TRUE(a && b);
+      EXPECT_EQ(a->metadata.camera_cut.value_or(false), b->metadata.camera_cut.value_or(false)) << file;
+      EXPECT_FALSE(b->metadata.camera_cut.value_or(false)) << file;
+    }
+}
+
+// Issue 16: noise patterns (SSAO, VPL sets, random jitter) are keyed by the instant, so a 40 Hz frame n and a
+// 120 Hz frame 3n are the same render: every payload, the reference and the colour, and the G-buffer's geometry
+// (its motion differs: it points to the previous frame of each rate).
+TEST(RenderCli, FramesAtTheSameInstantRenderAlikeAtAnyRate) {
+  const auto dir = test::scratch_dir("render_cli_instants");
+  const auto scene = write_test_scene(dir).string();
+  const std::string common = tool() + " " + scene + " --size 32x24 --reference-spp 3 --vpls 64 --shadow-map-size 256 " +
+                             "--jitter random --shade-jitter random";
+  std::string out;
+  ASSERT_EQ(test::run_command(common + " --fps 40 --frames 0-2 --out " + (dir / "r40").string(), &out), 0) << out;
+  ASSERT_EQ(test::run_command(common + " --fps 120 --frames 0-6 --out " + (dir / "r120").string(), &out), 0) << out;
+  for (int n : {1, 2}) {
+    char a[32], b[32];
+    std::snprintf(a, sizeof a, ".%04d.exr", n);
+    std::snprintf(b, sizeof b, ".%04d.exr", 3 * n);
+    for (const char* name : {"shade", "reference", "color"})
+      EXPECT_TRUE(same_pixels(dir / "r40" / (std::string(name) + a), dir / "r120" / (std::string(name) + b))) << name << n;
+    EXPECT_TRUE(same_pixels(dir / "r40" / (std::string("gbuffer") + a), dir / "r120" / (std::string("gbuffer") + b),
+                            {"motion.X", "motion.Y"}));
+  }
+}
+
+// Issue 16: a payload without a radiance term (direct, gi) still has a sum: the visibility terms as grey.
+TEST(RenderCli, PayloadWithoutRadianceHasANonZeroSum) {
+  const auto dir = test::scratch_dir("render_cli_visibility_sum");
+  const auto scene = write_test_scene(dir).string();
+  std::string out;
+  ASSERT_EQ(test::run_command(tool() + " " + scene + " --size 32x24 --factor 1 --frames 0-0 --outputs gbuffer,shade " +
+                                  "--shade-jitter none --payload ssao --out " + (dir / "o").string(), &out), 0) << out;
+  auto s = read_exr((dir / "o" / "shade.0000.exr").string());
+  auto g = read_exr((dir / "o" / "gbuffer.0000.exr").string());
+  ASSERT_TRUE(s && g);
+  std::size_t surface = 0;
+  for (std::size_t i = 0; i < s->pixel_count(); ++i) {
+    const bool on_surface = g->uint_plane("id")[i] != 0;  // the background has no payload at all
+    EXPECT_EQ(s->plane("R")[i], on_surface ? s->plane("ssao.Y")[i] : 0.0f) << i;
+    EXPECT_EQ(s->plane("G")[i], s->plane("R")[i]);
+    surface += on_surface && s->plane("R")[i] > 0.0f;
+  }
+  EXPECT_GT(surface, 50u);
+}
+
+// Issue 11: runaway ranges and malformed scenes are refused with a message; nothing is rendered.
+TEST(RenderCli, RunawayRangesAndMalformedScenesAreRefused) {
+  const auto dir = test::scratch_dir("render_cli_runaway");
+  const auto scene = write_test_scene(dir).string();
+  const std::string cmd = tool() + " " + scene + " --size 32x24 --out " + (dir / "o").string();
+  std::string out;
+  for (const char* bad : {"--frames 2147483647-2147483647", "--frames -1", "--duration inf", "--duration 1e30",
+                          "--duration -1", "--fps nan", "--camera 99999999999999999999999",
+                          "--clip 99999999999999999999999"}) {
+    EXPECT_EQ(test::run_command(cmd + " " + bad, &out), 1) << bad << "\n" << out;
+    EXPECT_LT(out.size(), 600u) << out;
+    EXPECT_EQ(out.find("stoul"), std::string::npos) << out;
+  }
+  EXPECT_FALSE(fs::exists(dir / "o" / "gbuffer.0000.exr"));
+  // Texture coordinates holding NaN, and a camera node scaled by zero: input errors, not NaN images.
+  std::ifstream in(scene);
+  std::string json((std::istreambuf_iterator<char>(in)), {});
+  const float nan_uv[8] = {0, 0, NAN, 0, 1, 1, 0, 1};
+  std::vector<unsigned char> uv(reinterpret_cast<const unsigned char*>(nan_uv),
+                                reinterpret_cast<const unsigned char*>(nan_uv) + sizeof nan_uv);
+  std::string with_uv = json;
+  with_uv.replace(with_uv.find(R"("attributes": {"POSITION": 0})"), 29, R"("attributes": {"POSITION": 0, "TEXCOORD_0": 5})");
+  with_uv.replace(with_uv.find(R"({"bufferView": 3, "componentType": 5126, "count": 2, "type": "VEC3"}])"), 69,
+                  R"({"bufferView": 3, "componentType": 5126, "count": 2, "type": "VEC3"},
+    {"bufferView": 4, "componentType": 5126, "count": 4, "type": "VEC2"}])");
+  with_uv.replace(with_uv.find(R"({"buffer": 0, "byteOffset": 116, "byteLength": 24}])"), 51,
+                  R"({"buffer": 0, "byteOffset": 116, "byteLength": 24},
+    {"buffer": 1, "byteOffset": 0, "byteLength": 32}])");
+  with_uv.replace(with_uv.rfind("]"), 1, R"(, {"byteLength": 32, "uri": "data:application/octet-stream;base64,)" +
+                                             base64(uv) + R"("}])");
+  std::ofstream(dir / "nan_uv.gltf") << with_uv;
+  EXPECT_EQ(test::run_command(tool() + " " + (dir / "nan_uv.gltf").string() + " --size 32x24 --out " + (dir / "o").string(),
+                              &out), 2) << out;
+  EXPECT_NE(out.find("NaN"), std::string::npos) << out;
+  std::string zero_camera = json;
+  zero_camera.replace(zero_camera.find(R"("nodes": [{"mesh": 0}, {"mesh": 1}])"), 35,
+                      R"("nodes": [{"mesh": 0}, {"mesh": 1}, {"camera": 0, "scale": [0, 0, 0], "translation": [0, 1, 5]}],
+  "cameras": [{"type": "perspective", "perspective": {"yfov": 0.8, "znear": 0.1, "zfar": 100}}])");
+  zero_camera.replace(zero_camera.find(R"("scenes": [{"nodes": [0, 1]}])"), 29, R"("scenes": [{"nodes": [0, 1, 2]}])");
+  std::ofstream(dir / "zero_camera.gltf") << zero_camera;
+  EXPECT_EQ(test::run_command(tool() + " " + (dir / "zero_camera.gltf").string() + " --size 32x24 --out " +
+                                  (dir / "o").string(), &out), 2) << out;
+  EXPECT_NE(out.find("camera's transform"), std::string::npos) << out;
+  EXPECT_FALSE(fs::exists(dir / "o" / "gbuffer.0000.exr"));
 }
 
 }  // namespace

@@ -1,5 +1,7 @@
 #include "test_support.h"
 
+#include <cstdlib>
+
 #include "temporal/core/exr.h"
 
 #include <sys/wait.h>
@@ -25,6 +27,9 @@ std::filesystem::path scratch_dir(const std::string& name) {
 }
 
 std::optional<std::filesystem::path> shared_assets() {
+  // TEMPORAL_SHARED_ASSETS overrides the default place (a worktree or checkout elsewhere than beside ../shared).
+  if (const char* env = std::getenv("TEMPORAL_SHARED_ASSETS"); env && *env && std::filesystem::is_directory(env))
+    return std::filesystem::canonical(env);
   auto dir = source_dir() / ".." / "shared" / "assets";
   if (std::filesystem::is_directory(dir)) return std::filesystem::canonical(dir);
   return std::nullopt;

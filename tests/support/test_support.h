@@ -16,7 +16,8 @@ namespace temporal::test {
 // A fresh, empty folder under the build tree for one test (removed and recreated on each call).
 std::filesystem::path scratch_dir(const std::string& name);
 
-// ../shared/assets beside the project, when present. Tests that need it call GTEST_SKIP() otherwise:
+// ../shared/assets beside the project (or $TEMPORAL_SHARED_ASSETS), when present. Tests that need it call
+// GTEST_SKIP() otherwise:
 //   auto assets = shared_assets(); if (!assets) GTEST_SKIP() << "../shared/assets is absent";
 std::optional<std::filesystem::path> shared_assets();
 

@@ -1,6 +1,9 @@
 // OpenEXR I/O through OpenImageIO: multi-part files (one part per layer), planar images, atomic writes.
 #include "temporal/core/exr.h"
 
+#include "temporal/core/atomic_file.h"
+
+#include <OpenEXR/openexr.h>
 #include <OpenImageIO/imageio.h>
 
 #include <glm/gtc/type_ptr.hpp>
@@ -8,6 +11,8 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cctype>
+#include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <map>
@@ -174,6 +179,97 @@ struct Part {
   bool half = false;
 };
 
+// What a file that is not OpenEXR is, from its first bytes (for a message that says how to fix it).
+std::string foreign_format(const unsigned char* b, std::size_t n) {
+  if (n >= 8 && std::memcmp(b, "\x89PNG\r\n\x1a\n", 8) == 0) return "PNG";
+  if (n >= 3 && b[0] == 0xFF && b[1] == 0xD8 && b[2] == 0xFF) return "JPEG";
+  if (n >= 4 && (std::memcmp(b, "II*\0", 4) == 0 || std::memcmp(b, "MM\0*", 4) == 0)) return "TIFF";
+  if (n >= 2 && b[0] == '#' && b[1] == 'u') return "USD text";
+  return {};
+}
+
+// Largest image the tools accept: 16384 x 16384 pixels per part (1 GiB per float channel).
+constexpr std::int64_t kMaxPixels = std::int64_t(16384) * 16384;
+constexpr int kMaxSide = 65536;
+
+// Checks, before any pixel is allocated, that `path` is an OpenEXR file whose parts are complete: the magic number,
+// sane part sizes, and for every part the last chunk (scanline block or tile) lies inside the file. A multi-part
+// file truncated in a part that the caller does not read is caught here (reading only the needed parts would
+// otherwise accept it). Cost: the headers, the chunk tables and one chunk leader per part.
+Status check_exr_structure(const std::string& path) {
+  std::error_code ec;
+  if (fs::is_directory(path, ec)) return Error::input(path, "is a folder, not an OpenEXR file");
+  if (!fs::exists(path, ec)) return Error::input(path, "no such file");
+  const auto size = fs::file_size(path, ec);
+  unsigned char magic[8] = {};
+  std::size_t got = 0;
+  if (FILE* f = std::fopen(path.c_str(), "rb")) {
+    got = std::fread(magic, 1, sizeof magic, f);
+    std::fclose(f);
+  } else {
+    return Error::input(path, "cannot open for reading (permissions?)");
+  }
+  if (got < 4 || !(magic[0] == 0x76 && magic[1] == 0x2f && magic[2] == 0x31 && magic[3] == 0x01)) {
+    const std::string what = foreign_format(magic, got);
+    if (what == "PNG" || what == "JPEG" || what == "TIFF")
+      return Error::input(path, "is a " + what + " image, not OpenEXR: the tools need scene-linear OpenEXR; convert it "
+                                "with `oiiotool IN --colorconvert sRGB linear -o OUT.exr` if it is sRGB-encoded");
+    return Error::input(path, std::string("is not an OpenEXR file") + (what.empty() ? "" : " (it looks like " + what + ")") +
+                                  (got < 4 ? ": it is empty or truncated" : ""));
+  }
+  exr_context_t ctx = nullptr;
+  exr_context_initializer_t init = EXR_DEFAULT_CONTEXT_INITIALIZER;
+  init.error_handler_fn = [](exr_const_context_t, exr_result_t, const char*) {};  // we word the errors ourselves
+  if (exr_start_read(&ctx, path.c_str(), &init) != EXR_ERR_SUCCESS) {
+    exr_finish(&ctx);
+    return Error::input(path, "cannot read the OpenEXR header: the file is truncated or corrupt");
+  }
+  struct Finish {
+    exr_context_t& c;
+    ~Finish() { exr_finish(&c); }
+  } finish{ctx};
+  int parts = 0;
+  if (exr_get_count(ctx, &parts) != EXR_ERR_SUCCESS || parts < 1)
+    return Error::input(path, "has no image part: the file is corrupt");
+  for (int p = 0; p < parts; ++p) {
+    exr_attr_box2i_t dw{};
+    exr_storage_t storage{};
+    if (exr_get_data_window(ctx, p, &dw) != EXR_ERR_SUCCESS || exr_get_storage(ctx, p, &storage) != EXR_ERR_SUCCESS)
+      return Error::input(path, "part " + std::to_string(p) + " has a corrupt header");
+    const std::int64_t w = std::int64_t(dw.max.x) - dw.min.x + 1, h = std::int64_t(dw.max.y) - dw.min.y + 1;
+    if (w < 1 || h < 1 || w > kMaxSide || h > kMaxSide || w * h > kMaxPixels)
+      return Error::input(path, "part " + std::to_string(p) + " declares " + std::to_string(w) + "x" +
+                                    std::to_string(h) + " pixels: the tools read at most 16384x16384 per image "
+                                    "(a corrupt header, or an image to crop or scale down first)");
+    exr_chunk_info_t last{};
+    exr_result_t r = EXR_ERR_SUCCESS;
+    if (storage == EXR_STORAGE_SCANLINE) {
+      r = exr_read_scanline_chunk_info(ctx, p, dw.max.y, &last);
+    } else if (storage == EXR_STORAGE_TILED) {
+      uint32_t tx = 0, ty = 0;
+      exr_tile_level_mode_t level = EXR_TILE_ONE_LEVEL;
+      exr_tile_round_mode_t round = EXR_TILE_ROUND_DOWN;
+      if (exr_get_tile_descriptor(ctx, p, &tx, &ty, &level, &round) == EXR_ERR_SUCCESS && tx > 0 && ty > 0)
+        r = exr_read_tile_chunk_info(ctx, p, int((w - 1) / tx), int((h - 1) / ty), 0, 0, &last);
+    } else {
+      continue;  // deep data: not produced or read by the tools
+    }
+    if (r != EXR_ERR_SUCCESS || last.data_offset + last.packed_size > size)
+      return Error::input(path, "is truncated or corrupt: part " + std::to_string(p) +
+                                    " ends beyond the end of the file (" + std::to_string(size) +
+                                    " bytes); write it again");
+  }
+  return Status::ok();
+}
+
+// Output files must be OpenEXR: refuse another extension rather than write EXR bytes under a misleading name.
+Status check_exr_extension(const std::string& path) {
+  std::string ext = fs::path(path).extension().string();
+  for (auto& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
+  if (ext == ".exr") return Status::ok();
+  return Error::usage("output '" + path + "' must end in .exr: the tools write OpenEXR (use compare --png for pictures)");
+}
+
 }  // namespace
 
 Expected<ExrCompression> parse_compression(const std::string& name) {
@@ -185,7 +281,7 @@ Expected<ExrCompression> parse_compression(const std::string& name) {
 }
 
 Expected<ExrInfo> read_exr_info(const std::string& path) {
-  if (!fs::exists(path)) return Error::input(path, "no such file");
+  if (Status st = check_exr_structure(path); !st) return st.error();
   auto in = ImageInput::open(path);
   if (!in) return Error::input(path, "cannot read as OpenEXR: " + oiio_error("unknown error") + " (is it truncated or corrupt?)");
   ExrInfo info;
@@ -199,7 +295,7 @@ Expected<ExrInfo> read_exr_info(const std::string& path) {
 }
 
 Expected<Image> read_exr(const std::string& path, const ExrSelection& selection) {
-  if (!fs::exists(path)) return Error::input(path, "no such file");
+  if (Status st = check_exr_structure(path); !st) return st.error();
   auto in = ImageInput::open(path);
   if (!in) return Error::input(path, "cannot read as OpenEXR: " + oiio_error("unknown error") + " (is it truncated or corrupt?)");
 
@@ -270,6 +366,7 @@ Expected<Image> read_exr(const std::string& path, const ExrSelection& selection)
 }
 
 Status write_exr(const std::string& path, const Image& image, const ExrWriteOptions& options) {
+  if (Status st = check_exr_extension(path); !st) return st;
   if (image.empty()) return Error::output(path, "refusing to write an empty image");
   if (image.channel_count() == 0) return Error::output(path, "refusing to write an image without channels");
 
@@ -322,23 +419,20 @@ Status write_exr(const std::string& path, const Image& image, const ExrWriteOpti
     specs.push_back(std::move(spec));
   }
 
-  const fs::path target(path);
-  std::error_code ec;
-  if (target.has_parent_path()) fs::create_directories(target.parent_path(), ec);
-  // The temporary name keeps the .exr extension so OIIO picks the OpenEXR writer, and starts with a dot
-  // so sequence scans never see it.
-  const fs::path tmp = target.parent_path() / ("." + target.filename().string() + ".tmp" + std::to_string(getpid()) + ".exr");
+  // Hidden temporary file beside the target (temporal/core/atomic_file.h), renamed over it when complete.
+  TemporaryFile file(path);
+  const std::string& tmp = file.path();
 
   auto out = ImageOutput::create("openexr");
   if (!out) return Error::output(path, "OpenImageIO has no OpenEXR writer: " + oiio_error("unknown error"));
   const bool multi = specs.size() > 1;
   if (multi && !out->supports("multiimage"))
     return Error::output(path, "this OpenImageIO cannot write multi-part EXR");
-  bool ok = multi ? out->open(tmp.string(), int(specs.size()), specs.data()) : out->open(tmp.string(), specs[0]);
+  bool ok = multi ? out->open(tmp, int(specs.size()), specs.data()) : out->open(tmp, specs[0]);
   std::vector<float> buffer;
   std::vector<std::uint32_t> buffer_uint;
   for (std::size_t s = 0; ok && s < parts.size(); ++s) {
-    if (s > 0) ok = out->open(tmp.string(), specs[s], ImageOutput::AppendSubimage);
+    if (s > 0) ok = out->open(tmp, specs[s], ImageOutput::AppendSubimage);
     if (!ok) break;
     const Part& p = parts[s];
     const std::size_t n = p.channels.size(), count = image.pixel_count();
@@ -370,17 +464,10 @@ Status write_exr(const std::string& path, const Image& image, const ExrWriteOpti
   const std::string write_error = ok ? std::string() : out->geterror();
   ok = out->close() && ok;
   out.reset();
-  if (!ok) {
-    fs::remove(tmp, ec);
+  if (!ok)
     return Error::output(path, "cannot write: " + (write_error.empty() ? oiio_error("unknown error") : write_error) +
                                    " (is the disk full or the folder read-only?)");
-  }
-  fs::rename(tmp, target, ec);
-  if (ec) {
-    fs::remove(tmp, ec);
-    return Error::output(path, "cannot move the finished file into place: " + ec.message());
-  }
-  return {};
+  return file.commit();
 }
 
 }  // namespace temporal

@@ -33,10 +33,10 @@ std::string join(const std::vector<std::string>& items) {
 
 std::string param_value_text(const Param& p) {
   return std::visit(
-      [](auto* v) -> std::string {
+      [&p](auto* v) -> std::string {
         using T = std::remove_pointer_t<decltype(v)>;
         if constexpr (std::is_same_v<T, bool>)
-          return *v ? "on" : "off";
+          return *v != p.inverted ? "on" : "off";
         else if constexpr (std::is_same_v<T, std::string>)
           return *v;
         else
@@ -52,9 +52,9 @@ std::string param_range_text(const Param& p) {
   // Appended piece by piece: `"[" + std::string` trips a false -Wrestrict in GCC 12.
   std::string text;
   if (lo && hi) {
-    text.append("[").append(number(p.min)).append(", ").append(number(p.max)).append("]");
+    text.append(p.above_min ? "(" : "[").append(number(p.min)).append(", ").append(number(p.max)).append("]");
   } else if (lo) {
-    text.append(">= ").append(number(p.min));
+    text.append(p.above_min ? "> " : ">= ").append(number(p.min));
   } else if (hi) {
     text.append("<= ").append(number(p.max));
   }
@@ -77,7 +77,7 @@ Status check_param(const Param& p) {
       },
       p.value);
   if (!std::isfinite(v)) return Error::usage(p.flag + " must be a finite number (got " + number(v) + ")");
-  if (v < p.min || v > p.max)
+  if (v < p.min || v > p.max || (p.above_min && v == p.min))
     return Error::usage(p.flag + " " + number(v) + " is out of range: it must be " + param_range_text(p));
   return Status::ok();
 }

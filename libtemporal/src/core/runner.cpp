@@ -1,7 +1,11 @@
 // The sequence runner (temporal/core/runner.h).
 #include "temporal/core/runner.h"
 
+#include <sys/stat.h>
+
 #include <algorithm>
+#include <cctype>
+#include <cmath>
 #include <deque>
 #include <filesystem>
 
@@ -29,6 +33,14 @@ std::vector<std::string> layer_channel_names(const std::string& layer) {
   return {};
 }
 
+// Outputs are OpenEXR: refuse another extension before any work is done.
+Status check_output_name(const std::string& pattern, const char* option) {
+  std::string ext = std::filesystem::path(pattern).extension().string();
+  for (auto& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
+  if (ext == ".exr") return Status::ok();
+  return Error::usage(std::string(option) + " '" + pattern + "' must end in .exr: the tools write OpenEXR");
+}
+
 // Everything the loop needs, resolved from the options once.
 struct Plan {
   SequencePattern input, out;
@@ -43,8 +55,11 @@ Expected<Plan> make_plan(const SequenceOptions& o, const StageInputs& needs) {
   if (!input) return input.error();
   auto out = SequencePattern::parse(o.out);
   if (!out) return out.error();
-  if (input->has_placeholder() && !out->has_placeholder())
+  if ((input->has_placeholder() || needs.outputs_per_frame > 1) && !out->has_placeholder())
     return Error::usage("--out '" + o.out + "' needs a frame placeholder (#### or %04d) for a sequence");
+  if (Status s = check_output_name(o.out, "--out"); !s) return s.error();
+  if (!o.state_out.empty())
+    if (Status s = check_output_name(o.state_out, "--state-out"); !s) return s.error();
   std::optional<FrameRange> range;
   if (!o.frames.empty()) {
     auto r = FrameRange::parse(o.frames);
@@ -95,7 +110,9 @@ class InputWindow {
   Status advance(int frame) {
     while (!cache_.empty() && cache_.front().first < frame) cache_.pop_front();
     int next = cache_.empty() ? frame : cache_.back().first + 1;
-    for (; next <= frame + needs_.lookahead; ++next) {
+    const int last = needs_.lookahead_past_range ? frame + needs_.lookahead
+                                                 : std::min(frame + needs_.lookahead, plan_.frames.back());
+    for (; next <= last; ++next) {
       const std::string path = plan_.input.path(next);
       if (next != frame && !std::filesystem::exists(path)) break;
       auto img = read_exr(path, ExrSelection{needs_.input_layers});
@@ -139,7 +156,8 @@ Status check_gbuffer_size(const Image& g, const Image& input, const StageInputs&
                                  " per axis (full = k * low)");
 }
 
-Status write_state(const Plan& plan, const FrameStage& stage, const RunIdentity& id, int frame) {
+Status write_state(const Plan& plan, const FrameStage& stage, const RunIdentity& id, int frame, const ProtectedInputs& inputs) {
+  if (Status s = inputs.check(plan.state_out->path(frame), "--state-out"); !s) return s;
   auto state = stage.save_state();
   if (!state) return state.error();
   FrameMetadata& md = state->metadata();
@@ -150,6 +168,19 @@ Status write_state(const Plan& plan, const FrameStage& stage, const RunIdentity&
 }
 
 }  // namespace
+
+void ProtectedInputs::add(const std::string& path) {
+  struct stat st {};
+  if (::stat(path.c_str(), &st) == 0) ids_.insert({std::uint64_t(st.st_dev), std::uint64_t(st.st_ino)});
+}
+
+Status ProtectedInputs::check(const std::string& path, const std::string& what) const {
+  struct stat st {};
+  if (::stat(path.c_str(), &st) != 0 || !ids_.count({std::uint64_t(st.st_dev), std::uint64_t(st.st_ino)}))
+    return Status::ok();
+  return Error::usage(what + " '" + path + "' is one of this run's inputs: writing it would destroy data not read "
+                      "yet; choose another output folder or name");
+}
 
 Expected<ExrCompression> parse_data_compression(const std::string& name) {
   auto c = parse_compression(name);
@@ -177,7 +208,7 @@ Status check_gbuffer_layers(const Image& g, const std::vector<LayerNeed>& needs,
 }
 
 std::size_t count_non_finite_layers(const Image& image, const std::vector<std::string>& layers) {
-  std::size_t n = 0;
+  std::vector<const float*> planes;
   for (const auto& name : image.channel_names()) {
     bool selected = layers.empty();
     for (const auto& l : layers) {
@@ -185,7 +216,13 @@ std::size_t count_non_finite_layers(const Image& image, const std::vector<std::s
       selected = selected || name == l || std::find(channels.begin(), channels.end(), name) != channels.end() ||
                  name.rfind(l + ".", 0) == 0 || (l == "rgb" && (name == "R" || name == "G" || name == "B"));
     }
-    if (const float* p = selected ? image.plane(name) : nullptr) n += count_non_finite({p, image.pixel_count()});
+    if (const float* p = selected ? image.plane(name) : nullptr) planes.push_back(p);
+  }
+  std::size_t n = 0;
+  for (std::size_t i = 0; i < image.pixel_count(); ++i) {
+    bool finite = true;
+    for (const float* p : planes) finite = finite && std::isfinite(p[i]);
+    n += finite ? 0 : 1;
   }
   return n;
 }
@@ -215,8 +252,22 @@ Expected<RunSummary> run_sequence(const SequenceOptions& options, FrameStage& st
     resumed = true;
   }
 
+  // Every file the run reads: no output may replace one of them (an output pattern equal to an input pattern,
+  // another spelling of it, or a link to it).
+  ProtectedInputs inputs;
+  for (const int f : plan->frames) {
+    inputs.add(plan->input.path(f));
+    for (int k = 1; k <= needs.lookahead; ++k) inputs.add(plan->input.path(f + k));
+    if (plan->gbuffer) inputs.add(plan->gbuffer->path(f));
+  }
+  if (!options.state_in.empty()) inputs.add(options.state_in);
+  if (Status s = inputs.check(plan->out.path(plan->frames.front()), "--out"); !s) return s.error();
+  if (plan->state_out)
+    if (Status s = inputs.check(plan->state_out->path(plan->frames.front()), "--state-out"); !s) return s.error();
+
   RunSummary summary;
   InputWindow window(*plan, needs);
+  int width = 0, height = 0;
   const std::vector<std::string> gsel = gbuffer_selection(needs);
   std::vector<StageOutput> outputs;
   int prev = -1;
@@ -231,9 +282,17 @@ Expected<RunSummary> run_sequence(const SequenceOptions& options, FrameStage& st
     if (Status s = window.advance(frame); !s) return s.error();
     sf.input = &window.current();
     sf.next = window.next();
+    if (i == 0) {
+      width = sf.input->width();
+      height = sf.input->height();
+    } else if (sf.input->width() != width || sf.input->height() != height) {
+      return Error::input(sf.input_path, "is " + dims(sf.input->width(), sf.input->height()) + " but frame " +
+                                             std::to_string(plan->frames.front()) + " is " + dims(width, height) +
+                                             ": every frame of a sequence must have one size");
+    }
     if (const std::size_t bad = count_non_finite_layers(*sf.input, needs.input_layers); bad > 0) {
       warn(sf.input_path, std::to_string(bad) +
-                              " non-finite values (NaN/Inf): treated as missing samples and kept out of every history");
+                              " pixels hold NaN or Inf: treated as missing samples and kept out of every history");
       summary.non_finite_input += bad;
     }
     Image gbuffer;
@@ -244,8 +303,8 @@ Expected<RunSummary> run_sequence(const SequenceOptions& options, FrameStage& st
       if (Status s = check_gbuffer_layers(*g, needs.gbuffer_layers, sf.gbuffer_path); !s) return s.error();
       if (Status s = check_gbuffer_size(*g, *sf.input, needs, sf.gbuffer_path, sf.input_path); !s) return s.error();
       if (const std::size_t bad = count_non_finite_layers(*g, gsel); bad > 0) {
-        warn(sf.gbuffer_path, std::to_string(bad) + " non-finite G-buffer values (NaN/Inf): those pixels get no "
-                                                     "history and no spatial weight");
+        warn(sf.gbuffer_path, std::to_string(bad) + " pixels hold NaN or Inf in the G-buffer: they get no history "
+                                                     "and no spatial weight");
         summary.non_finite_gbuffer += bad;
       }
       gbuffer = std::move(*g);
@@ -269,12 +328,14 @@ Expected<RunSummary> run_sequence(const SequenceOptions& options, FrameStage& st
       md.timings_ms = o.timings_ms;  // the input's pass timings describe another stage
       for (const auto& [k, v] : o.extra) md.extra[k] = v;
       o.image->metadata() = std::move(md);
-      if (Status s = write_exr(plan->out.path(o.frame), *o.image, plan->write); !s) return s.error();
+      const std::string path = plan->out.path(o.frame);
+      if (Status s = inputs.check(path, "--out"); !s) return s.error();
+      if (Status s = write_exr(path, *o.image, plan->write); !s) return s.error();
       summary.compute_ms += o.compute_ms;
       ++summary.outputs;
     }
     if (plan->state_out && (plan->state_out->has_placeholder() || i + 1 == n))
-      if (Status s = write_state(*plan, stage, identity, frame); !s) return s.error();
+      if (Status s = write_state(*plan, stage, identity, frame, inputs); !s) return s.error();
     if (const std::string line = stage.frame_summary(); !line.empty())
       log("frame " + std::to_string(frame) + ": " + line + (sf.cut ? " (history reset)" : ""));
     if (hooks.frame_done) hooks.frame_done(frame, int(i + 1), int(n));

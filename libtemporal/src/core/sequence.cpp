@@ -21,9 +21,29 @@ std::string_view trim(std::string_view s) {
   return s;
 }
 
+// Frame numbers the tools accept: 0 .. kMaxFrame (a run of eight digits; larger numbers are a typing error, and
+// loops over them would not end in any useful time).
+constexpr int kMaxFrame = 99'999'999;
+
+// A pattern for messages: long ones are cut (a mistyped width can make them megabytes long).
+std::string shown(const std::string& pattern) {
+  return pattern.size() <= 200 ? pattern : pattern.substr(0, 200) + "...";
+}
+
 }  // namespace
 
 Expected<FrameRange> FrameRange::parse(std::string_view text) {
+  auto checked = parse_unchecked(text);
+  if (!checked) return checked;
+  if (checked->first < 0)
+    return Error::usage("--frames " + std::string(trim(text)) + ": frames are numbered from 0 (frame N is time N / fps)");
+  if (checked->last > kMaxFrame)
+    return Error::usage("--frames " + std::string(trim(text)) + ": frame numbers above " + std::to_string(kMaxFrame) +
+                        " are not supported");
+  return checked;
+}
+
+Expected<FrameRange> FrameRange::parse_unchecked(std::string_view text) {
   text = trim(text);
   // A leading '-' belongs to a negative first frame, so look for the separator after the first character.
   const auto dash = text.find('-', 1);
@@ -44,13 +64,18 @@ Expected<FrameRange> FrameRange::parse(std::string_view text) {
 Expected<SequencePattern> SequencePattern::parse(std::string pattern) {
   SequencePattern p;
   p.pattern_ = pattern;
-  const auto hash = pattern.find('#');
-  const auto pct = pattern.find('%');
+  // The placeholder is in the file name: a folder may contain '#' or '%'.
+  const auto slash = pattern.rfind('/');
+  const std::size_t name_start = slash == std::string::npos ? 0 : slash + 1;
+  const auto hash = pattern.find('#', name_start);
+  const auto pct = pattern.find('%', name_start);
   if (hash != std::string::npos) {
     auto end = pattern.find_first_not_of('#', hash);
     if (end == std::string::npos) end = pattern.size();
     if (pattern.find('#', end) != std::string::npos)
-      return Error::usage("'" + pattern + "' has more than one run of '#': use one placeholder such as name.####.exr");
+      return Error::usage("'" + shown(pattern) + "' has more than one run of '#': use one placeholder such as name.####.exr");
+    if (end - hash > 10)
+      return Error::usage("'" + shown(pattern) + "': a placeholder of more than 10 '#' cannot be meant (frame numbers have at most 8 digits)");
     p.prefix_ = pattern.substr(0, hash);
     p.suffix_ = pattern.substr(end);
     p.width_ = int(end - hash);
@@ -60,14 +85,17 @@ Expected<SequencePattern> SequencePattern::parse(std::string pattern) {
     // %d, %4d or %04d
     std::size_t i = pct + 1;
     int width = 0;
-    while (i < pattern.size() && std::isdigit(static_cast<unsigned char>(pattern[i]))) width = width * 10 + (pattern[i++] - '0');
+    while (i < pattern.size() && std::isdigit(static_cast<unsigned char>(pattern[i])) && width <= 100)
+      width = width * 10 + (pattern[i++] - '0');
     if (i >= pattern.size() || pattern[i] != 'd')
-      return Error::usage("'" + pattern + "': only %d or %0Nd placeholders are understood (or a run of '#')");
+      return Error::usage("'" + shown(pattern) + "': only %d or %0Nd placeholders are understood (or a run of '#')");
+    if (width > 10)
+      return Error::usage("'" + shown(pattern) + "': a placeholder wider than %010d cannot be meant (frame numbers have at most 8 digits)");
     p.prefix_ = pattern.substr(0, pct);
     p.suffix_ = pattern.substr(i + 1);
     p.width_ = width;
     if (p.suffix_.find('%') != std::string::npos)
-      return Error::usage("'" + pattern + "' has more than one placeholder");
+      return Error::usage("'" + shown(pattern) + "' has more than one placeholder");
     return p;
   }
   p.prefix_ = pattern;

@@ -2,14 +2,17 @@
 //
 // Streaming: each frame's reference, G-buffer and test files are read, measured and dropped; what survives a
 // frame is the luminance of the reference and of each test (for flicker) and the metric rows. Only the layers
-// that are compared (plus `motion` and the mask) are read from the multi-part files.
+// that are compared (plus `motion` and the mask) are read from the multi-part files. The engine prepares what
+// several metrics share (validity, luminance, the motion-compensated change of luminance, the error-map image);
+// the metrics themselves are the registry's (registry.cpp).
 #include "temporal/metrics/comparison.h"
 
 #include "temporal/core/exr.h"
 #include "temporal/metrics/flicker.h"
 #include "temporal/core/image.h"
 #include "temporal/metrics/metrics.h"
-#include "temporal/metrics/warp.h"
+#include "temporal/core/reproject.h"
+#include "temporal/core/runner.h"
 
 #include <algorithm>
 #include <chrono>
@@ -60,11 +63,6 @@ std::vector<const float*> planes_of(const Image& image, const std::vector<std::s
   return planes;
 }
 
-std::string suffix_of(const std::string& name) {
-  const auto dot = name.rfind('.');
-  return dot == std::string::npos ? name : name.substr(dot + 1);
-}
-
 // Per-test state that lives across frames.
 struct TestState {
   SequencePattern pattern;
@@ -74,7 +72,458 @@ struct TestState {
   SequenceReport report;
 };
 
+// One comparison run: setup checks and inputs (open), then per frame the reference (reference_frame) and each
+// test (test_frame).
+class Run {
+ public:
+  Run(const ComparisonSetup& setup, const ComparisonHooks& hooks) : setup_(setup), hooks_(hooks) {}
+
+  Expected<ComparisonReport> run() {
+    if (auto st = open(); !st) return st.error();
+    // A range that starts after the first frame on disk (a shard of a longer sequence) first reads the frame
+    // before it, without reporting it: the first compared frame then gets the flicker value a single run over the
+    // whole sequence gives it, and per-shard results merge exactly (docs/compare.md, "Shards").
+    std::vector<int> order = report_.frames;
+    const bool prime = setup_.frames && previous_frame_exists(report_.frames.front() - 1);
+    if (prime) order.insert(order.begin(), report_.frames.front() - 1);
+    for (std::size_t fi = 0; fi < order.size(); ++fi) {
+      const int frame = order[fi];
+      priming_ = prime && fi == 0;
+      if (auto st = reference_frame(fi, frame); !st) return st.error();
+      for (auto& t : tests_) {
+        if (auto st = test_frame(t, fi, frame); !st) return st.error();
+        if (priming_) t.report.frames.pop_back();  // history only
+      }
+      if (ref_invalid_ && !priming_)
+        warn(ref_path_, std::to_string(ref_invalid_) + " pixels hold NaN or Inf; they are excluded from every metric");
+      for (std::size_t i = 0; i < n_; ++i)
+        if (!ref_valid_[i]) ref_y_[i] = std::numeric_limits<float>::quiet_NaN();
+      std::swap(ref_y_, ref_prev_y_);
+      ref_has_prev_ = true;
+      if (hooks_.frame_done && !priming_)
+        hooks_.frame_done(frame, int(fi + (prime ? 0 : 1)), int(report_.frames.size()));
+    }
+    priming_ = false;
+    for (auto& t : tests_) report_.sequences.push_back(std::move(t.report));
+    return std::move(report_);
+  }
+
+ private:
+  void log(const std::string& text) const {
+    if (hooks_.log) hooks_.log(text);
+  }
+  void warn(const std::string& file, const std::string& text) const {
+    if (hooks_.warning) hooks_.warning(file, text);
+  }
+
+  Status open();
+  Status open_tests(const FrameRange& range);
+  Status find_masks();
+  Status reference_frame(std::size_t fi, int frame);
+  Status test_frame(TestState& t, std::size_t fi, int frame);
+  FrameInputs inputs(TestState& t, int frame, std::span<const float* const> planes,
+                     std::span<const std::string> names, const float* mask, double peak, bool change, Image* maps);
+  Status write_maps(Image& maps, const Image& test, const TestState& t, const std::string& path, int frame,
+                    const FrameMetrics& m);
+
+  const ComparisonSetup& setup_;
+  const ComparisonHooks& hooks_;
+  ComparisonReport report_;
+  std::vector<const MetricDefinition*> definitions_;
+  std::vector<std::unique_ptr<FrameMeasure>> measures_;
+  std::optional<SequencePattern> ref_pattern_, gbuf_pattern_;
+  std::vector<TestState> tests_;
+  bool gbuf_mask_ = false, ref_mask_ = false;
+  ProtectedInputs inputs_;  // every file this comparison reads: no error map may replace one
+  bool priming_ = false;     // this frame only primes the history (the frame before a --frames range)
+  // True when frame `f` of the reference, of every test and of the G-buffer exists on disk.
+  bool previous_frame_exists(int f) const {
+    if (f < 0 || !std::filesystem::exists(ref_pattern_->path(f))) return false;
+    for (const auto& t : tests_)
+      if (!std::filesystem::exists(t.pattern.path(f))) return false;
+    return !gbuf_pattern_ || std::filesystem::exists(gbuf_pattern_->path(f));
+  }
+  bool gbuf_geometry_ = false, have_prev_geometry_ = false;  // G-buffer depth and ids for the disocclusion test
+  std::vector<float> prev_z_;
+  std::vector<std::uint32_t> prev_id_;
+  ExrSelection ref_sel_, gbuf_sel_;
+  // The current frame: reference and G-buffer, and the shared work planes (allocated at the first frame).
+  std::optional<Image> ref_, gbuf_;
+  std::string ref_path_;
+  std::vector<std::string> ref_names_;
+  std::vector<const float*> ref_planes_;
+  std::vector<float> ref_y_, ref_prev_y_, ref_delta_, warped_;
+  std::vector<std::uint8_t> ref_valid_, valid_;
+  std::size_t ref_invalid_ = 0;
+  bool ref_has_prev_ = false, history_ = false;
+  std::size_t n_ = 0;
+  int width_ = 0, height_ = 0;
+};
+
+Status Run::open() {
+  if (setup_.tests.empty()) return Error::usage("no test sequence given: name at least one TEST.####.exr after --reference");
+  if (!setup_.names.empty() && setup_.names.size() != setup_.tests.size())
+    return Error::usage("--names has " + std::to_string(setup_.names.size()) + " names for " +
+                        std::to_string(setup_.tests.size()) + " test sequences: give one name per test, comma-separated");
+  if (!(setup_.peak > 0.0) || !std::isfinite(setup_.peak)) return Error::usage("--peak must be a positive number or 'max'");
+  if (setup_.flip != FlipMode::Off &&
+      (!(setup_.flip_options.pixels_per_degree > 0.0) || !std::isfinite(setup_.flip_options.pixels_per_degree)))
+    return Error::usage("--ppd must be a positive number of pixels per degree (FLIP's default: 67.0206)");
+
+  report_.reference = setup_.reference;
+  report_.gbuffer = setup_.gbuffer;
+  report_.layer = setup_.layer.empty() ? std::string("rgb") : setup_.layer;
+  report_.reference_layer = setup_.reference_layer.empty() ? report_.layer : setup_.reference_layer;
+  report_.mask = setup_.mask;
+  report_.motion_compensated = !setup_.gbuffer.empty();
+  report_.warmup_frames = setup_.warmup_frames;
+  report_.bootstrap = setup_.bootstrap;
+  report_.peak = setup_.peak;
+  report_.peak_from_data = setup_.peak_from_data;
+  report_.flip = setup_.flip;
+  report_.pixels_per_degree = setup_.flip_options.pixels_per_degree;
+  definitions_ = enabled_metrics(setup_);
+  for (const auto* d : definitions_) {
+    report_.metrics.push_back(d->name);
+    measures_.push_back(d->make(setup_));
+  }
+
+  auto ref_pattern = SequencePattern::parse(setup_.reference);
+  if (!ref_pattern) return ref_pattern.error();
+  ref_pattern_ = *ref_pattern;
+  auto frames = resolve_frames(*ref_pattern_, setup_.frames);
+  if (!frames) return frames.error();
+  report_.frames = *frames;
+  const FrameRange range{report_.frames.front(), report_.frames.back()};
+
+  if (!setup_.gbuffer.empty()) {
+    auto p = SequencePattern::parse(setup_.gbuffer);
+    if (!p) return p.error();
+    if (auto f = resolve_frames(*p, range); !f) return f.error();
+    gbuf_pattern_ = *p;
+  }
+  if (auto st = open_tests(range); !st) return st;
+  if (auto st = find_masks(); !st) return st;
+  auto inputs = comparison_inputs(setup_);
+  if (!inputs) return inputs.error();
+  inputs_ = std::move(*inputs);
+  if (!setup_.error_maps.empty())  // before any work: an error map that would replace a frame not read yet
+    for (const auto& t : tests_)
+      for (const int f : report_.frames)
+        if (auto st = inputs_.check(frame_file(setup_.error_maps, t.report.name, f), "--error-maps"); !st) return st;
+  ref_sel_ = ExrSelection{{report_.reference_layer}};
+  if (ref_mask_) ref_sel_.layers.push_back(setup_.mask);
+  gbuf_sel_ = ExrSelection{{"motion"}};
+  if (gbuf_pattern_) {
+    // With depth and ids the flicker drops disoccluded pixels by the shared rule (temporal/core/reproject.h),
+    // as the methods do; a G-buffer with motion only gets the off-screen rule.
+    auto info = read_exr_info(gbuf_pattern_->path(report_.frames.front()));
+    if (!info) return info.error();
+    const auto& c = info->channels;
+    gbuf_geometry_ = std::find(c.begin(), c.end(), "depth.Z") != c.end() && std::find(c.begin(), c.end(), "id") != c.end();
+    if (gbuf_geometry_) gbuf_sel_.layers.insert(gbuf_sel_.layers.end(), {"depth", "id"});
+    report_.disocclusion_tested = gbuf_geometry_;
+  }
+  if (gbuf_mask_) gbuf_sel_.layers.push_back(setup_.mask);
+  return {};
+}
+
+Status Run::open_tests(const FrameRange& range) {
+  for (std::size_t i = 0; i < setup_.tests.size(); ++i) {
+    auto p = SequencePattern::parse(setup_.tests[i]);
+    if (!p) return p.error();
+    // Every frame must exist before any work is done: a missing file is reported at once.
+    if (auto f = resolve_frames(*p, range); !f) return f.error();
+    TestState t{*p, {}, {}, {}, {}, false, {}};
+    t.report.name = setup_.names.empty() ? sequence_name(setup_.tests[i]) : setup_.names[i];
+    t.report.pattern = setup_.tests[i];
+    tests_.push_back(std::move(t));
+  }
+  if (setup_.names.empty()) {  // make derived names unique: a/out.####.exr, b/out.####.exr -> a/out, b/out
+    for (std::size_t i = 0; i < tests_.size(); ++i)
+      for (std::size_t j = 0; j < tests_.size(); ++j)
+        if (i != j && tests_[i].report.name == sequence_name(setup_.tests[j])) {
+          const auto parent = fs::path(setup_.tests[i]).parent_path().filename().string();
+          tests_[i].report.name = (parent.empty() ? std::to_string(i + 1) : parent) + "/" + sequence_name(setup_.tests[i]);
+          break;
+        }
+  }
+  return {};
+}
+
+// Where the mask comes from: the test itself (a method's debug layer), else the G-buffer, else the reference.
+Status Run::find_masks() {
+  if (setup_.mask.empty()) return {};
+  const int first = report_.frames.front();
+  std::vector<std::string> gbuf_channels, ref_channels;
+  if (gbuf_pattern_) {
+    auto info = read_exr_info(gbuf_pattern_->path(first));
+    if (!info) return info.error();
+    gbuf_channels = info->channels;
+  }
+  auto ref_info = read_exr_info(ref_pattern_->path(first));
+  if (!ref_info) return ref_info.error();
+  ref_channels = ref_info->channels;
+  for (auto& t : tests_) {
+    auto info = read_exr_info(t.pattern.path(first));
+    if (!info) return info.error();
+    if (has_layer(info->channels, setup_.mask)) t.mask_source = "test";
+    else if (has_layer(gbuf_channels, setup_.mask)) t.mask_source = "gbuffer";
+    else if (has_layer(ref_channels, setup_.mask)) t.mask_source = "reference";
+    else
+      return Error::input(t.pattern.path(first), "no mask layer '" + setup_.mask + "' in this file" +
+                                                     (gbuf_pattern_ ? ", the G-buffer" : "") +
+                                                     " or the reference: write it (e.g. --debug-layers) or drop --mask");
+    gbuf_mask_ = gbuf_mask_ || t.mask_source == "gbuffer";
+    ref_mask_ = ref_mask_ || t.mask_source == "reference";
+    t.report.mask_source = t.mask_source;
+    log(t.report.name + ": mask '" + setup_.mask + "' from the " + t.mask_source);
+  }
+  return {};
+}
+
+// The reference (and G-buffer) of a frame: size and channel checks, luminance, validity, and the previous
+// luminance of the reference and of every test fetched along the motion in one pass.
+Status Run::reference_frame(std::size_t fi, int frame) {
+  ref_path_ = ref_pattern_->path(frame);
+  auto ref = read_exr(ref_path_, ref_sel_);
+  if (!ref) return ref.error();
+  ref_names_ = compared_channels(*ref, report_.reference_layer);
+  if (ref_names_.empty())
+    return Error::input(ref_path_, "no channels for layer '" + report_.reference_layer + "'; pick another --layer");
+  if (fi == 0) {
+    width_ = ref->width();
+    height_ = ref->height();
+    n_ = ref->pixel_count();
+    report_.width = width_;
+    report_.height = height_;
+    report_.reference_channels = ref_names_;
+    const int window = 11;
+    if (width_ < window || height_ < window)
+      return Error::input(ref_path_, "image is " + size_text(width_, height_) +
+                                         "; compare needs at least 11x11 pixels (the SSIM window)");
+    for (auto* v : {&ref_y_, &ref_prev_y_, &ref_delta_, &warped_}) v->resize(n_);
+    ref_valid_.resize(n_);
+    valid_.resize(n_);
+    for (auto& t : tests_) {
+      t.y.resize(n_);
+      t.prev_y.resize(n_);
+      t.delta.resize(n_);
+    }
+  } else if (ref->width() != width_ || ref->height() != height_) {
+    return Error::input(ref_path_, "is " + size_text(ref->width(), ref->height()) + " but frame " +
+                                       std::to_string(report_.frames.front()) + " is " + size_text(width_, height_) +
+                                       "; every frame of a sequence must have one size");
+  } else if (ref_names_ != report_.reference_channels) {
+    return Error::input(ref_path_, "has other channels for layer '" + report_.reference_layer + "' than frame " +
+                                       std::to_string(report_.frames.front()));
+  }
+  ref_ = std::move(*ref);
+
+  gbuf_.reset();
+  if (gbuf_pattern_) {
+    const std::string gpath = gbuf_pattern_->path(frame);
+    auto g = read_exr(gpath, gbuf_sel_);
+    if (!g) return g.error();
+    if (g->width() != width_ || g->height() != height_)
+      return Error::input(gpath, "G-buffer is " + size_text(g->width(), g->height()) + " but the reference is " +
+                                     size_text(width_, height_) + "; give the G-buffer rendered at the reference's size");
+    if (!g->plane("motion.X") || !g->plane("motion.Y"))
+      return Error::input(gpath, "the motion layer needs float channels motion.X and motion.Y");
+    if (gbuf_geometry_ && (!g->plane("depth.Z") || !g->uint_plane("id")))
+      return Error::input(gpath, "has no depth.Z or no uint id while frame " + std::to_string(report_.frames.front()) +
+                                     " has them; every G-buffer frame must carry the same layers");
+    if (const std::size_t bad = count_non_finite_layers(*g, {"motion", "depth"}); bad > 0)
+      warn(gpath, std::to_string(bad) + " pixels hold NaN or Inf in motion or depth: they have no history, so no "
+                                        "flicker value");
+    gbuf_ = std::move(*g);
+  }
+  const bool cut = (gbuf_ && gbuf_->metadata().camera_cut.value_or(false)) || ref_->metadata().camera_cut.value_or(false);
+  if (cut) log("frame " + std::to_string(frame) + ": camera cut, no flicker value");
+
+  ref_planes_ = planes_of(*ref_, ref_names_);
+  luminance_plane(ref_planes_, n_, ref_y_.data());
+  ref_invalid_ = finite_mask(ref_planes_, {}, n_, ref_valid_.data());
+  history_ = ref_has_prev_ && !cut;
+  if (history_) {
+    // One motion-compensated fetch for the previous luminance of the reference and of every test (they share
+    // the motion field); each test's warped history lands in its delta plane, finished in test_frame.
+    std::vector<const float*> previous = {ref_prev_y_.data()};
+    std::vector<float*> warped_out = {warped_.data()};
+    for (auto& t : tests_) {
+      previous.push_back(t.prev_y.data());
+      warped_out.push_back(t.delta.data());
+    }
+    reproject::Frames fr;
+    fr.width = width_;
+    fr.height = height_;
+    fr.motion_x = gbuf_ ? gbuf_->plane("motion.X") : nullptr;
+    fr.motion_y = gbuf_ ? gbuf_->plane("motion.Y") : nullptr;
+    if (gbuf_geometry_ && have_prev_geometry_) {
+      fr.z = gbuf_->plane("depth.Z");
+      fr.id = gbuf_->uint_plane("id");
+      fr.prev_z = prev_z_.data();
+      fr.prev_id = prev_id_.data();
+    }
+    reproject::warp_planes(fr, previous, warped_out);
+    temporal_delta(ref_y_.data(), warped_.data(), n_, ref_delta_.data());
+  }
+  if (gbuf_geometry_ && gbuf_) {  // the previous frame's geometry for the next frame's disocclusion test
+    const float* z = gbuf_->plane("depth.Z");
+    const std::uint32_t* id = gbuf_->uint_plane("id");
+    prev_z_.assign(z, z + n_);
+    prev_id_.assign(id, id + n_);
+    have_prev_geometry_ = true;
+  }
+  return {};
+}
+
+// One test frame: checks, the shared inputs (validity, luminance, temporal change), every measure, error maps.
+Status Run::test_frame(TestState& t, std::size_t fi, int frame) {
+  const std::string path = t.pattern.path(frame);
+  ExrSelection sel{{report_.layer}};
+  if (t.mask_source == "test") sel.layers.push_back(setup_.mask);
+  auto img = read_exr(path, sel);
+  if (!img) return img.error();
+  if (img->width() != width_ || img->height() != height_)
+    return Error::input(path, "is " + size_text(img->width(), img->height()) + " but the reference " + ref_path_ +
+                                  " is " + size_text(width_, height_) + "; compare images of the same size");
+  const auto names = compared_channels(*img, report_.layer);
+  if (names.size() != ref_names_.size())
+    return Error::input(path, "layer '" + report_.layer + "' has " + std::to_string(names.size()) +
+                                  " channels but the reference's '" + report_.reference_layer + "' has " +
+                                  std::to_string(ref_names_.size()) + "; pick matching layers (--layer, --reference-layer)");
+  if (fi == 0) report_.channels = names;
+  const float* mask = nullptr;
+  if (t.mask_source == "test") mask = mask_plane(*img, setup_.mask);
+  else if (t.mask_source == "gbuffer") mask = mask_plane(*gbuf_, setup_.mask);
+  else if (t.mask_source == "reference") mask = mask_plane(*ref_, setup_.mask);
+  if (!setup_.mask.empty() && !mask)
+    return Error::input(path, "mask '" + setup_.mask + "' is missing or not a float channel at this frame");
+
+  const auto t0 = std::chrono::steady_clock::now();
+  const auto planes = planes_of(*img, names);
+  FrameMetrics m;
+  m.frame = frame;
+  m.nonfinite_test = finite_mask(planes, {}, n_, valid_.data());
+  m.nonfinite_reference = ref_invalid_;
+  std::size_t inside = 0;
+  for (std::size_t i = 0; i < n_; ++i) {
+    valid_[i] &= ref_valid_[i];
+    m.valid_pixels += valid_[i];
+    inside += mask && valid_[i] && mask[i] > 0.5f;
+  }
+  m.peak = setup_.peak;
+  if (setup_.peak_from_data) {
+    std::vector<const float*> all = planes;
+    all.insert(all.end(), ref_planes_.begin(), ref_planes_.end());
+    m.peak = idiff_peak(all, n_);
+  }
+  if (mask) {
+    m.has_mask = true;
+    m.mask_fraction = m.valid_pixels ? double(inside) / double(m.valid_pixels) : 0.0;
+  }
+  luminance_plane(planes, n_, t.y.data());
+  const bool change = history_ && t.has_prev;
+  if (change) temporal_delta(t.y.data(), t.delta.data(), n_, t.delta.data());  // t.delta held the warped history
+
+  std::optional<Image> maps;
+  if (!setup_.error_maps.empty() && !priming_) maps.emplace(width_, height_);
+  const FrameInputs in = inputs(t, frame, planes, names, mask, m.peak, change, maps ? &*maps : nullptr);
+  for (std::size_t k = 0; k < measures_.size(); ++k) {
+    MetricSample sample;
+    sample.metric = definitions_[k]->name;
+    if (auto st = measures_[k]->measure(in, sample); !st) {
+      Error e = st.error();
+      if (e.file.empty()) e.file = path;
+      return e;
+    }
+    m.metrics.push_back(std::move(sample));
+  }
+  m.metrics_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  m.compute_ms = img->metadata().compute_ms;
+  m.timings_ms = img->metadata().timings_ms;
+  if (m.nonfinite_test)
+    warn(path, std::to_string(m.nonfinite_test) + " pixels hold NaN or Inf; they are excluded from every metric");
+  for (const auto& sample : m.metrics)
+    if (!sample.values.empty() && std::isinf(sample.values.front()) && sample.values.front() < 0)
+      warn(path, sample.metric + " is -inf: the test holds values so far from the reference that the squared error "
+                                 "overflows (a broken output); --fail-nonfinite makes this a failure");
+  if (maps)
+    if (auto st = write_maps(*maps, *img, t, path, frame, m); !st) return st;
+
+  // Keep this frame's luminance as history; pixels that were not finite must not be compared next frame.
+  for (std::size_t i = 0; i < n_; ++i)
+    if (!valid_[i]) t.y[i] = std::numeric_limits<float>::quiet_NaN();
+  std::swap(t.y, t.prev_y);
+  t.has_prev = true;
+  t.report.frames.push_back(std::move(m));
+  return {};
+}
+
+FrameInputs Run::inputs(TestState& t, int frame, std::span<const float* const> planes,
+                        std::span<const std::string> names, const float* mask, double peak, bool change, Image* maps) {
+  FrameInputs in;
+  in.frame = frame;
+  in.width = width_;
+  in.height = height_;
+  in.test = planes;
+  in.reference = ref_planes_;
+  in.channels = names;
+  in.test_y = t.y.data();
+  in.reference_y = ref_y_.data();
+  in.valid = valid_.data();
+  in.mask = mask;
+  in.peak = peak;
+  in.test_change = change ? t.delta.data() : nullptr;
+  in.reference_change = change ? ref_delta_.data() : nullptr;
+  in.maps = maps;
+  return in;
+}
+
+// The metrics' channels are in `maps` already; error.invalid and the header complete it.
+Status Run::write_maps(Image& maps, const Image& test, const TestState& t, const std::string& path, int frame,
+                       const FrameMetrics& m) {
+  float* inv = maps.add_channel("error.invalid");
+  for (std::size_t i = 0; i < n_; ++i) inv[i] = valid_[i] ? 0.0f : 1.0f;
+  auto& md = maps.metadata();
+  md.frame = frame;
+  md.fps = test.metadata().fps;
+  md.time = test.metadata().time;
+  md.compute_ms = m.metrics_ms;
+  md.tool = setup_.tool;
+  md.parameters = setup_.parameters;
+  md.extra["reference"] = ref_path_;
+  md.extra["test"] = path;
+  md.extra["nonFinitePixels"] = std::to_string(m.nonfinite_test);
+  const std::string out = frame_file(setup_.error_maps, t.report.name, frame);
+  if (Status st = inputs_.check(out, "--error-maps"); !st) return st;
+  return write_exr(out, maps);
+}
+
 }  // namespace
+
+Expected<ProtectedInputs> comparison_inputs(const ComparisonSetup& setup) {
+  ProtectedInputs inputs;
+  auto ref = SequencePattern::parse(setup.reference);
+  if (!ref) return ref.error();
+  auto frames = resolve_frames(*ref, setup.frames);
+  if (!frames) return frames.error();
+  std::vector<SequencePattern> patterns = {*ref};
+  for (const auto& t : setup.tests) {
+    auto p = SequencePattern::parse(t);
+    if (!p) return p.error();
+    patterns.push_back(*p);
+  }
+  if (!setup.gbuffer.empty()) {
+    auto g = SequencePattern::parse(setup.gbuffer);
+    if (!g) return g.error();
+    patterns.push_back(*g);
+  }
+  for (const auto& p : patterns)
+    for (const int f : *frames) inputs.add(p.path(f));
+  return inputs;
+}
 
 std::string sequence_name(const std::string& pattern) {
   std::string name = fs::path(pattern).filename().string();
@@ -92,339 +541,37 @@ std::string sequence_name(const std::string& pattern) {
 }
 
 Expected<ComparisonReport> compare_sequences(const ComparisonSetup& setup, const ComparisonHooks& hooks) {
-  auto log = [&](const std::string& text) {
-    if (hooks.log) hooks.log(text);
-  };
-  auto warn = [&](const std::string& file, const std::string& text) {
-    if (hooks.warning) hooks.warning(file, text);
-  };
-  if (setup.tests.empty()) return Error::usage("no test sequence given: name at least one TEST.####.exr after --reference");
-  if (!setup.names.empty() && setup.names.size() != setup.tests.size())
-    return Error::usage("--names has " + std::to_string(setup.names.size()) + " names for " +
-                        std::to_string(setup.tests.size()) + " test sequences: give one name per test, comma-separated");
-  if (!(setup.peak > 0.0) || !std::isfinite(setup.peak)) return Error::usage("--peak must be a positive number or 'max'");
-
-  ComparisonReport report;
-  report.reference = setup.reference;
-  report.gbuffer = setup.gbuffer;
-  report.layer = setup.layer.empty() ? std::string("rgb") : setup.layer;
-  report.reference_layer = setup.reference_layer.empty() ? report.layer : setup.reference_layer;
-  report.mask = setup.mask;
-  report.motion_compensated = !setup.gbuffer.empty();
-  report.peak = setup.peak;
-  report.peak_from_data = setup.peak_from_data;
-
-  auto ref_pattern = SequencePattern::parse(setup.reference);
-  if (!ref_pattern) return ref_pattern.error();
-  auto frames = resolve_frames(*ref_pattern, setup.frames);
-  if (!frames) return frames.error();
-  report.frames = *frames;
-  const FrameRange range{report.frames.front(), report.frames.back()};
-
-  std::optional<SequencePattern> gbuf_pattern;
-  if (!setup.gbuffer.empty()) {
-    auto p = SequencePattern::parse(setup.gbuffer);
-    if (!p) return p.error();
-    if (auto f = resolve_frames(*p, range); !f) return f.error();
-    gbuf_pattern = *p;
-  }
-
-  std::vector<TestState> tests;
-  for (std::size_t i = 0; i < setup.tests.size(); ++i) {
-    auto p = SequencePattern::parse(setup.tests[i]);
-    if (!p) return p.error();
-    // Every frame must exist before any work is done: a missing file is reported at once.
-    if (auto f = resolve_frames(*p, range); !f) return f.error();
-    TestState t{*p, {}, {}, {}, {}, false, {}};
-    t.report.name = setup.names.empty() ? sequence_name(setup.tests[i]) : setup.names[i];
-    t.report.pattern = setup.tests[i];
-    tests.push_back(std::move(t));
-  }
-  if (setup.names.empty()) {  // make derived names unique: a/out.####.exr, b/out.####.exr -> a/out, b/out
-    for (std::size_t i = 0; i < tests.size(); ++i)
-      for (std::size_t j = 0; j < tests.size(); ++j)
-        if (i != j && tests[i].report.name == sequence_name(setup.tests[j])) {
-          const auto parent = fs::path(setup.tests[i]).parent_path().filename().string();
-          tests[i].report.name = (parent.empty() ? std::to_string(i + 1) : parent) + "/" + sequence_name(setup.tests[i]);
-          break;
-        }
-  }
-
-  // Where the mask comes from: the test itself (a method's debug layer), else the G-buffer, else the reference.
-  const int first = report.frames.front();
-  bool gbuf_mask = false, ref_mask = false;
-  if (!setup.mask.empty()) {
-    std::vector<std::string> gbuf_channels, ref_channels;
-    if (gbuf_pattern) {
-      auto info = read_exr_info(gbuf_pattern->path(first));
-      if (!info) return info.error();
-      gbuf_channels = info->channels;
-    }
-    auto ref_info = read_exr_info(ref_pattern->path(first));
-    if (!ref_info) return ref_info.error();
-    ref_channels = ref_info->channels;
-    for (auto& t : tests) {
-      auto info = read_exr_info(t.pattern.path(first));
-      if (!info) return info.error();
-      if (has_layer(info->channels, setup.mask)) t.mask_source = "test";
-      else if (has_layer(gbuf_channels, setup.mask)) t.mask_source = "gbuffer";
-      else if (has_layer(ref_channels, setup.mask)) t.mask_source = "reference";
-      else
-        return Error::input(t.pattern.path(first), "no mask layer '" + setup.mask + "' in this file" +
-                                                       (gbuf_pattern ? ", the G-buffer" : "") +
-                                                       " or the reference: write it (e.g. --debug-layers) or drop --mask");
-      gbuf_mask = gbuf_mask || t.mask_source == "gbuffer";
-      ref_mask = ref_mask || t.mask_source == "reference";
-      t.report.mask_source = t.mask_source;
-      log(t.report.name + ": mask '" + setup.mask + "' from the " + t.mask_source);
-    }
-  }
-
-  ExrSelection ref_sel{{report.reference_layer}};
-  if (ref_mask) ref_sel.layers.push_back(setup.mask);
-  ExrSelection gbuf_sel{{"motion"}};
-  if (gbuf_mask) gbuf_sel.layers.push_back(setup.mask);
-
-  // Work planes, allocated at the first frame and reused.
-  std::vector<float> ref_y, ref_prev_y, ref_delta, warped, ssim_map, flicker_map, luma_diff;
-  std::vector<std::uint8_t> ref_valid, valid;
-  bool ref_has_prev = false;
-  std::size_t n = 0;
-  int width = 0, height = 0;
-
-  for (std::size_t fi = 0; fi < report.frames.size(); ++fi) {
-    const int frame = report.frames[fi];
-    const std::string ref_path = ref_pattern->path(frame);
-    auto ref = read_exr(ref_path, ref_sel);
-    if (!ref) return ref.error();
-    const auto ref_names = compared_channels(*ref, report.reference_layer);
-    if (ref_names.empty())
-      return Error::input(ref_path, "no channels for layer '" + report.reference_layer + "'; pick another --layer");
-    if (fi == 0) {
-      width = ref->width();
-      height = ref->height();
-      n = ref->pixel_count();
-      report.width = width;
-      report.height = height;
-      report.reference_channels = ref_names;
-      const int window = 11;
-      if (width < window || height < window)
-        return Error::input(ref_path, "image is " + size_text(width, height) +
-                                          "; compare needs at least 11x11 pixels (the SSIM window)");
-      for (auto* v : {&ref_y, &ref_prev_y, &ref_delta, &warped, &ssim_map, &flicker_map, &luma_diff}) v->resize(n);
-      ref_valid.resize(n);
-      valid.resize(n);
-      for (auto& t : tests) {
-        t.y.resize(n);
-        t.prev_y.resize(n);
-        t.delta.resize(n);
-      }
-    } else if (ref->width() != width || ref->height() != height) {
-      return Error::input(ref_path, "is " + size_text(ref->width(), ref->height()) + " but frame " +
-                                        std::to_string(report.frames.front()) + " is " + size_text(width, height) +
-                                        "; every frame of a sequence must have one size");
-    } else if (ref_names != report.reference_channels) {
-      return Error::input(ref_path, "has other channels for layer '" + report.reference_layer + "' than frame " +
-                                        std::to_string(report.frames.front()));
-    }
-
-    std::optional<Image> gbuf;
-    if (gbuf_pattern) {
-      const std::string gpath = gbuf_pattern->path(frame);
-      auto g = read_exr(gpath, gbuf_sel);
-      if (!g) return g.error();
-      if (g->width() != width || g->height() != height)
-        return Error::input(gpath, "G-buffer is " + size_text(g->width(), g->height()) + " but the reference is " +
-                                       size_text(width, height) + "; give the G-buffer rendered at the reference's size");
-      if (!g->plane("motion.X") || !g->plane("motion.Y"))
-        return Error::input(gpath, "the motion layer needs float channels motion.X and motion.Y");
-      gbuf = std::move(*g);
-    }
-    const bool cut = (gbuf && gbuf->metadata().camera_cut.value_or(false)) || ref->metadata().camera_cut.value_or(false);
-    const float* mx = gbuf ? gbuf->plane("motion.X") : nullptr;
-    const float* my = gbuf ? gbuf->plane("motion.Y") : nullptr;
-    if (cut) log("frame " + std::to_string(frame) + ": camera cut, no flicker value");
-
-    // Reference: luminance, validity and its own temporal change.
-    const auto ref_planes = planes_of(*ref, ref_names);
-    luminance_plane(ref_planes, n, ref_y.data());
-    const std::size_t ref_invalid = finite_mask(ref_planes, {}, n, ref_valid.data());
-    const bool history = ref_has_prev && !cut;
-    if (history) {
-      // One motion-compensated fetch for the previous luminance of the reference and of every test (they
-      // share the motion field); each test's warped history lands in its delta plane, finished below.
-      std::vector<const float*> previous = {ref_prev_y.data()};
-      std::vector<float*> warped_out = {warped.data()};
-      for (auto& t : tests) {
-        previous.push_back(t.prev_y.data());
-        warped_out.push_back(t.delta.data());
-      }
-      warp_bilinear(previous, width, height, mx, my, warped_out);
-      temporal_delta(ref_y.data(), warped.data(), n, ref_delta.data());
-    }
-
-    for (auto& t : tests) {
-      const std::string path = t.pattern.path(frame);
-      ExrSelection sel{{report.layer}};
-      if (t.mask_source == "test") sel.layers.push_back(setup.mask);
-      auto img = read_exr(path, sel);
-      if (!img) return img.error();
-      if (img->width() != width || img->height() != height)
-        return Error::input(path, "is " + size_text(img->width(), img->height()) + " but the reference " + ref_path +
-                                      " is " + size_text(width, height) + "; compare images of the same size");
-      const auto names = compared_channels(*img, report.layer);
-      if (names.size() != ref_names.size())
-        return Error::input(path, "layer '" + report.layer + "' has " + std::to_string(names.size()) +
-                                      " channels but the reference's '" + report.reference_layer + "' has " +
-                                      std::to_string(ref_names.size()) + "; pick matching layers (--layer, --reference-layer)");
-      if (fi == 0) report.channels = names;
-      const float* mask = nullptr;
-      if (t.mask_source == "test") mask = mask_plane(*img, setup.mask);
-      else if (t.mask_source == "gbuffer") mask = mask_plane(*gbuf, setup.mask);
-      else if (t.mask_source == "reference") mask = mask_plane(*ref, setup.mask);
-      if (!setup.mask.empty() && !mask)
-        return Error::input(path, "mask '" + setup.mask + "' is missing or not a float channel at this frame");
-
-      const auto t0 = std::chrono::steady_clock::now();
-      const auto planes = planes_of(*img, names);
-      FrameMetrics m;
-      m.frame = frame;
-      const std::size_t test_invalid = finite_mask(planes, {}, n, valid.data());
-      for (std::size_t i = 0; i < n; ++i) valid[i] &= ref_valid[i];
-      m.nonfinite_test = test_invalid;
-      m.nonfinite_reference = ref_invalid;
-      m.peak = setup.peak;
-      if (setup.peak_from_data) {
-        std::vector<const float*> all = planes;
-        all.insert(all.end(), ref_planes.begin(), ref_planes.end());
-        m.peak = idiff_peak(all, n);
-      }
-
-      const auto err = squared_error(planes, ref_planes, width, height, valid.data(), mask);
-      m.valid_pixels = err.all.samples / std::max<std::size_t>(1, names.size());
-      m.mse_rgb = err.all.samples ? err.all.mean() : kNaN;
-      m.psnr_rgb = psnr_db(err.all, m.peak);
-
-      luminance_plane(planes, n, t.y.data());
-      const float* ty = t.y.data();
-      const float* ry = ref_y.data();
-      const auto err_y = squared_error({&ty, 1}, {&ry, 1}, width, height, valid.data(), mask);
-      m.psnr_y = psnr_db(err_y.all, m.peak);
-
-      SsimOptions so;
-      so.peak = m.peak;
-      auto s = ssim(t.y.data(), ref_y.data(), width, height, valid.data(), mask, so,
-                    setup.error_maps.empty() ? nullptr : ssim_map.data());
-      if (!s) return Error::input(path, s.error().message);
-      m.ssim = s->mean;
-
-      FlickerResult fl;
-      const bool flick = history && t.has_prev;
-      if (flick) {
-        temporal_delta(t.y.data(), t.delta.data(), n, t.delta.data());  // t.delta held the warped history
-        fl = flicker(t.delta.data(), ref_delta.data(), width, height, valid.data(), mask,
-                     setup.error_maps.empty() ? nullptr : flicker_map.data());
-        m.flicker_pixels = fl.pixels;
-        if (fl.pixels) m.flicker = fl.rms();
-      } else if (!setup.error_maps.empty()) {
-        std::fill(flicker_map.begin(), flicker_map.end(), 0.0f);
-      }
-
-      if (mask) {
-        m.has_mask = true;
-        m.mask_fraction = err.all.samples ? double(err.inside.samples) / double(err.all.samples) : 0.0;
-        m.psnr_rgb_inside = psnr_db(err.inside, m.peak);
-        m.psnr_rgb_outside = psnr_db(err.outside, m.peak);
-        m.psnr_y_inside = psnr_db(err_y.inside, m.peak);
-        m.psnr_y_outside = psnr_db(err_y.outside, m.peak);
-        m.ssim_inside = s->mean_inside;
-        m.ssim_outside = s->mean_outside;
-        if (flick && fl.pixels_inside) m.flicker_inside = fl.rms_inside();
-        if (flick && fl.pixels_outside) m.flicker_outside = fl.rms_outside();
-      }
-      m.metrics_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-      m.compute_ms = img->metadata().compute_ms;
-      m.timings_ms = img->metadata().timings_ms;
-      if (test_invalid)
-        warn(path, std::to_string(test_invalid) + " pixels hold NaN or Inf; they are excluded from every metric");
-
-      if (!setup.error_maps.empty()) {
-        Image map(width, height);
-        for (std::size_t c = 0; c < names.size(); ++c) {
-          float* e = map.add_channel("error." + suffix_of(names[c]));
-          const float* a = planes[c];
-          const float* b = ref_planes[c];
-          for (std::size_t i = 0; i < n; ++i) e[i] = valid[i] ? std::fabs(a[i] - b[i]) : 0.0f;
-        }
-        float* ey = map.add_channel("error.Y");
-        for (std::size_t i = 0; i < n; ++i) ey[i] = valid[i] ? std::fabs(ty[i] - ry[i]) : 0.0f;
-        std::copy(ssim_map.begin(), ssim_map.end(), map.add_channel("error.ssim"));
-        std::copy(flicker_map.begin(), flicker_map.end(), map.add_channel("error.flicker"));
-        float* inv = map.add_channel("error.invalid");
-        for (std::size_t i = 0; i < n; ++i) inv[i] = valid[i] ? 0.0f : 1.0f;
-        auto& md = map.metadata();
-        md.frame = frame;
-        md.fps = img->metadata().fps;
-        md.time = img->metadata().time;
-        md.compute_ms = m.metrics_ms;
-        md.tool = setup.tool;
-        md.parameters = setup.parameters;
-        md.extra["reference"] = ref_path;
-        md.extra["test"] = path;
-        md.extra["nonFinitePixels"] = std::to_string(test_invalid);
-        const std::string out = frame_file(setup.error_maps, t.report.name, frame);
-        if (auto st = write_exr(out, map); !st) return st.error();
-      }
-
-      // Keep this frame's luminance as history; pixels that were not finite must not be compared next frame.
-      for (std::size_t i = 0; i < n; ++i)
-        if (!valid[i]) t.y[i] = std::numeric_limits<float>::quiet_NaN();
-      std::swap(t.y, t.prev_y);
-      t.has_prev = true;
-      t.report.frames.push_back(std::move(m));
-    }
-    if (ref_invalid) warn(ref_path, std::to_string(ref_invalid) + " pixels hold NaN or Inf; they are excluded from every metric");
-    for (std::size_t i = 0; i < n; ++i)
-      if (!ref_valid[i]) ref_y[i] = std::numeric_limits<float>::quiet_NaN();
-    std::swap(ref_y, ref_prev_y);
-    ref_has_prev = true;
-    if (hooks.frame_done) hooks.frame_done(frame, int(fi + 1), int(report.frames.size()));
-  }
-  for (auto& t : tests) report.sequences.push_back(std::move(t.report));
-  return report;
+  return Run(setup, hooks).run();
 }
 
 // ---------------------------------------------------------------------------------------------------------
-// Summaries and thresholds
+// Samples, summaries and thresholds
 
-const char* metric_name(Metric metric) {
-  switch (metric) {
-    case Metric::PsnrRgb: return "psnr_rgb";
-    case Metric::PsnrY: return "psnr_y";
-    case Metric::Ssim: return "ssim";
-    case Metric::Flicker: return "flicker";
-  }
-  return "?";
+const MetricSample* FrameMetrics::sample(std::string_view metric) const {
+  for (const auto& s : metrics)
+    if (s.metric == metric) return &s;
+  return nullptr;
 }
 
-bool metric_higher_is_better(Metric metric) { return metric != Metric::Flicker; }
-
-double metric_value(const FrameMetrics& f, Metric metric) {
-  switch (metric) {
-    case Metric::PsnrRgb: return f.psnr_rgb;
-    case Metric::PsnrY: return f.psnr_y;
-    case Metric::Ssim: return f.ssim;
-    case Metric::Flicker: return f.flicker.value_or(kNaN);
-  }
-  return kNaN;
+MetricSample& FrameMetrics::ensure_sample(std::string_view metric) {
+  for (auto& s : metrics)
+    if (s.metric == metric) return s;
+  metrics.push_back({std::string(metric), {}, kNoValue, kNoValue, 0});
+  return metrics.back();
 }
 
-MetricSummary summarize(const SequenceReport& sequence, Metric metric) {
+double FrameMetrics::value(std::string_view metric, std::size_t column) const {
+  const MetricSample* s = sample(metric);
+  return s && column < s->values.size() ? s->values[column] : kNaN;
+}
+
+MetricSummary summarize(const SequenceReport& sequence, std::string_view metric, std::size_t column) {
   MetricSummary s;
-  s.higher_is_better = metric_higher_is_better(metric);
+  const MetricDefinition* d = find_metric(metric);
+  s.higher_is_better = d ? d->higher_is_better : true;
   double sum = 0.0;
   for (const auto& f : sequence.frames) {
-    const double v = metric_value(f, metric);
+    const double v = f.value(metric, column);
     if (std::isnan(v)) continue;
     if (s.count == 0 || v < s.min) {
       s.min = v;
@@ -440,6 +587,13 @@ MetricSummary summarize(const SequenceReport& sequence, Metric metric) {
   s.mean = s.count ? sum / double(s.count) : kNaN;
   if (!s.count) s.min = s.max = kNaN;
   return s;
+}
+
+std::vector<double> metric_series(const SequenceReport& sequence, std::string_view metric, std::size_t column) {
+  std::vector<double> v;
+  v.reserve(sequence.frames.size());
+  for (const auto& f : sequence.frames) v.push_back(f.value(metric, column));
+  return v;
 }
 
 std::optional<double> mean_compute_ms(const SequenceReport& sequence) {
@@ -461,28 +615,54 @@ std::optional<double> mean_compute_ms(const SequenceReport& sequence) {
 }
 
 std::string ThresholdFailure::message() const {
+  if (!text.empty()) return sequence + ": " + text;
+  const MetricDefinition* d = find_metric(metric);
+  const char* unit = d ? d->unit.c_str() : "";
+  const bool higher = d ? d->higher_is_better : true;
   char text[256];
-  const bool db = metric == Metric::PsnrRgb || metric == Metric::PsnrY;
-  std::snprintf(text, sizeof text, "%s: %s %.6g%s %s limit %.6g%s", sequence.c_str(), metric_name(metric), value,
-                db ? " dB" : "", metric_higher_is_better(metric) ? "<" : ">", limit, db ? " dB" : "");
+  std::snprintf(text, sizeof text, "%s: %s %.6g%s %s limit %.6g%s", sequence.c_str(), metric.c_str(), value, unit,
+                higher ? "<" : ">", limit, unit);
   return text;
+}
+
+Status check_threshold_setup(const ComparisonSetup& setup, const Thresholds& thresholds) {
+  for (const auto& [name, limit] : thresholds.limits) {
+    const MetricDefinition* d = find_metric(name);
+    if (!d || d->threshold_option.empty()) return Error::usage("no threshold for a metric called '" + name + "'");
+    if (d->enabled && !d->enabled(setup))
+      return Error::usage("--fail-" + d->threshold_option + " judges " + name + ", which is not measured: " + d->enable_hint);
+    if (!std::isfinite(limit)) return Error::usage("--fail-" + d->threshold_option + " needs a finite number");
+  }
+  return {};
 }
 
 std::vector<ThresholdFailure> check_thresholds(const ComparisonReport& report, const Thresholds& th) {
   std::vector<ThresholdFailure> failures;
-  for (const auto& seq : report.sequences) {
-    auto judge = [&](Metric metric, const std::optional<double>& limit) {
-      if (!limit) return;
-      const auto s = summarize(seq, metric);
-      if (!s.count) return;  // no value (e.g. flicker of a one-frame sequence): nothing to judge
+  for (const auto& seq : report.sequences)
+    for (const auto& name : report.metrics) {  // registry order: psnr_rgb, ssim, flicker, flip
+      const auto limit = th.limits.find(name);
+      if (limit == th.limits.end()) continue;
+      const auto s = summarize(seq, name);
+      if (!s.count) continue;  // no value (e.g. flicker of a one-frame sequence): nothing to judge
       const double v = th.worst_frame ? s.worst() : s.mean;
-      const bool fail = s.higher_is_better ? v < *limit : v > *limit;
-      if (fail) failures.push_back({seq.name, metric, v, *limit});
-    };
-    judge(Metric::PsnrRgb, th.psnr);
-    judge(Metric::Ssim, th.ssim);
-    judge(Metric::Flicker, th.flicker);
-  }
+      const bool fail = s.higher_is_better ? v < limit->second : v > limit->second;
+      if (fail) failures.push_back({seq.name, name, v, limit->second, {}});
+    }
+  if (th.nonfinite)
+    for (const auto& seq : report.sequences) {
+      std::size_t frames = 0, pixels = 0;
+      for (const auto& f : seq.frames) {
+        bool bad = f.nonfinite_test > 0;
+        for (const auto& sample : f.metrics)
+          bad = bad || (!sample.values.empty() && std::isinf(sample.values.front()) && sample.values.front() < 0);
+        frames += bad ? 1 : 0;
+        pixels += f.nonfinite_test;
+      }
+      if (frames > 0)
+        failures.push_back({seq.name, "nonfinite", double(frames), 0.0,
+                            std::to_string(frames) + " frames with NaN/Inf pixels (" + std::to_string(pixels) +
+                                " pixels) or an overflowing error (--fail-nonfinite)"});
+    }
   return failures;
 }
 

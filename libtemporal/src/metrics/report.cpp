@@ -1,12 +1,16 @@
 // CSV, JSON and chart descriptions of a comparison (temporal/metrics/comparison.h). Formats in docs/compare.md.
 #include "temporal/metrics/comparison.h"
 
+#include "temporal/core/atomic_file.h"
+
 #include <nlohmann/json.hpp>
 
+#include <charconv>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <limits>
 #include <map>
 
@@ -15,39 +19,21 @@ namespace {
 
 namespace fs = std::filesystem;
 
-Status write_text_atomic(const std::string& path, const std::string& text) {
-  std::error_code ec;
-  const fs::path p(path);
-  if (p.has_parent_path()) fs::create_directories(p.parent_path(), ec);
-  const std::string tmp = path + ".tmp";
-  {
-    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-    if (!out) return Error::output(path, "cannot create the file: check that its folder exists and is writable");
-    out << text;
-    out.flush();
-    if (!out) {
-      out.close();
-      fs::remove(tmp, ec);
-      return Error::output(path, "cannot write the file (disk full?)");
-    }
-  }
-  fs::rename(tmp, path, ec);
-  if (ec) {
-    fs::remove(tmp, ec);
-    return Error::output(path, "cannot move the temporary file into place: " + ec.message());
-  }
-  return {};
-}
-
-// CSV field: empty for "no value", `inf` / `-inf` for infinities, else %.*g.
-std::string field(double v, int digits = 8) {
+// CSV field: empty for "no value", `inf` / `-inf` for infinities, else the shortest text that reads back as the
+// same double (std::to_chars): per-shard CSVs then merge into exactly the single run's means (read_comparison_csv).
+// `digits` > 0 rounds instead (timings, whose last digits mean nothing).
+std::string field(double v, int digits = 0) {
   if (std::isnan(v)) return "";
   if (std::isinf(v)) return v > 0 ? "inf" : "-inf";
   char text[64];
-  std::snprintf(text, sizeof text, "%.*g", digits, v);
-  return text;
+  if (digits > 0) {
+    std::snprintf(text, sizeof text, "%.*g", digits, v);
+    return text;
+  }
+  const auto r = std::to_chars(text, text + sizeof text, v);
+  return std::string(text, r.ptr);
 }
-std::string field(const std::optional<double>& v, int digits = 8) { return v ? field(*v, digits) : std::string(); }
+std::string field(const std::optional<double>& v, int digits = 0) { return v ? field(*v, digits) : std::string(); }
 
 std::string csv_quote(const std::string& s) {
   if (s.find_first_of(",\"\n") == std::string::npos) return s;
@@ -86,16 +72,74 @@ double mean_of(const SequenceReport& seq, Get get) {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
+// The measured metrics' definitions, in report order.
+std::vector<const MetricDefinition*> definitions_of(const ComparisonReport& report) {
+  std::vector<const MetricDefinition*> out;
+  for (const auto& name : report.metrics)
+    if (const MetricDefinition* d = find_metric(name)) out.push_back(d);
+  return out;
+}
+
+// The CSV layout (docs/compare.md, "Outputs"): the historical metrics' primary columns, their other columns,
+// the frame's facts, the mask columns of the historical metrics, then every other metric's columns and its mask
+// columns. Each cell is a function of the sequence and frame.
+struct CsvColumn {
+  std::string header;
+  std::function<std::string(const SequenceReport&, const FrameMetrics&)> cell;
+};
+
+std::vector<CsvColumn> csv_layout(const ComparisonReport& report) {
+  const auto defs = definitions_of(report);
+  const bool mask = !report.mask.empty();
+  std::vector<CsvColumn> cols;
+  cols.push_back({"frame", [](const SequenceReport&, const FrameMetrics& f) { return std::to_string(f.frame); }});
+  cols.push_back({"sequence", [](const SequenceReport& s, const FrameMetrics&) { return csv_quote(s.name); }});
+  auto value = [&](const MetricDefinition* d, std::size_t k) {
+    return CsvColumn{d->columns[k].csv, [name = d->name, k](const SequenceReport&, const FrameMetrics& f) {
+                       return field(f.value(name, k));
+                     }};
+  };
+  auto inside_outside = [&](const MetricDefinition* d) {
+    for (const bool in : {true, false})
+      cols.push_back({d->mask_columns[in ? 0 : 1], [name = d->name, in](const SequenceReport&, const FrameMetrics& f) {
+                        const MetricSample* s = f.sample(name);
+                        return field(s ? (in ? s->inside : s->outside) : kNaN);
+                      }});
+  };
+  for (const auto* d : defs)
+    if (d->historical_csv) cols.push_back(value(d, 0));
+  for (const auto* d : defs)
+    if (d->historical_csv)
+      for (std::size_t k = 1; k < d->columns.size(); ++k) cols.push_back(value(d, k));
+  cols.push_back({"peak", [](const SequenceReport&, const FrameMetrics& f) { return field(f.peak); }});
+  cols.push_back({"valid_pixels", [](const SequenceReport&, const FrameMetrics& f) { return std::to_string(f.valid_pixels); }});
+  cols.push_back({"nonfinite_test", [](const SequenceReport&, const FrameMetrics& f) { return std::to_string(f.nonfinite_test); }});
+  cols.push_back({"nonfinite_reference",
+                  [](const SequenceReport&, const FrameMetrics& f) { return std::to_string(f.nonfinite_reference); }});
+  cols.push_back({"compute_ms", [](const SequenceReport&, const FrameMetrics& f) { return field(f.compute_ms, 8); }});
+  cols.push_back({"metrics_ms", [](const SequenceReport&, const FrameMetrics& f) { return field(f.metrics_ms, 5); }});
+  if (mask) {
+    cols.push_back({"mask_fraction", [](const SequenceReport&, const FrameMetrics& f) { return field(f.mask_fraction); }});
+    for (const auto* d : defs)
+      if (d->historical_csv) inside_outside(d);
+  }
+  for (const auto* d : defs) {
+    if (d->historical_csv) continue;
+    for (std::size_t k = 0; k < d->columns.size(); ++k) cols.push_back(value(d, k));
+    if (mask) inside_outside(d);
+  }
+  return cols;
+}
+
 }  // namespace
 
 Status write_comparison_csv(const ComparisonReport& report, const std::string& path) {
-  const bool mask = !report.mask.empty();
-  std::string text =
-      "frame,sequence,psnr_rgb_db,psnr_y_db,ssim,flicker,mse_rgb,peak,valid_pixels,nonfinite_test,"
-      "nonfinite_reference,compute_ms,metrics_ms";
-  if (mask)
-    text += ",mask_fraction,psnr_rgb_in_db,psnr_rgb_out_db,psnr_y_in_db,psnr_y_out_db,ssim_in,ssim_out,flicker_in,"
-            "flicker_out";
+  const auto cols = csv_layout(report);
+  std::string text;
+  for (std::size_t c = 0; c < cols.size(); ++c) {
+    if (c) text += ',';
+    text += cols[c].header;
+  }
   text += "\n";
   // Frame-major: all sequences of frame N, then frame N+1 (the order compare computes them).
   std::size_t frames = 0;
@@ -103,18 +147,118 @@ Status write_comparison_csv(const ComparisonReport& report, const std::string& p
   for (std::size_t i = 0; i < frames; ++i)
     for (const auto& s : report.sequences) {
       if (i >= s.frames.size()) continue;
-      const auto& f = s.frames[i];
-      text += std::to_string(f.frame) + "," + csv_quote(s.name) + "," + field(f.psnr_rgb) + "," + field(f.psnr_y) +
-              "," + field(f.ssim) + "," + field(f.flicker) + "," + field(f.mse_rgb) + "," + field(f.peak) + "," +
-              std::to_string(f.valid_pixels) + "," + std::to_string(f.nonfinite_test) + "," +
-              std::to_string(f.nonfinite_reference) + "," + field(f.compute_ms) + "," + field(f.metrics_ms, 5);
-      if (mask)
-        text += "," + field(f.mask_fraction) + "," + field(f.psnr_rgb_inside) + "," + field(f.psnr_rgb_outside) + "," +
-                field(f.psnr_y_inside) + "," + field(f.psnr_y_outside) + "," + field(f.ssim_inside) + "," +
-                field(f.ssim_outside) + "," + field(f.flicker_inside) + "," + field(f.flicker_outside);
+      for (std::size_t c = 0; c < cols.size(); ++c) {
+        if (c) text += ',';
+        text += cols[c].cell(s, s.frames[i]);
+      }
       text += "\n";
     }
   return write_text_atomic(path, text);
+}
+
+namespace {
+
+// A metric's JSON summary: the primary value's {mean, min, max, min_frame, max_frame, frames}, and the mean over
+// frames of each other column that names a JSON key.
+nlohmann::ordered_json jinterval(const Interval& ci) { return nlohmann::ordered_json::array({jnum(ci.low), jnum(ci.high)}); }
+
+// Mean, interval and counts of part of a series (temporal/metrics/statistics.h).
+nlohmann::ordered_json jmean(std::span<const double> series, const BootstrapOptions& o) {
+  const MeanInterval m = bootstrap_mean(series, o);
+  nlohmann::ordered_json j = {{"frames", m.count}, {"mean", jnum(m.mean)}, {"ci95", jinterval(m.ci)}};
+  if (m.infinite) j["infinite_frames"] = m.infinite;
+  return j;
+}
+
+nlohmann::ordered_json metric_json(const ComparisonReport& report, const SequenceReport& s, const MetricDefinition& d) {
+  auto j = jsummary(summarize(s, d.name));
+  if (j.is_null()) return j;
+  // Intervals: the whole sequence, and with --warmup the steady state apart from the warm-up frames.
+  const auto series = metric_series(s, d.name);
+  const auto all = jmean(series, report.bootstrap);
+  j["ci95"] = all["ci95"];
+  if (all.contains("infinite_frames")) j["infinite_frames"] = all["infinite_frames"];
+  const std::size_t warm = std::min(series.size(), std::size_t(std::max(0, report.warmup_frames)));
+  if (warm > 0) {
+    j["warmup"] = jmean(std::span<const double>(series).first(warm), report.bootstrap);
+    j["steady"] = jmean(std::span<const double>(series).subspan(warm), report.bootstrap);
+  }
+  for (std::size_t k = 1; k < d.columns.size(); ++k)
+    if (!d.columns[k].json.empty())
+      j[d.columns[k].json] = jnum(mean_of(s, [&](const FrameMetrics& f) { return f.value(d.name, k); }));
+  return j;
+}
+
+nlohmann::ordered_json sequence_json(const ComparisonReport& report, const SequenceReport& s) {
+  using json = nlohmann::ordered_json;
+  json js;
+  js["name"] = s.name;
+  js["path"] = s.pattern;
+  js["frames"] = s.frames.size();
+  const auto defs = definitions_of(report);
+  for (const auto* d : defs) js[d->name] = metric_json(report, s, *d);
+  std::size_t nf_test = 0, nf_ref = 0;
+  for (const auto& f : s.frames) {
+    nf_test += f.nonfinite_test;
+    nf_ref += f.nonfinite_reference;
+  }
+  js["nonfinite_pixels"] = {{"test", nf_test}, {"reference", nf_ref}};
+  js["compute_ms"] = jnum(mean_compute_ms(s));
+  json timings = json::object();
+  std::map<std::string, std::pair<double, std::size_t>> sums;
+  for (const auto& f : s.frames)
+    for (const auto& [name, ms] : f.timings_ms) {
+      sums[name].first += ms;
+      sums[name].second += 1;
+    }
+  for (const auto& [name, sum] : sums) timings[name] = sum.first / double(sum.second);
+  js["timings_ms"] = timings;
+  js["metrics_ms"] = jnum(mean_of(s, [](const FrameMetrics& f) { return f.metrics_ms; }));
+  if (!report.mask.empty()) {
+    js["mask_source"] = s.mask_source;
+    js["mask_fraction"] = jnum(mean_of(s, [](const FrameMetrics& f) { return f.mask_fraction; }));
+    for (const bool inside : {true, false}) {
+      json region;
+      for (const auto* d : defs)
+        region[d->name] = jnum(mean_of(s, [&](const FrameMetrics& f) {
+          const MetricSample* m = f.sample(d->name);
+          return m ? (inside ? m->inside : m->outside) : kNaN;
+        }));
+      js[inside ? "inside_mask" : "outside_mask"] = region;
+    }
+  }
+  return js;
+}
+
+// The paired difference a - b of every two test sequences for every metric, over the frames where both have a
+// value, with its interval (and the steady state apart with --warmup): the numbers behind an "A beats B".
+nlohmann::ordered_json paired_json(const ComparisonReport& report) {
+  using json = nlohmann::ordered_json;
+  json pairs = json::array();
+  for (std::size_t a = 0; a < report.sequences.size(); ++a)
+    for (std::size_t b = a + 1; b < report.sequences.size(); ++b)
+      for (const auto* d : definitions_of(report)) {
+        const auto sa = metric_series(report.sequences[a], d->name), sb = metric_series(report.sequences[b], d->name);
+        const MeanInterval m = bootstrap_paired_difference(sa, sb, report.bootstrap);
+        if (m.count == 0) continue;
+        json p = {{"a", report.sequences[a].name}, {"b", report.sequences[b].name}, {"metric", d->name},
+                  {"higher_is_better", d->higher_is_better}, {"frames", m.count}, {"mean_difference", jnum(m.mean)},
+                  {"ci95", jinterval(m.ci)}};
+        const std::size_t warm = std::min(sa.size(), std::size_t(std::max(0, report.warmup_frames)));
+        if (warm > 0) {
+          const MeanInterval st = bootstrap_paired_difference(std::span<const double>(sa).subspan(warm),
+                                                              std::span<const double>(sb).subspan(warm), report.bootstrap);
+          p["steady"] = {{"frames", st.count}, {"mean_difference", jnum(st.mean)}, {"ci95", jinterval(st.ci)}};
+        }
+        pairs.push_back(std::move(p));
+      }
+  return pairs;
+}
+
+}  // namespace
+
+const char* flip_mode_name(FlipMode mode) {
+  return mode == FlipMode::Ldr ? "ldr" : mode == FlipMode::Hdr ? "hdr" : "off";
 }
 
 Status write_comparison_json(const ComparisonReport& report, const Thresholds& thresholds,
@@ -136,63 +280,63 @@ Status write_comparison_json(const ComparisonReport& report, const Thresholds& t
                  {"last", report.frames.empty() ? 0 : report.frames.back()},
                  {"count", report.frames.size()}};
   j["motion_compensated"] = report.motion_compensated;
+  j["disocclusion_tested"] = report.disocclusion_tested;
   j["peak"] = report.peak_from_data ? json("max") : json(report.peak);
   j["mask"] = report.mask.empty() ? json(nullptr) : json(report.mask);
-  j["thresholds"] = {{"psnr_rgb", jnum(thresholds.psnr)},
-                     {"ssim", jnum(thresholds.ssim)},
-                     {"flicker", jnum(thresholds.flicker)},
-                     {"judged_on", thresholds.worst_frame ? "worst" : "mean"}};
+  if (report.flip != FlipMode::Off)
+    j["flip"] = {{"mode", flip_mode_name(report.flip)}, {"pixels_per_degree", report.pixels_per_degree}};
+  json th = json::object();
+  for (const auto* d : definitions_of(report)) {
+    if (d->threshold_option.empty()) continue;
+    const auto limit = thresholds.limits.find(d->name);
+    th[d->name] = limit == thresholds.limits.end() ? json(nullptr) : jnum(limit->second);
+  }
+  th["judged_on"] = thresholds.worst_frame ? "worst" : "mean";
+  j["thresholds"] = th;
   j["passed"] = failures.empty();
   json jf = json::array();
   for (const auto& f : failures)
-    jf.push_back({{"sequence", f.sequence}, {"metric", metric_name(f.metric)}, {"value", jnum(f.value)},
+    jf.push_back({{"sequence", f.sequence}, {"metric", f.metric}, {"value", jnum(f.value)},
                   {"limit", jnum(f.limit)}, {"message", f.message()}});
   j["failures"] = jf;
-
   json seqs = json::array();
-  for (const auto& s : report.sequences) {
-    json js;
-    js["name"] = s.name;
-    js["path"] = s.pattern;
-    js["frames"] = s.frames.size();
-    for (Metric m : {Metric::PsnrRgb, Metric::PsnrY, Metric::Ssim, Metric::Flicker})
-      js[metric_name(m)] = jsummary(summarize(s, m));
-    std::size_t nf_test = 0, nf_ref = 0;
-    for (const auto& f : s.frames) {
-      nf_test += f.nonfinite_test;
-      nf_ref += f.nonfinite_reference;
-    }
-    js["nonfinite_pixels"] = {{"test", nf_test}, {"reference", nf_ref}};
-    js["compute_ms"] = jnum(mean_compute_ms(s));
-    json timings = json::object();
-    std::map<std::string, std::pair<double, std::size_t>> sums;
-    for (const auto& f : s.frames)
-      for (const auto& [name, ms] : f.timings_ms) {
-        sums[name].first += ms;
-        sums[name].second += 1;
-      }
-    for (const auto& [name, sum] : sums) timings[name] = sum.first / double(sum.second);
-    js["timings_ms"] = timings;
-    js["metrics_ms"] = jnum(mean_of(s, [](const FrameMetrics& f) { return f.metrics_ms; }));
-    if (!report.mask.empty()) {
-      js["mask_source"] = s.mask_source;
-      js["mask_fraction"] = jnum(mean_of(s, [](const FrameMetrics& f) { return f.mask_fraction; }));
-      auto region = [&](bool inside) {
-        return json{
-            {"psnr_rgb", jnum(mean_of(s, [&](const FrameMetrics& f) { return inside ? f.psnr_rgb_inside : f.psnr_rgb_outside; }))},
-            {"psnr_y", jnum(mean_of(s, [&](const FrameMetrics& f) { return inside ? f.psnr_y_inside : f.psnr_y_outside; }))},
-            {"ssim", jnum(mean_of(s, [&](const FrameMetrics& f) { return inside ? f.ssim_inside : f.ssim_outside; }))},
-            {"flicker", jnum(mean_of(s, [&](const FrameMetrics& f) {
-               return (inside ? f.flicker_inside : f.flicker_outside).value_or(kNaN);
-             }))}};
-      };
-      js["inside_mask"] = region(true);
-      js["outside_mask"] = region(false);
-    }
-    seqs.push_back(js);
-  }
+  for (const auto& s : report.sequences) seqs.push_back(sequence_json(report, s));
   j["sequences"] = seqs;
+  j["paired"] = paired_json(report);
   return write_text_atomic(path, j.dump(2) + "\n");
+}
+
+std::string summary_table(const ComparisonReport& report) {
+  auto cell = [](double v, const std::string& format) {
+    if (std::isnan(v)) return std::string("-");
+    if (std::isinf(v)) return std::string(v > 0 ? "inf" : "-inf");
+    char text[64];
+    std::snprintf(text, sizeof text, format.c_str(), v);
+    return std::string(text);
+  };
+  std::string out;
+  auto put = [&](const std::string& text, int width, bool left) {  // printf's %-Ns / %Ns, after a space
+    if (!out.empty() && out.back() != '\n') out += ' ';
+    const std::size_t w = std::size_t(width), pad = text.size() < w ? w - text.size() : 0;
+    if (!left) out.append(pad, ' ');
+    out += text;
+    if (left) out.append(pad, ' ');
+  };
+  const auto defs = definitions_of(report);
+  put("sequence", 20, true);
+  put("frames", 7, false);
+  for (const auto* d : defs) put(d->name, d->table_width, false);
+  put("compute_ms", 11, false);
+  out += '\n';
+  for (const auto& s : report.sequences) {
+    put(s.name, 20, true);
+    put(std::to_string(s.frames.size()), 7, false);
+    for (const auto* d : defs) put(cell(summarize(s, d->name).mean, d->table_format), d->table_width, false);
+    const auto ms = mean_compute_ms(s);
+    put(ms ? cell(*ms, "%.3f") : std::string("-"), 11, false);
+    out += '\n';
+  }
+  return out;
 }
 
 }  // namespace temporal

@@ -5,6 +5,7 @@
 #include "temporal/morph/grid_warp.h"
 
 #include "temporal/core/parallel.h"
+#include "temporal/core/reproject.h"
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -203,58 +204,203 @@ namespace {
 constexpr int kBand = 16;  // rows per raster band (the unit of parallel work)
 constexpr std::size_t kMaxAttributes = 8;
 
-// Bilinear footprint of continuous position (u, v), clamped at the border: the four texel indices and weights
-// are computed once per fragment and applied to every plane.
-struct Footprint {
-  std::size_t i00, i01, i10, i11;
-  float ax, ay;
-};
-inline Footprint footprint(int w, int h, float u, float v) {
-  const float fx = u - 0.5f, fy = v - 0.5f;
-  const float x0f = std::floor(fx), y0f = std::floor(fy);
-  const int x0 = std::clamp(int(x0f), 0, w - 1), x1 = std::clamp(int(x0f) + 1, 0, w - 1);
-  const int y0 = std::clamp(int(y0f), 0, h - 1), y1 = std::clamp(int(y0f) + 1, 0, h - 1);
-  const std::size_t r0 = std::size_t(y0) * std::size_t(w), r1 = std::size_t(y1) * std::size_t(w);
-  return {r0 + std::size_t(x0), r0 + std::size_t(x1), r1 + std::size_t(x0), r1 + std::size_t(x1), fx - x0f, fy - y0f};
-}
-inline float sample(const float* p, const Footprint& f) {
-  const float top = p[f.i00] + f.ax * (p[f.i01] - p[f.i00]);
-  const float bot = p[f.i10] + f.ax * (p[f.i11] - p[f.i10]);
-  return top + f.ay * (bot - top);
-}
-
 // Top-left rule: an edge a->b owns the pixel centres lying exactly on it when it goes down, or goes left
 // along a row. The two triangles that share an edge traverse it in opposite directions, so exactly one owns it.
 inline bool owns(double dx, double dy) { return dy > 0.0 || (dy == 0.0 && dx < 0.0); }
+
+// The three vertices of triangle t: each cell is split along its top-left to bottom-right diagonal.
+inline void corners(const SnappedGrid& grid, int t, int out[3]) {
+  const int cells_x = grid.nx - 1;
+  const int c = t >> 1;
+  const int a = (c / cells_x) * grid.nx + (c % cells_x);
+  if ((t & 1) == 0) {
+    out[0] = a; out[1] = a + 1; out[2] = a + grid.nx + 1;
+  } else {
+    out[0] = a; out[1] = a + grid.nx + 1; out[2] = a + grid.nx;
+  }
+}
+
+// One GridRasterizer::draw call: what every band reads, and the work of one band (its triangles, then the
+// pixels none of them covered). Bands own disjoint rows of the targets and of the z-buffer.
+class BandRaster {
+ public:
+  BandRaster(const SnappedGrid& grid, std::span<const float> tx, std::span<const float> ty, const GridRaster& raster,
+             float* zbuffer)
+      : grid_(grid), tx_(tx), ty_(ty), r_(raster), zbuffer_(zbuffer), w_(grid.width), h_(grid.height),
+        ns_(raster.source.size()), na_(raster.attributes.size()), blend_(raster.blend_attribute),
+        nt_(blend_ >= 0 ? ns_ / 2 : ns_), cull_(raster.cull_zero_attributes && ns_ == 0 && na_ > 0) {}
+
+  void band(int band, const std::vector<std::int32_t>& triangles) {
+    const int y0 = band * kBand, y1 = std::min(h_, y0 + kBand);
+    std::fill(zbuffer_ + std::ptrdiff_t(y0) * w_, zbuffer_ + std::ptrdiff_t(y1) * w_,
+              std::numeric_limits<float>::infinity());
+    for (const int t : triangles) triangle(t, y0, y1);
+    uncovered(y0, y1);
+  }
+
+ private:
+  bool all_attributes_zero(const int v[3]) const {
+    for (std::size_t c = 0; c < na_; ++c)
+      if (r_.attributes[c][v[0]] != 0.0f || r_.attributes[c][v[1]] != 0.0f || r_.attributes[c][v[2]] != 0.0f)
+        return false;
+    return true;
+  }
+
+  // Scan-converts triangle t over rows [band_y0, band_y1).
+  void triangle(int t, int band_y0, int band_y1) {
+    int v[3];
+    corners(grid_, t, v);
+    if (cull_ && all_attributes_zero(v)) return;
+    double px[3] = {tx_[v[0]], tx_[v[1]], tx_[v[2]]};
+    double py[3] = {ty_[v[0]], ty_[v[1]], ty_[v[2]]};
+    double area = cross(px[1] - px[0], py[1] - py[0], px[2] - px[0], py[2] - py[0]);
+    if (std::abs(area) < 1e-12) return;
+    if (area < 0.0) {  // a folded-over triangle: draw it too, with its vertices reordered
+      std::swap(px[1], px[2]);
+      std::swap(py[1], py[2]);
+      std::swap(v[1], v[2]);
+      area = -area;
+    }
+    const double inv_area = 1.0 / area;
+    const int xa = std::max(0, int(std::ceil(std::min({px[0], px[1], px[2]}) - 0.5)));
+    const int xb = std::min(w_ - 1, int(std::floor(std::max({px[0], px[1], px[2]}) - 0.5)));
+    const int ya = std::max(band_y0, int(std::ceil(std::min({py[0], py[1], py[2]}) - 0.5)));
+    const int yb = std::min(band_y1 - 1, int(std::floor(std::max({py[0], py[1], py[2]}) - 0.5)));
+    if (xa > xb || ya > yb) return;
+    // Edge k goes from vertex k+1 to vertex k+2 (opposite vertex k); its edge function, divided by the
+    // area, is vertex k's barycentric weight. Evaluated exactly in double at the row start, then stepped.
+    double ex[3], ey[3];
+    bool own[3];
+    for (int k = 0; k < 3; ++k) {
+      const int p = (k + 1) % 3, q = (k + 2) % 3;
+      ex[k] = px[q] - px[p];
+      ey[k] = py[q] - py[p];
+      own[k] = owns(ex[k], ey[k]);
+    }
+    const float su[3] = {grid_.x[v[0]], grid_.x[v[1]], grid_.x[v[2]]};
+    const float sv[3] = {grid_.y[v[0]], grid_.y[v[1]], grid_.y[v[2]]};
+    // Attribute values at the three vertices, loaded once per triangle (at most kMaxAttributes).
+    float av[kMaxAttributes][3];
+    for (std::size_t c = 0; c < na_; ++c)
+      for (int k = 0; k < 3; ++k) av[c][k] = r_.attributes[c][v[k]];
+    for (int y = ya; y <= yb; ++y) {
+      const double cy = y + 0.5, cx0 = xa + 0.5;
+      double e0[3];
+      for (int k = 0; k < 3; ++k) {
+        const int p = (k + 1) % 3;
+        e0[k] = cross(ex[k], ey[k], cx0 - px[p], cy - py[p]);
+      }
+      // The row's span: e_k(x) = e_k(xa) - ey_k (x - xa) >= 0 for every edge. Widened by one pixel on each
+      // side; the exact test (with the fill rule) runs inside.
+      int xs = xa, xe = xb;
+      bool empty = false;
+      for (int k = 0; k < 3; ++k) {
+        if (ey[k] > 0.0) {
+          xe = std::min(xe, xa + int(std::floor(e0[k] / ey[k])) + 1);
+        } else if (ey[k] < 0.0) {
+          xs = std::max(xs, xa + int(std::ceil(e0[k] / ey[k])) - 1);
+        } else if (e0[k] < 0.0) {
+          empty = true;
+        }
+      }
+      if (empty || xs > xe) continue;
+      double e[3];
+      for (int k = 0; k < 3; ++k) e[k] = e0[k] - ey[k] * double(xs - xa);
+      for (int x = xs; x <= xe; ++x, e[0] -= ey[0], e[1] -= ey[1], e[2] -= ey[2]) {
+        if (e[0] < 0.0 || e[1] < 0.0 || e[2] < 0.0) continue;
+        if ((e[0] == 0.0 && !own[0]) || (e[1] == 0.0 && !own[1]) || (e[2] == 0.0 && !own[2])) continue;
+        const float w0 = float(e[0] * inv_area), w1 = float(e[1] * inv_area), w2 = 1.0f - w0 - w1;
+        const float u = w0 * su[0] + w1 * su[1] + w2 * su[2];
+        const float vv = w0 * sv[0] + w1 * sv[1] + w2 * sv[2];
+        fragment(x, y, u, vv, w0, w1, w2, av);
+      }
+    }
+  }
+
+  // Pixel (x, y) covered at barycentric (w0, w1, w2), texture coordinate (u, vv): depth test, attributes, and
+  // the source planes fetched at (u, vv) through the reprojection module's bilinear fetch.
+  void fragment(int x, int y, float u, float vv, float w0, float w1, float w2, const float (*av)[3]) {
+    const std::size_t pix = std::size_t(y) * std::size_t(w_) + std::size_t(x);
+    float& z_here = zbuffer_[pix];
+    // Texture coordinates are continuous pixel coordinates (pixel centres at +0.5); the reprojection module's
+    // fetches take positions with the centres at integers.
+    const float fu = u - 0.5f, fv = vv - 0.5f;
+    if (r_.source_depth) {
+      // Section 6: "we enable the depth test and pass depth from the original frame": the depth of the source
+      // pixel that contains (u, vv), its nearest pixel centre.
+      const float z = r_.source_depth[reproject::nearest(fu, fv, w_, h_)];
+      if (!(z < z_here)) return;
+      z_here = z;
+    } else {
+      z_here = 0.0f;  // covered
+    }
+    float blend_weight = 0.0f;
+    for (std::size_t c = 0; c < na_; ++c) {
+      const float val = w0 * av[c][0] + w1 * av[c][1] + w2 * av[c][2];
+      r_.attr_target[c][pix] = val;
+      if (int(c) == blend_) blend_weight = val;
+    }
+    if (ns_ == 0) return;
+    const reproject::Bilinear f = reproject::bilinear(fu, fv, w_, h_);
+    if (blend_ < 0) {
+      for (std::size_t c = 0; c < ns_; ++c) r_.target[c][pix] = f(r_.source[c]);
+    } else if (blend_weight > 0.0f) {
+      for (std::size_t c = 0; c < nt_; ++c) {
+        const float sharp = f(r_.source[c]);
+        r_.target[c][pix] = sharp + blend_weight * (f(r_.source[nt_ + c]) - sharp);
+      }
+    } else {
+      for (std::size_t c = 0; c < nt_; ++c) r_.target[c][pix] = f(r_.source[c]);
+    }
+  }
+
+  // Pixels no fragment reached (only possible where degenerate triangles meet): the source pixel itself and the
+  // attributes' `uncovered` value.
+  void uncovered(int y0, int y1) {
+    for (int y = y0; y < y1; ++y)
+      for (int x = 0; x < w_; ++x) {
+        const std::size_t pix = std::size_t(y) * std::size_t(w_) + std::size_t(x);
+        if (zbuffer_[pix] != std::numeric_limits<float>::infinity()) continue;
+        for (std::size_t c = 0; c < na_; ++c)
+          r_.attr_target[c][pix] = c < r_.attr_uncovered.size() ? r_.attr_uncovered[c] : 0.0f;
+        if (blend_ < 0) {
+          for (std::size_t c = 0; c < ns_; ++c) r_.target[c][pix] = r_.source[c][pix];
+        } else {
+          const float a = r_.attr_target[std::size_t(blend_)][pix];
+          for (std::size_t c = 0; c < nt_; ++c)
+            r_.target[c][pix] = r_.source[c][pix] + a * (r_.source[nt_ + c][pix] - r_.source[c][pix]);
+        }
+      }
+  }
+
+  const SnappedGrid& grid_;
+  std::span<const float> tx_, ty_;
+  const GridRaster& r_;
+  float* zbuffer_;
+  const int w_, h_;
+  const std::size_t ns_, na_;  // source planes, attributes
+  const int blend_;
+  const std::size_t nt_;       // target planes
+  const bool cull_;
+};
 
 }  // namespace
 
 void GridRasterizer::draw(const SnappedGrid& grid, std::span<const float> tx, std::span<const float> ty,
                           const GridRaster& raster) {
-  const int w = grid.width, h = grid.height;
+  if (raster.attributes.size() > kMaxAttributes) return;  // documented limit (never reached by the callers)
+  const int h = grid.height;
   const int bands = (h + kBand - 1) / kBand;
-  const int cells_x = grid.nx - 1;
   const int triangles = 2 * grid.cell_count();
   // The z-buffer doubles as the coverage mask (infinity: no fragment yet).
-  zbuffer_.resize(std::size_t(w) * std::size_t(h));
+  zbuffer_.resize(std::size_t(grid.width) * std::size_t(h));
   bins_.resize(std::size_t(bands));
   for (auto& b : bins_) b.clear();
-
-  auto corners = [&](int t, int out[3]) {
-    const int c = t >> 1;
-    const int a = (c / cells_x) * grid.nx + (c % cells_x);
-    // Each cell is split along its top-left to bottom-right diagonal.
-    if ((t & 1) == 0) {
-      out[0] = a; out[1] = a + 1; out[2] = a + grid.nx + 1;
-    } else {
-      out[0] = a; out[1] = a + grid.nx + 1; out[2] = a + grid.nx;
-    }
-  };
   // Binning by bands of target rows, in triangle order, so each band draws its triangles in the same order
   // as a serial rasteriser would: the result does not depend on the thread count.
   for (int t = 0; t < triangles; ++t) {
     int v[3];
-    corners(t, v);
+    corners(grid, t, v);
     const float y0 = std::min({ty[v[0]], ty[v[1]], ty[v[2]]});
     const float y1 = std::max({ty[v[0]], ty[v[1]], ty[v[2]]});
     const int r0 = std::max(0, int(std::ceil(y0 - 0.5f)));
@@ -262,139 +408,9 @@ void GridRasterizer::draw(const SnappedGrid& grid, std::span<const float> tx, st
     if (r1 < r0) continue;
     for (int b = r0 / kBand; b <= r1 / kBand; ++b) bins_[std::size_t(b)].push_back(t);
   }
-
-  const std::size_t ns = raster.source.size(), na = raster.attributes.size();
-  const bool depth_test = raster.source_depth != nullptr;
-  const int blend = raster.blend_attribute;
-  const std::size_t nt = blend >= 0 ? ns / 2 : ns;  // target planes
-  const bool cull = raster.cull_zero_attributes && ns == 0 && na > 0;
-  if (na > kMaxAttributes) return;  // documented limit (never reached by the callers)
+  BandRaster raster_bands(grid, tx, ty, raster, zbuffer_.data());
   tbb::parallel_for(tbb::blocked_range<int>(0, bands, 1), [&](const tbb::blocked_range<int>& range) {
-    for (int band = range.begin(); band < range.end(); ++band) {
-      const int band_y0 = band * kBand, band_y1 = std::min(h, band_y0 + kBand);
-      std::fill(zbuffer_.begin() + std::ptrdiff_t(band_y0) * w, zbuffer_.begin() + std::ptrdiff_t(band_y1) * w,
-                std::numeric_limits<float>::infinity());
-      for (const int t : bins_[std::size_t(band)]) {
-        int v[3];
-        corners(t, v);
-        if (cull) {
-          bool zero = true;
-          for (std::size_t c = 0; c < na; ++c)
-            zero = zero && raster.attributes[c][v[0]] == 0.0f && raster.attributes[c][v[1]] == 0.0f &&
-                   raster.attributes[c][v[2]] == 0.0f;
-          if (zero) continue;
-        }
-        double px[3] = {tx[v[0]], tx[v[1]], tx[v[2]]};
-        double py[3] = {ty[v[0]], ty[v[1]], ty[v[2]]};
-        double area = cross(px[1] - px[0], py[1] - py[0], px[2] - px[0], py[2] - py[0]);
-        if (std::abs(area) < 1e-12) continue;
-        if (area < 0.0) {  // a folded-over triangle: draw it too, with its vertices reordered
-          std::swap(px[1], px[2]);
-          std::swap(py[1], py[2]);
-          std::swap(v[1], v[2]);
-          area = -area;
-        }
-        const double inv_area = 1.0 / area;
-        const int xa = std::max(0, int(std::ceil(std::min({px[0], px[1], px[2]}) - 0.5)));
-        const int xb = std::min(w - 1, int(std::floor(std::max({px[0], px[1], px[2]}) - 0.5)));
-        const int ya = std::max(band_y0, int(std::ceil(std::min({py[0], py[1], py[2]}) - 0.5)));
-        const int yb = std::min(band_y1 - 1, int(std::floor(std::max({py[0], py[1], py[2]}) - 0.5)));
-        if (xa > xb || ya > yb) continue;
-        // Edge k goes from vertex k+1 to vertex k+2 (opposite vertex k); its edge function, divided by the
-        // area, is vertex k's barycentric weight. Evaluated exactly in double at the row start, then stepped.
-        double ex[3], ey[3];
-        bool own[3];
-        for (int k = 0; k < 3; ++k) {
-          const int p = (k + 1) % 3, q = (k + 2) % 3;
-          ex[k] = px[q] - px[p];
-          ey[k] = py[q] - py[p];
-          own[k] = owns(ex[k], ey[k]);
-        }
-        const float su[3] = {grid.x[v[0]], grid.x[v[1]], grid.x[v[2]]};
-        const float sv[3] = {grid.y[v[0]], grid.y[v[1]], grid.y[v[2]]};
-        // Attribute values at the three vertices, loaded once per triangle (at most kMaxAttributes).
-        float av[kMaxAttributes][3];
-        for (std::size_t c = 0; c < na; ++c)
-          for (int k = 0; k < 3; ++k) av[c][k] = raster.attributes[c][v[k]];
-        for (int y = ya; y <= yb; ++y) {
-          const double cy = y + 0.5, cx0 = xa + 0.5;
-          double e0[3];
-          for (int k = 0; k < 3; ++k) {
-            const int p = (k + 1) % 3;
-            e0[k] = cross(ex[k], ey[k], cx0 - px[p], cy - py[p]);
-          }
-          // The row's span: e_k(x) = e_k(xa) - ey_k (x - xa) >= 0 for every edge. Widened by one pixel on each
-          // side; the exact test (with the fill rule) runs inside.
-          int xs = xa, xe = xb;
-          bool empty = false;
-          for (int k = 0; k < 3; ++k) {
-            if (ey[k] > 0.0) {
-              xe = std::min(xe, xa + int(std::floor(e0[k] / ey[k])) + 1);
-            } else if (ey[k] < 0.0) {
-              xs = std::max(xs, xa + int(std::ceil(e0[k] / ey[k])) - 1);
-            } else if (e0[k] < 0.0) {
-              empty = true;
-            }
-          }
-          if (empty || xs > xe) continue;
-          double e[3];
-          for (int k = 0; k < 3; ++k) e[k] = e0[k] - ey[k] * double(xs - xa);
-          float* zrow = zbuffer_.data() + std::size_t(y) * std::size_t(w);
-          for (int x = xs; x <= xe; ++x, e[0] -= ey[0], e[1] -= ey[1], e[2] -= ey[2]) {
-            if (e[0] < 0.0 || e[1] < 0.0 || e[2] < 0.0) continue;
-            if ((e[0] == 0.0 && !own[0]) || (e[1] == 0.0 && !own[1]) || (e[2] == 0.0 && !own[2])) continue;
-            const float w0 = float(e[0] * inv_area), w1 = float(e[1] * inv_area), w2 = 1.0f - w0 - w1;
-            const float u = w0 * su[0] + w1 * su[1] + w2 * su[2];
-            const float vv = w0 * sv[0] + w1 * sv[1] + w2 * sv[2];
-            const std::size_t pix = std::size_t(y) * std::size_t(w) + std::size_t(x);
-            if (depth_test) {
-              // Section 6: "we enable the depth test and pass depth from the original frame".
-              const int sx = std::clamp(int(u), 0, w - 1), sy = std::clamp(int(vv), 0, h - 1);
-              const float z = raster.source_depth[std::size_t(sy) * std::size_t(w) + std::size_t(sx)];
-              if (!(z < zrow[x])) continue;
-              zrow[x] = z;
-            } else {
-              zrow[x] = 0.0f;  // covered
-            }
-            float blend_weight = 0.0f;
-            for (std::size_t c = 0; c < na; ++c) {
-              const float val = w0 * av[c][0] + w1 * av[c][1] + w2 * av[c][2];
-              raster.attr_target[c][pix] = val;
-              if (int(c) == blend) blend_weight = val;
-            }
-            if (ns > 0) {
-              const Footprint f = footprint(w, h, u, vv);
-              if (blend < 0) {
-                for (std::size_t c = 0; c < ns; ++c) raster.target[c][pix] = sample(raster.source[c], f);
-              } else if (blend_weight > 0.0f) {
-                for (std::size_t c = 0; c < nt; ++c) {
-                  const float sharp = sample(raster.source[c], f);
-                  raster.target[c][pix] = sharp + blend_weight * (sample(raster.source[nt + c], f) - sharp);
-                }
-              } else {
-                for (std::size_t c = 0; c < nt; ++c) raster.target[c][pix] = sample(raster.source[c], f);
-              }
-            }
-          }
-        }
-      }
-      // Pixels no fragment reached (only possible where degenerate triangles meet): the source pixel itself
-      // and the attributes' `uncovered` value.
-      for (int y = band_y0; y < band_y1; ++y)
-        for (int x = 0; x < w; ++x) {
-          const std::size_t pix = std::size_t(y) * std::size_t(w) + std::size_t(x);
-          if (zbuffer_[pix] != std::numeric_limits<float>::infinity()) continue;
-          for (std::size_t c = 0; c < na; ++c)
-            raster.attr_target[c][pix] = c < raster.attr_uncovered.size() ? raster.attr_uncovered[c] : 0.0f;
-          if (blend < 0) {
-            for (std::size_t c = 0; c < ns; ++c) raster.target[c][pix] = raster.source[c][pix];
-          } else {
-            const float a = raster.attr_target[std::size_t(blend)][pix];
-            for (std::size_t c = 0; c < nt; ++c)
-              raster.target[c][pix] = raster.source[c][pix] + a * (raster.source[nt + c][pix] - raster.source[c][pix]);
-          }
-        }
-    }
+    for (int band = range.begin(); band < range.end(); ++band) raster_bands.band(band, bins_[std::size_t(band)]);
   });
 }
 

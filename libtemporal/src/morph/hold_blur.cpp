@@ -3,6 +3,7 @@
 #include "temporal/morph/hold_blur.h"
 
 #include "temporal/core/parallel.h"
+#include "temporal/core/reproject.h"
 
 #include <algorithm>
 #include <cmath>
@@ -46,22 +47,14 @@ Expected<Image> perceive_hold(std::span<const Image* const> frames, const std::v
         const float cx = float(x) + 0.5f, cy = float(y) + 0.5f;
         std::fill(sum.begin(), sum.end(), 0.0);
         for (std::size_t f = 0; f < count; ++f) {
-          // Midpoint rule over the hold time of frame f: the eye is at (f + s) * v, s in [0, 1). The bilinear
-          // footprint is shared by every channel.
+          // Midpoint rule over the hold time of frame f: the eye is at (f + s) * v, s in [0, 1). One bilinear
+          // fetch of the reprojection module (pixel centres at integers there, edge taps repeated) serves every
+          // channel.
           for (int s = 0; s < samples; ++s) {
             const float tt = float(f) + (float(s) + 0.5f) / float(samples);
             const float fx = cx + tt * vx - 0.5f, fy = cy + tt * vy - 0.5f;
-            const float x0f = std::floor(fx), y0f = std::floor(fy);
-            const float ax = fx - x0f, ay = fy - y0f;
-            const int x0 = std::clamp(int(x0f), 0, w - 1), x1 = std::clamp(int(x0f) + 1, 0, w - 1);
-            const int yy0 = std::clamp(int(y0f), 0, h - 1), yy1 = std::clamp(int(y0f) + 1, 0, h - 1);
-            const std::size_t r0 = std::size_t(yy0) * std::size_t(w), r1 = std::size_t(yy1) * std::size_t(w);
-            for (std::size_t c = 0; c < nc; ++c) {
-              const float* p = src[f * nc + c];
-              const float top = p[r0 + x0] + ax * (p[r0 + x1] - p[r0 + x0]);
-              const float bot = p[r1 + x0] + ax * (p[r1 + x1] - p[r1 + x0]);
-              sum[c] += top + ay * (bot - top);
-            }
+            const reproject::Bilinear b = reproject::bilinear(fx, fy, w, h);
+            for (std::size_t c = 0; c < nc; ++c) sum[c] += b(src[f * nc + c]);
           }
         }
         const double norm = 1.0 / (double(samples) * double(count));

@@ -52,33 +52,39 @@ Status EmaFilter::process(const FilterInput& in, Image& output, FilterStats* sta
   const float alpha = params_.alpha, tol = params_.depth_tolerance;
   const std::uint8_t* valid = valid_.data();
 
+  // The history fetch and its rejection are the shared reprojection rules (temporal/core/reproject.h): off
+  // screen, or every bilinear tap another surface (depth and id of the previous frame) -> no history.
+  reproject::Frames frames;
+  frames.width = w;
+  frames.height = h;
+  frames.motion_x = in.motion_x;
+  frames.motion_y = in.motion_y;
+  frames.z = use_depth ? in.depth : nullptr;
+  frames.prev_z = use_depth ? prev_depth : nullptr;
+  frames.id = use_id ? in.id : nullptr;
+  frames.prev_id = use_id ? prev_id : nullptr;
+  frames.test = {tol, use_id};
   std::atomic<std::size_t> rejects{0};
   parallel_rows(h, [&](int y0, int y1) {
+    thread_local reproject::HistoryRow taps;
+    thread_local std::vector<float> fetched;
+    fetched.resize(std::size_t(3) * w);
+    float* rows[3] = {fetched.data(), fetched.data() + w, fetched.data() + 2 * w};
     std::size_t local = 0;
-    for (int yy = y0; yy < y1; ++yy)
+    for (int yy = y0; yy < y1; ++yy) {
+      reproject::reproject_row(frames, yy, taps);
+      if (same) reproject::gather_row(taps, hist, rows, channels, w);
       for (int xx = 0; xx < w; ++xx) {
         const std::size_t i = std::size_t(yy) * std::size_t(w) + std::size_t(xx);
-        const float mvx = in.motion_x ? in.motion_x[i] : 0.0f;
-        const float mvy = in.motion_y ? in.motion_y[i] : 0.0f;
-        const float fx = float(xx) + mvx, fy = float(yy) + mvy;
-        bool reject = in.reset || !same || !reproject::on_screen(fx, fy, w, h);
-        if (!reject && (use_depth || use_id)) {
-          const std::size_t q = reproject::nearest(fx, fy, w, h);
-          if (use_id && prev_id[q] != in.id[i]) reject = true;
-          if (use_depth && std::fabs(prev_depth[q] - in.depth[i]) > tol * std::fabs(in.depth[i])) reject = true;
-        }
-        float hv[3] = {};
-        if (!reject) {
-          const reproject::Bilinear b = reproject::bilinear(fx, fy, w, h);
-          for (int c = 0; c < channels; ++c) hv[c] = b(hist[c]);
-        }
+        const bool reject = in.reset || !same || taps.hit[xx] == 0.0f;
         local += reject ? 1 : 0;
         for (int c = 0; c < channels; ++c) {
+          const float hv = reject ? 0.0f : rows[c][xx];
           float v;
           if (valid[i])
-            v = reject ? y[c][i] : alpha * hv[c] + (1.0f - alpha) * y[c][i];  // eq. 1
+            v = reject ? y[c][i] : alpha * hv + (1.0f - alpha) * y[c][i];  // eq. 1
           else
-            v = reject ? 0.0f : hv[c];  // no valid sample: keep the history (0 when there is none)
+            v = hv;  // no valid sample: keep the history (0 when there is none)
           out[c][i] = v;
           next[c][i] = v;
         }
@@ -86,6 +92,7 @@ Status EmaFilter::process(const FilterInput& in, Image& output, FilterStats* sta
         if (next_id) next_id[i] = in.id[i];
         if (dbg) dbg[i] = reject ? 1.0f : 0.0f;
       }
+    }
     rejects += local;
   });
   std::swap(history_, next_);

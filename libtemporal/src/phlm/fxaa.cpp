@@ -8,6 +8,7 @@
 #include "temporal/core/reproject.h"
 
 #include <algorithm>
+#include <utility>
 #include <atomic>
 #include <cmath>
 #include <vector>
@@ -54,7 +55,22 @@ Status fxaa(const FilterInput& in, Image& output, const FxaaParams& params, Filt
           if (dbg) dbg[i] = 0.0f;
         };
         if (!valid[i]) {
-          pass_through();
+          // No sample here (NaN/Inf input): the mean of the finite 4-neighbours, 0 when there is none. A non-finite
+          // value never reaches the output (docs/conventions.md, "Non-finite values").
+          for (int c = 0; c < channels; ++c) {
+            float sum = 0.0f;
+            int n = 0;
+            for (const auto& [dx, dy] : {std::pair{-1, 0}, std::pair{1, 0}, std::pair{0, -1}, std::pair{0, 1}}) {
+              const int qx = px + dx, qy = py + dy;
+              if (qx < 0 || qy < 0 || qx >= w || qy >= h) continue;
+              const std::size_t q = std::size_t(qy) * std::size_t(w) + std::size_t(qx);
+              if (!valid[q]) continue;
+              sum += y[c][q];
+              ++n;
+            }
+            out[c][i] = n > 0 ? sum / float(n) : 0.0f;
+          }
+          if (dbg) dbg[i] = 0.0f;
           continue;
         }
         const float lumaM = at(px, py);

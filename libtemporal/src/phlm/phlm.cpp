@@ -326,8 +326,21 @@ void run_phlm(const FilterInput& in, const PhlmParams& params, bool have_prev, c
         }
         local_trace = max_(local_trace, trace_p);
 
-        // Line 22 / eq. 8: the output is the updated model's prediction.
-        for (int c = 0; c < C; ++c) out[c][i] = s * rls::predict(m, c, x);
+        // Line 22 / eq. 8: the output is the updated model's prediction. Where this frame has no sample the
+        // carried model was not box-tested (Algorithm 1 tests against y, which is missing): its prediction is
+        // clamped to the box of the valid neighbours, so a stale or extrapolating model cannot leave the local
+        // range (the model itself is kept unchanged for the next frame).
+        {
+          float f[C];
+          for (int c = 0; c < C; ++c) f[c] = s * rls::predict(m, c, x);
+          if (!centre_valid && any_valid) {
+            float fb[C];
+            to_box_space<C>(f, fb);
+            for (int c = 0; c < C; ++c) fb[c] = std::isfinite(fb[c]) ? std::clamp(fb[c], bmin[c], bmax[c]) : bmin[c];
+            from_box_space<C>(fb, f);
+          }
+          for (int c = 0; c < C; ++c) out[c][i] = f[c];
+        }
 
         for (int c = 0; c < C; ++c)
           for (int k = 0; k < N; ++k) next[i * L::kSize + L::kBeta + std::size_t(c * N + k)] = m.beta[c][k];
@@ -479,6 +492,19 @@ Status PhlmFilter::set_state(const Image& state, int channels) {
                                   "--state-out` on the same --layer");
     if (count_non_finite({src, state.pixel_count()}) != 0)
       return Error::input({}, "state channel '" + name + "' holds NaN or Inf values; it cannot be resumed");
+    // P = U D U^T must stay positive definite (D > 0) and the model scale s positive (model_scale gives s >= 1,
+    // and bilinear fetches of it stay within rounding of that); anything else is not a state this filter wrote,
+    // and would turn the next frame's update into NaN.
+    const bool is_d = name.rfind("P.D", 0) == 0, is_scale = name == "scale.s";
+    if (is_d || is_scale) {
+      for (std::size_t i = 0; i < state.pixel_count(); ++i)
+        if (!(src[i] > 0.0f))
+          return Error::input({}, "state channel '" + name + "' holds " + std::to_string(src[i]) + " at pixel (" +
+                                      std::to_string(i % std::size_t(state.width())) + ", " +
+                                      std::to_string(i / std::size_t(state.width())) + "): " +
+                                      (is_d ? "P must be positive definite" : "the model scale must be positive") +
+                                      "; this is not a state written by filter-phlm --state-out");
+    }
     planes.push_back(src);
   }
   channels_ = channels;
@@ -491,6 +517,10 @@ Status PhlmFilter::set_state(const Image& state, int channels) {
     for (std::size_t k = 0; k < size; ++k) state_[i * size + k] = planes[k][i];
   have_state_ = true;
   return Status::ok();
+}
+
+std::string PhlmFilter::stats_text(const FilterStats& stats) const {
+  return ", max trace(P) " + std::to_string(stats.max_trace_p);
 }
 
 }  // namespace temporal

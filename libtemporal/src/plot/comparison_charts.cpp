@@ -20,37 +20,34 @@ std::vector<std::pair<std::string, Chart>> comparison_charts(const ComparisonRep
   const std::string ref_name = fs::path(report.reference).filename().string();
   std::vector<std::pair<std::string, Chart>> charts;
 
-  struct PerFrame {
-    Metric metric;
-    std::string suffix, title, y_label;
-  };
-  const std::vector<PerFrame> per_frame = {
-      {Metric::PsnrRgb, "", "PSNR (" + report.layer + ") per frame", "PSNR (dB)"},
-      {Metric::PsnrY, "-psnr-y", "PSNR of luminance per frame", "PSNR (dB)"},
-      {Metric::Ssim, "-ssim", "SSIM of luminance per frame", "SSIM"},
-      {Metric::Flicker, "-flicker",
-       std::string("Temporal instability per frame") + (report.motion_compensated ? " (motion-compensated)" : ""),
-       "flicker (RMS of luminance change difference)"},
-  };
-  for (const auto& pf : per_frame) {
+  // One chart per measured metric, from its registry entry (temporal/metrics/comparison.h).
+  for (const auto& name : report.metrics) {
+    const MetricDefinition* d = find_metric(name);
+    if (!d) continue;
+    std::string title = d->chart.title;
+    auto replace = [&](const std::string& key, const std::string& with) {
+      if (const auto at = title.find(key); at != std::string::npos) title.replace(at, key.size(), with);
+    };
+    replace("{layer}", report.layer);
+    replace("{motion}", report.motion_compensated ? " (motion-compensated)" : "");
     Chart c;
-    c.title = pf.title + " against " + ref_name;
+    c.title = title + " against " + ref_name;
     c.x_label = "frame";
-    c.y_label = pf.y_label;
+    c.y_label = d->chart.y_label;
     bool any = false;
     for (const auto& s : report.sequences) {
       ChartSeries series;
       series.name = s.name;
       for (const auto& f : s.frames) {
-        const double v = metric_value(f, pf.metric);
+        const double v = f.value(name);
         series.x.push_back(f.frame);
         series.y.push_back(std::isfinite(v) ? v : kNaN);  // +inf PSNR (identical frame) leaves a gap
         any = any || std::isfinite(v);
       }
       c.series.push_back(std::move(series));
     }
-    if (pf.metric == Metric::Flicker && !any) continue;  // one frame: no temporal change to measure
-    charts.emplace_back(stem + pf.suffix + ext, std::move(c));
+    if (d->chart.skip_without_values && !any) continue;  // e.g. one frame: no temporal change to measure
+    charts.emplace_back(stem + d->chart.suffix + ext, std::move(c));
   }
 
   Chart speed;
@@ -60,7 +57,7 @@ std::vector<std::pair<std::string, Chart>> comparison_charts(const ComparisonRep
   speed.style = ChartStyle::Points;
   for (const auto& s : report.sequences) {
     const auto ms = mean_compute_ms(s);
-    const auto psnr = summarize(s, Metric::PsnrRgb);
+    const auto psnr = summarize(s, "psnr_rgb");
     if (!ms || !psnr.count || !std::isfinite(psnr.mean)) continue;
     speed.series.push_back({s.name, {*ms}, {psnr.mean}});
   }

@@ -20,55 +20,15 @@ namespace temporal {
 
 using namespace render_detail;
 
-// ---- option parsing ------------------------------------------------------------------------------------
-
-namespace {
-std::vector<std::string> split_list(const std::string& list) {
-  std::vector<std::string> out;
-  std::stringstream ss(list);
-  std::string item;
-  while (std::getline(ss, item, ','))
-    if (!item.empty()) out.push_back(item);
-  return out;
-}
-}  // namespace
-
-Expected<PayloadOptions> parse_payload_terms(const std::string& list, PayloadOptions base) {
-  base.direct = base.shadow = base.ssao = base.gi = false;
-  const auto items = split_list(list);
-  if (items.empty()) return Error::usage("--payload needs at least one of direct, shadow, ssao, gi");
-  for (const auto& t : items) {
-    if (t == "direct") base.direct = true;
-    else if (t == "shadow") base.shadow = true;
-    else if (t == "ssao") base.ssao = true;
-    else if (t == "gi") base.gi = true;
-    else return Error::usage("unknown payload term '" + t + "': use direct, shadow, ssao, gi");
-  }
-  return base;
-}
-
-std::vector<std::string> PayloadOptions::channels() const {
-  std::vector<std::string> c = {"R", "G", "B"};
-  if (direct) c.insert(c.end(), {"direct.R", "direct.G", "direct.B"});
-  if (shadow) c.push_back("shadow.Y");
-  if (ssao) c.push_back("ssao.Y");
-  if (gi) c.insert(c.end(), {"gi.R", "gi.G", "gi.B"});
-  return c;
-}
-
-Expected<RenderOutputs> RenderOutputs::parse(const std::string& list) {
-  RenderOutputs o;
-  o.gbuffer = o.shade = o.reference = o.color = false;
-  const auto items = split_list(list);
-  if (items.empty()) return Error::usage("--outputs needs at least one of gbuffer, shade, reference, color");
-  for (const auto& t : items) {
-    if (t == "gbuffer") o.gbuffer = true;
-    else if (t == "shade") o.shade = true;
-    else if (t == "reference") o.reference = true;
-    else if (t == "color") o.color = true;
-    else return Error::usage("unknown output '" + t + "': use gbuffer, shade, reference, color");
-  }
-  return o;
+SceneGeometry geometry_of(const Scene& scene) {
+  SceneGeometry g;
+  g.primitives = &scene.primitives();
+  g.materials = &scene.materials();
+  g.textures = &scene.textures();
+  g.bounds_min = scene.bounds_min();
+  g.bounds_max = scene.bounds_max();
+  g.ambient = scene.ambient();
+  return g;
 }
 
 glm::mat4 camera_projection(const CameraState& camera, int width, int height) {
@@ -133,7 +93,9 @@ Expected<Fbo> make_fbo(const GlFunctions& gl, int w, int h, const std::vector<GL
   const GLenum status = gl.CheckFramebufferStatus(GL_FRAMEBUFFER);
   gl.BindFramebuffer(GL_FRAMEBUFFER, 0);
   if (status != GL_FRAMEBUFFER_COMPLETE)
-    return Error::internal(std::string("framebuffer ") + name + " is incomplete (status " + std::to_string(status) + ")");
+    return Error::usage(std::string("OpenGL cannot make the ") + std::to_string(w) + "x" + std::to_string(h) + " " + name +
+                        " framebuffer (status " + std::to_string(status) +
+                        "): the image is beyond what llvmpipe can allocate here; reduce --size");
   return f;
 }
 
@@ -159,6 +121,18 @@ struct LightView {
   float texel_world = 0.0f;    // world size of a shadow-map texel near the scene centre
   float rsm_measure = 0.0f;    // directional: world area of an RSM texel; else solid angle of the centre texel
 };
+
+// The instant of frame N at `fps` in microseconds (wrapping after 71 minutes): the key of every random pattern.
+// Rates whose frames share instants (40 Hz frame n, 120 Hz frame 3n) get the same key.
+std::uint32_t instant_key(int frame, double fps) {
+  return std::uint32_t(std::uint64_t(std::llround(double(frame) / fps * 1e6)));
+}
+
+// The index frame_jitter() hashes or walks: random jitter is keyed by the instant; the regular and Halton patterns
+// walk their sequence with the frame number (their order is what makes them regular or low-discrepancy).
+int jitter_frame(JitterMode mode, int frame, std::uint32_t instant) {
+  return mode == JitterMode::Random ? int(instant & 0x7fffffffu) : frame;
+}
 
 }  // namespace
 
@@ -186,7 +160,7 @@ struct Renderer::Impl {
   Status init();
   void set_lights(GLuint program, const FrameState& state) const;
   Status light_maps(const FrameState& state);
-  void select_vpls(int frame, int sample);
+  void select_vpls(std::uint32_t instant, int sample);
   struct View {
     glm::mat4 view{1.0f}, proj{1.0f}, proj_jittered{1.0f}, prev_vp{1.0f};
     glm::vec3 camera_pos{0.0f};
@@ -226,7 +200,7 @@ Status Renderer::Impl::init() {
   if (auto s = build("gbuffer", kGeometryVertex, kGbufferFragment, gbuffer_program); !s) return s;
   if (auto s = build("shadow", kGeometryVertex, kShadowFragment, shadow_program); !s) return s;
   if (auto s = build("rsm", kGeometryVertex, kRsmFragment, rsm_program); !s) return s;
-  if (auto s = build("shade", kFullscreenVertex, deferred_fragment(p.direct, p.shadow, p.ssao, p.gi), shade_program); !s)
+  if (auto s = build("shade", kFullscreenVertex, deferred_fragment(p.direct, p.shadow, p.ssao, p.gi, scene.ambient != glm::vec3(0.0f)), shade_program); !s)
     return s;
   g.GenVertexArrays(1, &empty_vao);
   g.GenBuffers(1, &vpl_buffer);
@@ -384,13 +358,13 @@ Status Renderer::Impl::light_maps(const FrameState& state) {
 // carrying its reflected flux times (lit texels / vpl_count), so the sum estimates the whole RSM's
 // one-bounce light without bias. The set changes every frame and every reference sample (seed 000 relies
 // on accumulating this noise over time).
-void Renderer::Impl::select_vpls(int frame, int sample) {
+void Renderer::Impl::select_vpls(std::uint32_t instant, int sample) {
   if (!rsm.fbo) return;
   const int count = rsm_valid.empty() ? 0 : options.payload.vpl_count;
   vpl_scratch.assign(std::size_t(kMaxVpls) * 8, 0.0f);
   const float scale = count > 0 ? float(rsm_valid.size()) / float(count) : 0.0f;
   for (int i = 0; i < count; ++i) {
-    const std::uint32_t r = hash_u32(options.seed, std::uint32_t(frame), std::uint32_t(sample) + 0x5151u, std::uint32_t(i));
+    const std::uint32_t r = hash_u32(options.seed, instant, std::uint32_t(sample) + 0x5151u, std::uint32_t(i));
     const std::size_t t = rsm_valid[r % rsm_valid.size()];
     // Packed as the shader reads it (shaders.cpp, Vpls): (position, n.x), (flux with sign(n.z) on r, n.y).
     float* v = &vpl_scratch[std::size_t(i) * 8];
@@ -494,6 +468,8 @@ void Renderer::Impl::shade(const Fbo& gb, const Fbo& target, const View& v, std:
   g.Uniform1ui(g.GetUniformLocation(prog, "u_seed"), seed);
   const float clamp_d = p.vpl_clamp > 0 ? p.vpl_clamp : 0.02f * scene_diagonal;
   g.Uniform1f(g.GetUniformLocation(prog, "u_vpl_clamp2"), clamp_d * clamp_d);
+  if (scene.ambient != glm::vec3(0.0f))
+    g.Uniform3f(g.GetUniformLocation(prog, "u_ambient"), state->ambient.x, state->ambient.y, state->ambient.z);
   g.BindVertexArray(empty_vao);
   g.DrawArrays(GL_TRIANGLES, 0, 3);
   g.BindVertexArray(0);
@@ -634,25 +610,6 @@ Renderer::~Renderer() = default;
 const RenderOptions& Renderer::options() const { return impl_->options; }
 std::string Renderer::gl_description() const { return impl_->context->description(); }
 
-Status validate(const RenderOptions& options) {
-  const PayloadOptions& p = options.payload;
-  if (options.width < 1 || options.height < 1 || options.width > 16384 || options.height > 16384)
-    return Error::usage("--size must be between 1x1 and 16384x16384");
-  if (options.factor < 1 || options.width % options.factor != 0 || options.height % options.factor != 0)
-    return Error::usage("--factor " + std::to_string(options.factor) + " must divide the width and height (" +
-                        std::to_string(options.width) + "x" + std::to_string(options.height) + ")");
-  if (options.reference_spp < 1) return Error::usage("--reference-spp must be at least 1");
-  if (options.shade_mip_bias && !(std::abs(*options.shade_mip_bias) <= 16.0f))
-    return Error::usage("--shade-mip-bias must be a number between -16 and 16 (or 'auto')");
-  if (p.pcf_kernel < 1 || p.pcf_kernel > 32) return Error::usage("--pcf must be between 1 and 32");
-  if (p.shadow_map_size < 16 || p.shadow_map_size > 8192) return Error::usage("--shadow-map-size must be in 16..8192");
-  if (p.ssao_directions < 1 || p.ssao_steps < 1) return Error::usage("--ssao-directions and --ssao-steps must be >= 1");
-  if (p.vpl_count < 1 || p.vpl_count > kMaxVpls)
-    return Error::usage("--vpls must be between 1 and " + std::to_string(kMaxVpls));
-  if (p.rsm_size < 4 || p.rsm_size > 2048) return Error::usage("--rsm-size must be in 4..2048");
-  return {};
-}
-
 Expected<Renderer> Renderer::create(const RenderOptions& options, const SceneGeometry& scene) {
   if (auto s = validate(options); !s) return s.error();
   if (!scene.primitives || !scene.materials || !scene.textures) return Error::internal("Renderer::create without a scene");
@@ -687,11 +644,14 @@ Expected<RenderedFrame> Renderer::render(const FrameInput& in) {
   if (payload && (o.payload.shadow || o.payload.gi)) {
     const auto t0 = Clock::now();
     if (auto s = im.light_maps(*in.current); !s) return s.error();
-    im.select_vpls(in.frame, 0);
+    im.select_vpls(instant_key(in.frame, in.fps), 0);
     finish();
     result.timings_ms[kPassLightMaps] = ms_since(t0);
   }
-  const std::uint32_t frame_seed = hash_u32(o.seed, std::uint32_t(in.frame), 0xa0u);
+  // Random patterns (SSAO rotations, VPL sets, random jitter) are keyed by the frame's instant, not its number, so
+  // a 40 Hz frame n and a 120 Hz frame 3n are the same render (docs/conventions.md, "Jitter" and "Noise").
+  const std::uint32_t instant = instant_key(in.frame, in.fps);
+  const std::uint32_t frame_seed = hash_u32(o.seed, instant, 0xa0u);
 
   const Impl::View full = im.make_view(in, w, h, {0.0f, 0.0f});
   if (out.gbuffer) {
@@ -707,7 +667,7 @@ Expected<RenderedFrame> Renderer::render(const FrameInput& in) {
     // The low-resolution payload: a G-buffer rendered at 1/k with this frame's jitter (in low-res pixels,
     // conventions "Jitter"), shaded directly. Its samples are exactly full-res pixel centres for the regular
     // pattern. Textures are read at the full-resolution mip level (LOD bias -log2 k by default, RenderOptions).
-    const glm::vec2 jitter = frame_jitter(o.shade_jitter, in.frame, k, o.seed);
+    const glm::vec2 jitter = frame_jitter(o.shade_jitter, jitter_frame(o.shade_jitter, in.frame, instant), k, o.seed);
     const Impl::View low = im.make_view(in, w / k, h / k, jitter);
     const float lod_bias = o.shade_mip_bias ? *o.shade_mip_bias : -std::log2(float(k));
     const auto t0 = Clock::now();
@@ -723,7 +683,8 @@ Expected<RenderedFrame> Renderer::render(const FrameInput& in) {
   }
   if (out.color) {
     // Colour: the same payload at full resolution, one sample per pixel at the colour jitter (no AA).
-    const glm::vec2 jitter = frame_jitter(o.color_jitter, in.frame, k, o.seed ^ 0xc0104u);
+    const glm::vec2 jitter =
+        frame_jitter(o.color_jitter, jitter_frame(o.color_jitter, in.frame, instant), k, o.seed ^ 0xc0104u);
     const Impl::View view = im.make_view(in, w, h, jitter);
     const auto t0 = Clock::now();
     im.draw_gbuffer(im.gbuffer_full, view);
@@ -748,9 +709,9 @@ Expected<RenderedFrame> Renderer::render(const FrameInput& in) {
       const auto i = std::uint32_t(s + 1);
       const glm::vec2 jitter(radical_inverse(i, 2) - 0.5f, radical_inverse(i, 3) - 0.5f);
       const Impl::View view = im.make_view(in, w, h, jitter);
-      if (s > 0 && im.rsm.fbo) im.select_vpls(in.frame, s);
+      if (s > 0 && im.rsm.fbo) im.select_vpls(instant, s);
       im.draw_gbuffer(im.gbuffer_full, view);
-      im.shade(im.gbuffer_full, im.shade_full, view, hash_u32(o.seed, std::uint32_t(in.frame), 0xbeefu, i), true,
+      im.shade(im.gbuffer_full, im.shade_full, view, hash_u32(o.seed, instant, 0xbeefu, i), true,
                s == 0);
     }
     finish();

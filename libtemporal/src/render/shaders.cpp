@@ -166,7 +166,7 @@ layout(binding = 3) uniform sampler2DShadow u_shadow_map;
 layout(std140, binding = 0) uniform Vpls { vec4 vpl_data[2 * MAX_VPLS]; };
 layout(location = 0) out vec4 o_direct;  // rgb direct, a shadow
 layout(location = 1) out vec4 o_gi;      // rgb gi, a ssao
-layout(location = 2) out vec4 o_sum;     // rgb direct * shadow + gi * ssao
+layout(location = 2) out vec4 o_sum;     // rgb direct * shadow + gi * ssao (shadow * ssao without direct and gi)
 uniform vec3 u_camera_pos;
 uniform mat4 u_light_vp;       // world -> key light's shadow texture coordinates and depth, [0, 1]
 uniform int u_pcf;             // PCF kernel N (N x N taps)
@@ -179,6 +179,7 @@ uniform float u_proj_scale;    // pixels per world unit at depth 1 (P[1][1] * he
 uniform uint u_seed;           // changes every frame (and every reference sample)
 uniform int u_vpl_count;
 uniform float u_vpl_clamp2;    // minimum squared VPL distance
+uniform vec3 u_ambient;        // radiance of the environment (AMBIENT only)
 const float PI = 3.14159265358979;
 
 uint pcg(uint v) {
@@ -294,15 +295,26 @@ void main() {
     acc += vec3(abs(b.x), b.y, b.z) * (c / max(d2, u_vpl_clamp2));
   }
   gi = diffuse * acc / PI;
+#ifdef AMBIENT
+  // A uniform environment (USD DomeLight) of radiance L: a Lambertian surface reflects diffuse * L (docs/usd.md).
+  gi += diffuse * u_ambient;
+#endif
 #endif
   o_direct = vec4(direct, shadow);
   o_gi = vec4(gi, ao);
+#if defined(TERM_DIRECT) || defined(TERM_GI)
   o_sum = vec4(direct * shadow + gi * ao, 0.0);
+#else
+  // Neither radiance term: the sum is the visibility terms themselves, as grey, so that R,G,B is never an
+  // all-zero image that every method reproduces "perfectly" (docs/render-gbuffer.md, Outputs).
+  o_sum = vec4(vec3(shadow * ao), 0.0);
+#endif
 }
 )GLSL";
 
-std::string deferred_fragment(bool direct, bool shadow, bool ssao, bool gi) {
+std::string deferred_fragment(bool direct, bool shadow, bool ssao, bool gi, bool ambient) {
   std::string s = "#version 450 core\n";
+  if (ambient) s += "#define AMBIENT 1\n";
   if (direct) s += "#define TERM_DIRECT 1\n";
   if (shadow) s += "#define TERM_SHADOW 1\n";
   if (ssao) s += "#define TERM_SSAO 1\n";

@@ -15,8 +15,10 @@ extern const char* const kShadowFragment;
 extern const char* const kRsmFragment;
 // Full-screen triangle.
 extern const char* const kFullscreenVertex;
-// Deferred payload shading; `defines` switches terms on (TERM_DIRECT, TERM_SHADOW, TERM_SSAO, TERM_GI).
-std::string deferred_fragment(bool direct, bool shadow, bool ssao, bool gi);
+// Deferred payload shading; `defines` switches terms on (TERM_DIRECT, TERM_SHADOW, TERM_SSAO, TERM_GI) and the
+// ambient of a uniform environment into gi (AMBIENT: only compiled for scenes that have one, so that other
+// scenes run exactly the shader they always ran).
+std::string deferred_fragment(bool direct, bool shadow, bool ssao, bool gi, bool ambient);
 
 inline constexpr int kMaxLights = 8;
 // VPLs live in a uniform block of two vec4 each: 64 KiB / 32 bytes, rounded down.

@@ -1,5 +1,5 @@
 // Animation sampler evaluation, glTF 2.0 section 3.11 and Appendix C ("Interpolation").
-#include "scene_impl.h"
+#include "scene_description.h"
 
 #include <algorithm>
 #include <cmath>
@@ -34,6 +34,18 @@ void slerp(const float* a, const float* b, float s, float* out) {
   }
   for (int i = 0; i < 4; ++i) out[i] = wa * a[i] + sign * wb * b[i];
   normalise4(out);
+}
+
+// Hermite spline of Appendix C: p(s) = (2s^3 - 3s^2 + 1) v_k + td (s^3 - 2s^2 + s) b_k
+//                                  + (-2s^3 + 3s^2) v_k+1 + td (s^3 - s^2) a_k+1,
+// b_k the out-tangent of key k, a_k+1 the in-tangent of key k+1, both scaled by the key spacing td.
+// Compiled without FMA contraction so that the value does not depend on the CPU (-march=native) and equals
+// what the scene generator bakes into the USD copies of the built-in scenes (assets/generator).
+__attribute__((optimize("fp-contract=off"))) void hermite(const float* v0, const float* b0, const float* v1,
+                                                           const float* a1, float s, float td, int c, float* out) {
+  const float s2 = s * s, s3 = s2 * s;
+  const float h00 = 2 * s3 - 3 * s2 + 1, h10 = s3 - 2 * s2 + s, h01 = -2 * s3 + 3 * s2, h11 = s3 - s2;
+  for (int i = 0; i < c; ++i) out[i] = h00 * v0[i] + h10 * td * b0[i] + h01 * v1[i] + h11 * td * a1[i];
 }
 
 }  // namespace
@@ -72,16 +84,9 @@ void sample(const Sampler& sampler, float t, bool rotation, float* out) {
         }
         break;
       case Interpolation::CubicSpline: {
-        // Hermite spline of Appendix C: p(s) = (2s^3 - 3s^2 + 1) v_k + td (s^3 - 2s^2 + s) b_k
-        //                                      + (-2s^3 + 3s^2) v_k+1 + td (s^3 - s^2) a_k+1,
-        // b_k the out-tangent of key k, a_k+1 the in-tangent of key k+1, both scaled by the key spacing td.
-        const float s2 = s * s, s3 = s2 * s;
-        const float h00 = 2 * s3 - 3 * s2 + 1, h10 = s3 - 2 * s2 + s, h01 = -2 * s3 + 3 * s2, h11 = s3 - s2;
         const float* v0 = value(k);
-        const float* b0 = v0 + c;           // out-tangent of k
         const float* v1 = value(k1);
-        const float* a1 = v1 - c;           // in-tangent of k+1
-        for (int i = 0; i < c; ++i) out[i] = h00 * v0[i] + h10 * td * b0[i] + h01 * v1[i] + h11 * td * a1[i];
+        hermite(v0, v0 + c, v1, v1 - c, s, td, c, out);  // out-tangent of k, in-tangent of k+1
         break;
       }
     }

@@ -9,7 +9,7 @@
 #include "temporal/core/image.h"
 #include "temporal/metrics/metrics.h"
 #include "temporal/metrics/flicker.h"
-#include "temporal/metrics/warp.h"
+#include "temporal/core/reproject.h"
 
 #include <benchmark/benchmark.h>
 
@@ -261,10 +261,16 @@ void BM_CompareKernels_1080p(benchmark::State& state) {
     luminance_plane(rp, n, ry.data());
     luminance_plane(tp, n, ty.data());
     auto s = ssim(ty.data(), ry.data(), w, h, valid.data(), nullptr, SsimOptions{});
-    warp_bilinear(ry.data(), w, h, mx.data(), my.data(), warped.data());
+    reproject::Frames fr;
+    fr.width = w;
+    fr.height = h;
+    fr.motion_x = mx.data();
+    fr.motion_y = my.data();
+    const float* prev[] = {ry.data(), ty.data()};
+    float* warped2[] = {warped.data(), rd.data()};
+    reproject::warp_planes(fr, prev, warped2);  // both previous planes share one motion field, as in compare
+    temporal_delta(ty.data(), rd.data(), n, td.data());
     temporal_delta(ry.data(), warped.data(), n, rd.data());
-    warp_bilinear(ty.data(), w, h, mx.data(), my.data(), warped.data());
-    temporal_delta(ty.data(), warped.data(), n, td.data());
     auto fl = flicker(td.data(), rd.data(), w, h, valid.data(), nullptr);
     benchmark::DoNotOptimize(e);
     benchmark::DoNotOptimize(s);

@@ -1,7 +1,9 @@
 // Seed 004 Table 1 on the CPU: the two in-between frames of a 40 -> 120 Hz upsampling at 1024x1024, split into
 // motion flow (snapped grid), morph (warped grid rasterisation) and blur (pyramid, reconstruction,
 // compensation). Counters flow_ms, morph_ms, blur_ms are per rendered frame (= per two in-between frames).
+// One benchmark per method of the registry (temporal/morph/methods.h): BM_<method>1024x3/<threads>.
 #include "temporal/morph/hold_blur.h"
+#include "temporal/morph/methods.h"
 #include "temporal/morph/morph.h"
 #include "temporal/core/parallel.h"
 
@@ -52,7 +54,7 @@ const Scene& scene() {
   return s;
 }
 
-void run_method(benchmark::State& state, MorphMethod method) {
+void run_method(benchmark::State& state, const std::string& method) {
   const Scene& s = scene();
   // Argument: worker threads (0: every core). One thread gives the total work, robust to a loaded machine.
   const ThreadLimit limit(int(state.range(0)));
@@ -77,10 +79,6 @@ void run_method(benchmark::State& state, MorphMethod method) {
   state.counters["total_ms"] = sum.total_ms() / n;
 }
 
-void BM_Didyk1024x3(benchmark::State& state) { run_method(state, MorphMethod::Didyk); }
-void BM_Warp1024x3(benchmark::State& state) { run_method(state, MorphMethod::Warp); }
-void BM_Blend1024x3(benchmark::State& state) { run_method(state, MorphMethod::Blend); }
-
 // The perceived-image simulation of one displayed frame (window 3) at 1024x1024.
 void BM_PerceiveHold1024(benchmark::State& state) {
   const Scene& s = scene();
@@ -91,9 +89,16 @@ void BM_PerceiveHold1024(benchmark::State& state) {
   }
 }
 
-BENCHMARK(BM_Didyk1024x3)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->MeasureProcessCPUTime()->UseRealTime();
-BENCHMARK(BM_Warp1024x3)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->MeasureProcessCPUTime()->UseRealTime();
-BENCHMARK(BM_Blend1024x3)->Arg(0)->Unit(benchmark::kMillisecond)->MeasureProcessCPUTime()->UseRealTime();
+[[maybe_unused]] const bool registered = [] {
+  for (const auto& m : morph_methods())
+    benchmark::RegisterBenchmark(("BM_" + m.name + "1024x3").c_str(), run_method, m.name)
+        ->Arg(0)
+        ->Arg(1)
+        ->Unit(benchmark::kMillisecond)
+        ->MeasureProcessCPUTime()
+        ->UseRealTime();
+  return true;
+}();
 BENCHMARK(BM_PerceiveHold1024)->Unit(benchmark::kMillisecond);
 
 }  // namespace

@@ -4,9 +4,10 @@
 #include "temporal/core/image.h"
 #include "temporal/core/sequence.h"
 #include "temporal/metrics/metrics.h"
-#include "temporal/phlm/phlm.h"
+#include "temporal/phlm/filters.h"
 
 #include <cstdio>
+#include <memory>
 #include <random>
 #include <string>
 #include <vector>
@@ -36,7 +37,11 @@ int main(int argc, char** argv) {
   // Load the sequence back, filter it, measure the last frame.
   auto list = resolve_frames(*pattern, std::nullopt);
   if (!list) return std::fprintf(stderr, "%s\n", list.error().message.c_str()), 1;
-  PhlmFilter filter;
+  // Any method of filter-phlm by name, from the registry (temporal/phlm/filters.h), with its default parameters.
+  FilterOptions options;
+  const FilterMethod* method = find_filter_method("phlm");
+  if (!method) return std::fprintf(stderr, "no method phlm\n"), 1;
+  std::unique_ptr<FrameFilter> filter = method->create(options);
   Image output;
   double psnr_in = 0, psnr_out = 0;
   for (const int f : *list) {
@@ -46,7 +51,7 @@ int main(int argc, char** argv) {
     in.color = &*frame;
     in.channels = {"R", "G", "B"};
     in.reset = f == list->front();
-    if (Status s = filter.process(in, output); !s) return std::fprintf(stderr, "%s\n", s.error().message.c_str()), 1;
+    if (Status s = filter->process(in, output); !s) return std::fprintf(stderr, "%s\n", s.error().message.c_str()), 1;
     const float* ref[] = {clean.plane("R"), clean.plane("G"), clean.plane("B")};
     const float* noisy[] = {frame->plane("R"), frame->plane("G"), frame->plane("B")};
     const float* filtered[] = {output.plane("R"), output.plane("G"), output.plane("B")};

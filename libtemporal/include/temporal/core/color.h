@@ -6,6 +6,8 @@
 // built-in config, and a test checks that the two agree.
 #pragma once
 
+#include "temporal/core/fwd.h"
+
 #include "temporal/core/error.h"
 
 #include <memory>
@@ -15,7 +17,6 @@
 
 namespace temporal {
 
-class Image;
 
 // Rec.709 / sRGB primaries luminance (ITU-R BT.709), on linear values.
 inline float luminance(float r, float g, float b) { return 0.2126f * r + 0.7152f * g + 0.0722f * b; }

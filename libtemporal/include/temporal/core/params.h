@@ -22,16 +22,32 @@ struct Param {
   std::variant<float*, double*, int*, bool*, std::string*> value;
   double min = -std::numeric_limits<double>::infinity();
   double max = std::numeric_limits<double>::infinity();
-  std::vector<std::string> choices;
+  std::vector<std::string> choices = {};  // (a default, so designated initializers may leave it out)
+  bool above_min = false;  // the value must be strictly greater than min ("> 0")
+  // A flag that turns a default-on feature off: giving it sets the bool field to false (`--no-snap` for
+  // `GridOptions::snap`), so the option struct keeps its positive-sense field and its default.
+  bool inverted = false;
 
   // Shorthands for the common ranges.
   static Param real(std::string flag, std::string help, float* v, double lo, double hi) {
     return {std::move(flag), std::move(help), v, lo, hi, {}};
   }
+  // A value strictly above `lo` (e.g. a positive scale: > 0).
+  static Param positive(std::string flag, std::string help, float* v, double lo = 0.0,
+                        double hi = std::numeric_limits<double>::infinity()) {
+    Param p{std::move(flag), std::move(help), v, lo, hi, {}};
+    p.above_min = true;
+    return p;
+  }
   static Param integer(std::string flag, std::string help, int* v, int lo, int hi) {
     return {std::move(flag), std::move(help), v, double(lo), double(hi), {}};
   }
   static Param flag_on(std::string flag, std::string help, bool* v) { return {std::move(flag), std::move(help), v, 0, 1, {}}; }
+  static Param flag_off(std::string flag, std::string help, bool* v) {
+    Param p{std::move(flag), std::move(help), v, 0, 1, {}};
+    p.inverted = true;
+    return p;
+  }
   static Param choice(std::string flag, std::string help, std::string* v, std::vector<std::string> options) {
     return {std::move(flag), std::move(help), v, 0, 0, std::move(options)};
   }
@@ -42,7 +58,8 @@ struct Param {
 };
 using ParamList = std::vector<Param>;
 
-// The current value as text (the default, before parsing): "0.2", "4", "on", "herzog".
+// The current value as text (the default, before parsing): "0.2", "4", "on", "herzog". A flag reads "on" when it is
+// in effect (an inverted flag: when its field is false).
 std::string param_value_text(const Param& param);
 // The valid range as text: "[0, 1]", "> 0", "one of: cache, refresh"; empty when unbounded.
 std::string param_range_text(const Param& param);

@@ -20,6 +20,7 @@
 #include "temporal/core/sequence.h"
 
 #include <cstddef>
+#include <cstdint>
 #include <functional>
 #include <map>
 #include <optional>
@@ -58,8 +59,12 @@ struct StageInputs {
   // 0: the scale is read from the input header's temporal:jitterFactor.
   int gbuffer_scale = 1;
   // Frames after the current one the stage sees (morph-120hz blend: 1; --perceive: the eye's window - 1), read
-  // from disk even past the selected range while the files exist.
+  // from disk even past the selected range while the files exist (unless lookahead_past_range is false: then
+  // only frames of the list are read, and the last frame of the list sees none).
   int lookahead = 0;
+  bool lookahead_past_range = true;
+  // Outputs the stage writes per input frame (morph-120hz: factor); above 1, --out must have a placeholder.
+  int outputs_per_frame = 1;
 };
 
 // One frame handed to a stage.
@@ -130,6 +135,18 @@ Expected<RunSummary> run_sequence(const SequenceOptions& options, FrameStage& st
 
 // --- Pieces shared with compare ----------------------------------------------------------------------------
 
+// The files a run reads, by identity (device and inode), so that no output ever replaces one of them: an output
+// pattern equal to an input pattern, another spelling of the same path, a hard or symbolic link to an input.
+class ProtectedInputs {
+ public:
+  void add(const std::string& path);  // ignored when the file does not exist
+  // Usage error when `path` exists and is one of the inputs; `what` names the option ("--out").
+  Status check(const std::string& path, const std::string& what) const;
+
+ private:
+  std::set<std::pair<std::uint64_t, std::uint64_t>> ids_;
+};
+
 // The output compression of a data sequence: `none`, `zip`, `piz`; `dwaa` is refused (lossy on data).
 Expected<ExrCompression> parse_data_compression(const std::string& name);
 
@@ -137,7 +154,8 @@ Expected<ExrCompression> parse_data_compression(const std::string& name);
 // produce it. `path` names the file in the error.
 Status check_gbuffer_layers(const Image& gbuffer, const std::vector<LayerNeed>& needs, const std::string& path);
 
-// Non-finite values in the float planes of the named layers of `image` (every float plane when empty).
+// Pixels of `image` with a NaN or Inf in any float plane of the named layers (every float plane when empty; "rgb"
+// stands for R, G, B).
 std::size_t count_non_finite_layers(const Image& image, const std::vector<std::string>& layers);
 
 }  // namespace temporal

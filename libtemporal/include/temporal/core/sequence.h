@@ -13,14 +13,18 @@ namespace temporal {
 struct FrameRange {
   int first = 0;
   int last = 0;  // inclusive
-  // Parses "A-B", "A" (one frame) or "A-" is refused: the end must be given.
+  // Parses "A-B" or "A" (one frame); "A-" is refused (the end must be given), so are negative frames and frames
+  // above 99,999,999 (usage errors).
   static Expected<FrameRange> parse(std::string_view text);
+  // The same without the bounds (for frame lists that may name any frame).
+  static Expected<FrameRange> parse_unchecked(std::string_view text);
   int count() const { return last - first + 1; }
 };
 
 class SequencePattern {
  public:
-  // Accepts one run of '#' (the run's length is the zero-padded width) or one printf `%0Nd` / `%d`.
+  // Accepts one run of '#' (the run's length is the zero-padded width, at most 10) or one printf `%0Nd` / `%d`, in
+  // the file name (a folder may contain '#' or '%').
   // A path without a placeholder is a single-frame "sequence" (frame numbers are then ignored).
   static Expected<SequencePattern> parse(std::string pattern);
 

@@ -1,20 +1,45 @@
 // Sequence comparison, the engine of the `compare` tool: streams a reference and any number of test
-// sequences frame by frame (only the current frame and the previous frame's luminance are in memory), computes
-// PSNR, SSIM and flicker (temporal/metrics/metrics.h, temporal/metrics/flicker.h) per frame and per test, optionally inside and
-// outside a mask layer, writes error maps, and turns the results into CSV, JSON, charts and threshold checks.
-// docs/compare.md defines every number.
+// sequences frame by frame (only the current frame and the previous frame's luminance are in memory), measures
+// every metric of the registry per frame and per test, optionally inside and outside a mask layer, writes error
+// maps, and turns the results into CSV, JSON, a summary table, charts and threshold checks. docs/compare.md
+// defines every number.
+//
+// The metric set is open: a metric is one entry of the registry (metric_registry()) - its name, the per-frame
+// measure, the CSV columns it writes, whether higher is better, its threshold option `--fail-<option>`, its
+// chart and its column of the summary table - and the CSV, JSON, thresholds, charts and table iterate the
+// registry. Adding a metric is one source file (src/metrics/metric_<name>.cpp: the definition and its
+// FrameMeasure), one line in src/metrics/registry.cpp (with its declaration in registry.h), and its section in
+// docs/compare.md.
 #pragma once
 
 #include "temporal/core/error.h"
+#include "temporal/core/runner.h"
 #include "temporal/core/sequence.h"
+#include "temporal/metrics/flip.h"
+#include "temporal/metrics/statistics.h"
 
+#include <array>
+#include <cstdint>
 #include <functional>
+#include <limits>
 #include <map>
+#include <set>
+#include <memory>
 #include <optional>
+#include <span>
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace temporal {
+
+class Image;
+
+// FLIP in compare (temporal/metrics/flip.h): off, LDR-FLIP of the display-encoded frames (sRGB OETF of the
+// values clamped to [0, 1]), or HDR-FLIP of the scene-linear values.
+enum class FlipMode { Off, Ldr, Hdr };
+// "off", "ldr", "hdr" (the values of `compare --flip`).
+const char* flip_mode_name(FlipMode mode);
 
 struct ComparisonSetup {
   std::string reference;               // reference sequence pattern (REF.####.exr)
@@ -28,35 +53,125 @@ struct ComparisonSetup {
   std::optional<FrameRange> frames;    // empty: every reference frame on disk
   double peak = 1.0;                   // PSNR / SSIM peak L (units of the pixel values)
   bool peak_from_data = false;         // idiff's rule per frame: max(1, largest finite value of both images)
+  FlipMode flip = FlipMode::Off;       // off by default: FLIP costs more than PSNR and SSIM together
+  FlipOptions flip_options;            // viewing condition (pixels per degree) and HDR-FLIP settings
   std::string error_maps;              // folder for <name>.####.exr error maps; empty: none
+  int warmup_frames = 0;               // the first N compared frames are summarised apart from the steady state
+  BootstrapOptions bootstrap;          // intervals of the JSON summary (temporal/metrics/statistics.h)
   std::string tool;                    // `temporal:tool` of the error maps
   std::string parameters;              // `temporal:parameters` of the error maps
 };
 
-// Metrics of one test frame. NaN means "no value" (no pixel compared); PSNR is +infinity for identical images.
+// --- The metric registry -----------------------------------------------------------------------------------
+
+inline constexpr double kNoValue = std::numeric_limits<double>::quiet_NaN();
+
+// One metric on one test frame. values[k] belongs to MetricDefinition::columns[k]; the first is the primary
+// value (the one summaries, thresholds, charts and the table use). NaN means "no value".
+struct MetricSample {
+  std::string metric;                // registry name
+  std::vector<double> values;
+  double inside = kNoValue;          // primary value over the pixels (or windows) inside the mask
+  double outside = kNoValue;         // ... and outside it
+  std::size_t count = 0;             // pixels or windows that entered the primary value
+};
+
+// What a metric sees of one test frame. Planes are width * height floats, row-major.
+struct FrameInputs {
+  int frame = 0;
+  int width = 0, height = 0;
+  std::span<const float* const> test;        // compared channels of the test
+  std::span<const float* const> reference;   // the reference's, same order
+  std::span<const std::string> channels;     // names of the test's compared channels
+  const float* test_y = nullptr;             // Rec.709 luminance of the compared channels (luminance_plane)
+  const float* reference_y = nullptr;
+  const std::uint8_t* valid = nullptr;       // 1 where every compared channel of both images is finite
+  const float* mask = nullptr;               // inside: > 0.5; null without a mask
+  double peak = 1.0;                         // PSNR / SSIM peak of this frame
+  // The motion-compensated change of luminance since the previous frame (temporal_delta of the warped previous
+  // luminance, temporal/metrics/flicker.h); null when the frame has no usable previous frame (first frame,
+  // camera cut).
+  const float* test_change = nullptr;
+  const float* reference_change = nullptr;
+  Image* maps = nullptr;                     // the frame's error-map image (add channels); null without maps
+};
+
+// The per-frame work of one metric. One instance per comparison measures every test frame in turn, so it may
+// keep scratch buffers between frames.
+class FrameMeasure {
+ public:
+  virtual ~FrameMeasure() = default;
+  // Fills out.values (one per column), out.inside / out.outside when in.mask is set, and out.count. An error's
+  // file is filled in by the caller.
+  virtual Status measure(const FrameInputs& in, MetricSample& out) = 0;
+};
+
+struct MetricColumn {
+  std::string csv;   // CSV header of the per-frame value
+  std::string json;  // key of its mean over frames in the metric's JSON summary; empty: CSV only. Unused for
+                     // the first (primary) column, whose summary is the metric's JSON object itself
+};
+
+// The per-frame chart of the primary value (`--plot F.png` writes F<suffix>.png). In the title, "{layer}"
+// becomes the compared layer and "{motion}" " (motion-compensated)" when a G-buffer was given.
+struct MetricChart {
+  std::string suffix;
+  std::string title;
+  std::string y_label;
+  bool skip_without_values = false;  // no chart when no frame has a value (flicker of a single frame)
+};
+
+struct MetricDefinition {
+  std::string name;                    // "psnr_rgb": JSON key, threshold and failure name, table header
+  std::string unit;                    // " dB" in messages, or empty
+  bool higher_is_better = true;
+  std::vector<MetricColumn> columns;   // CSV columns, primary first
+  std::array<std::string, 2> mask_columns;  // CSV columns of the primary value inside / outside the mask
+  // The four metrics compare always had keep their historical CSV places (pipelines parse them): primary
+  // columns after `sequence`, other columns before `peak`, mask columns after `mask_fraction`. Every other
+  // metric's columns (and then its mask columns) follow, in registry order.
+  bool historical_csv = false;
+  std::string threshold_option;        // "psnr" gives `--fail-psnr`; empty: no threshold
+  std::string threshold_help;          // its --help text
+  MetricChart chart;
+  int table_width = 10;                // summary table column
+  std::string table_format = "%.3f";   // printf format of the mean
+  // Null: always measured. Otherwise whether `setup` asks for the metric, and what to add when it does not.
+  bool (*enabled)(const ComparisonSetup& setup) = nullptr;
+  std::string enable_hint;             // e.g. "add --flip ldr or --flip hdr"
+  std::unique_ptr<FrameMeasure> (*make)(const ComparisonSetup& setup) = nullptr;
+};
+
+// Every metric compare knows, in CSV / table order.
+const std::vector<MetricDefinition>& metric_registry();
+// The registry entry called `name`, or null.
+const MetricDefinition* find_metric(std::string_view name);
+// The entries `setup` measures.
+std::vector<const MetricDefinition*> enabled_metrics(const ComparisonSetup& setup);
+
+// --- Results -----------------------------------------------------------------------------------------------
+
+// One test frame. PSNR is +infinity for identical images.
 struct FrameMetrics {
   int frame = 0;
-  double peak = 1.0;       // the peak used for this frame
-  double mse_rgb = 0.0;    // mean over valid pixels and compared channels of (test - reference)^2
-  double psnr_rgb = 0.0;   // dB, over every compared channel
-  double psnr_y = 0.0;     // dB, on luminance
-  double ssim = 0.0;       // MSSIM on luminance
-  std::optional<double> flicker;  // RMS of d_t (temporal/metrics/flicker.h); absent at the first frame and camera cuts
-  std::size_t flicker_pixels = 0;
+  double peak = 1.0;                    // the peak used for this frame
   std::size_t nonfinite_test = 0;       // pixels with a NaN/Inf in the test (excluded)
   std::size_t nonfinite_reference = 0;  // pixels with a NaN/Inf in the reference (excluded)
-  std::size_t valid_pixels = 0;         // pixels that entered PSNR
-  // Inside / outside the mask (only with a mask). mask_fraction: share of valid pixels inside.
+  std::size_t valid_pixels = 0;         // pixels that entered the metrics
   bool has_mask = false;
-  double mask_fraction = 0.0;
-  double psnr_rgb_inside = 0.0, psnr_rgb_outside = 0.0;
-  double psnr_y_inside = 0.0, psnr_y_outside = 0.0;
-  double ssim_inside = 0.0, ssim_outside = 0.0;
-  std::optional<double> flicker_inside, flicker_outside;
+  double mask_fraction = 0.0;           // share of valid pixels inside the mask
   // From the test file's header: `temporal:computeMs` and `temporal:ms:<pass>` (milliseconds).
   std::optional<double> compute_ms;
   std::map<std::string, double> timings_ms;
-  double metrics_ms = 0.0;  // time compare spent on this frame's metrics (I/O excluded)
+  double metrics_ms = 0.0;              // time compare spent on this frame's metrics (I/O excluded)
+  std::vector<MetricSample> metrics;    // one per measured metric, in ComparisonReport::metrics order
+
+  // The sample of `metric`, or null when it was not measured.
+  const MetricSample* sample(std::string_view metric) const;
+  // The sample of `metric`, added when absent (for reports assembled by hand).
+  MetricSample& ensure_sample(std::string_view metric);
+  // values[column] of `metric`; NaN when the metric or the value is absent.
+  double value(std::string_view metric, std::size_t column = 0) const;
 };
 
 struct SequenceReport {
@@ -77,67 +192,91 @@ struct ComparisonReport {
   int width = 0, height = 0;
   std::vector<int> frames;
   bool motion_compensated = false;
+  bool disocclusion_tested = false;  // the G-buffer had depth and ids: flicker drops disoccluded pixels
   double peak = 1.0;
   bool peak_from_data = false;
+  FlipMode flip = FlipMode::Off;
+  double pixels_per_degree = kFlipDefaultPixelsPerDegree;  // FLIP's viewing condition
+  std::vector<std::string> metrics;             // names of the measured metrics, registry order
+  int warmup_frames = 0;                        // ComparisonSetup::warmup_frames
+  BootstrapOptions bootstrap;                   // ComparisonSetup::bootstrap
   std::vector<SequenceReport> sequences;
 };
 
-// Observers of a running comparison (the library never prints; the tool decides what to show).
-struct ComparisonHooks {
-  std::function<void(int frame, int done, int total)> frame_done;  // after each frame (done of total)
-  std::function<void(const std::string& file, const std::string& text)> warning;  // e.g. NaN pixels found
-  std::function<void(const std::string& text)> log;                           // details for --verbose
-};
+// Observers of a running comparison (the library never prints; the tool decides what to show): the runner's
+// hooks (temporal/core/runner.h), frame_done after each frame, warnings (e.g. NaN pixels found), --verbose lines.
+using ComparisonHooks = RunHooks;
 
 // Runs the comparison. Errors: Usage (bad setup), Input (missing/corrupt files, missing layers, size or
-// channel-count mismatch, empty sequence), Output (error maps not writable).
+// channel-count mismatch, empty sequence, a layer FLIP cannot read), Output (error maps not writable).
 Expected<ComparisonReport> compare_sequences(const ComparisonSetup& setup, const ComparisonHooks& hooks = {});
+
+// Every file a comparison reads (reference, test and G-buffer frames), so that the caller can refuse an output
+// (CSV, JSON, chart) that would replace one of them; the engine itself refuses such error maps.
+Expected<ProtectedInputs> comparison_inputs(const ComparisonSetup& setup);
 
 // The name `compare` gives a test sequence without --names: the file name without folder, frame number and
 // extension (`out/taa.####.exr` -> `taa`).
 std::string sequence_name(const std::string& pattern);
 
-// --- Summaries -------------------------------------------------------------------------------------------
-
-enum class Metric { PsnrRgb, PsnrY, Ssim, Flicker };
-// "psnr_rgb", "psnr_y", "ssim", "flicker"
-const char* metric_name(Metric metric);
-// True when larger values are better (PSNR, SSIM).
-bool metric_higher_is_better(Metric metric);
-// The per-frame value, NaN when the frame has none (flicker of the first frame).
-double metric_value(const FrameMetrics& frame, Metric metric);
+// --- Summaries ---------------------------------------------------------------------------------------------
 
 struct MetricSummary {
   std::size_t count = 0;  // frames with a value
   double mean = 0.0;      // mean of the per-frame values (+inf if any PSNR frame is +inf)
   double min = 0.0, max = 0.0;
   int min_frame = 0, max_frame = 0;
-  double worst() const { return higher_is_better ? min : max; }  // min for PSNR/SSIM, max for flicker
+  double worst() const { return higher_is_better ? min : max; }
   bool higher_is_better = true;
 };
-MetricSummary summarize(const SequenceReport& sequence, Metric metric);
+// Summary of a metric's primary value (or of values[column]) over the frames that have one.
+MetricSummary summarize(const SequenceReport& sequence, std::string_view metric, std::size_t column = 0);
+
+// The per-frame values of a metric's primary value (or values[column]), one per frame in order, NaN where the
+// frame has none.
+std::vector<double> metric_series(const SequenceReport& sequence, std::string_view metric, std::size_t column = 0);
 
 // Mean of `temporal:computeMs` over frames that have it (else the mean sum of the `temporal:ms:*` timings).
 std::optional<double> mean_compute_ms(const SequenceReport& sequence);
 
-// --- Thresholds (compare --fail-*) -----------------------------------------------------------------------
+// The table compare prints: one line per sequence with its frame count, the mean of each measured metric and
+// the mean compute time from the headers.
+std::string summary_table(const ComparisonReport& report);
+
+// --- Thresholds (compare --fail-*) -------------------------------------------------------------------------
 
 struct Thresholds {
-  std::optional<double> psnr;     // fail when PSNR (RGB) < psnr dB
-  std::optional<double> ssim;     // fail when SSIM < ssim
-  std::optional<double> flicker;  // fail when flicker > flicker
-  bool worst_frame = false;       // judge the worst frame instead of the sequence mean
+  std::map<std::string, double> limits;  // metric name -> limit; fail when the judged value is worse
+  bool worst_frame = false;              // judge the worst frame instead of the sequence mean
+  bool nonfinite = false;                // fail when a test frame has NaN/Inf pixels or an overflowing error
 };
 struct ThresholdFailure {
   std::string sequence;
-  Metric metric = Metric::PsnrRgb;
+  std::string metric;
   double value = 0.0;
   double limit = 0.0;
-  std::string message() const;  // "taa: mean psnr_rgb 28.1 dB < 30 dB"
+  std::string text;             // the message when it is not a metric against a limit (--fail-nonfinite)
+  std::string message() const;  // "taa: psnr_rgb 28.1 dB < limit 30 dB"
 };
+// Usage error when a limit names a metric that has no threshold or that `setup` does not measure (with how to
+// turn it on).
+Status check_threshold_setup(const ComparisonSetup& setup, const Thresholds& thresholds);
 std::vector<ThresholdFailure> check_thresholds(const ComparisonReport& report, const Thresholds& thresholds);
 
-// --- Outputs (written atomically: temporary file, then rename) --------------------------------------------
+// --- Shards ---------------------------------------------------------------------------------------------------
+
+// Reads a CSV written by write_comparison_csv back into a report (per-frame values exactly as computed; the
+// inputs' metadata is not in the CSV). Input error for a file that is not such a CSV.
+Expected<ComparisonReport> read_comparison_csv(const std::string& path);
+// Joins per-shard reports of one comparison (same metrics, same sequences in the same order, disjoint frame
+// ranges) into one, frames in order. `names` (the shards' files) are for messages and the merged report's
+// `reference`. The merged summaries equal a single run's exactly (docs/compare.md, "Shards").
+Expected<ComparisonReport> merge_comparisons(const std::vector<ComparisonReport>& parts,
+                                            const std::vector<std::string>& names = {});
+// read_comparison_csv of each file, merge_comparisons, and the summary settings of `setup` (warm-up, bootstrap).
+Expected<ComparisonReport> merge_comparison_csvs(const std::vector<std::string>& csvs, const ComparisonSetup& setup);
+
+// --- Outputs (written atomically: temporary file, then rename) ---------------------------------------------
 
 // One row per frame and test sequence; infinite PSNR is written `inf`, missing values are empty fields.
 Status write_comparison_csv(const ComparisonReport& report, const std::string& path);

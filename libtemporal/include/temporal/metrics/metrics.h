@@ -10,6 +10,8 @@
 // a peak value `peak` in the same units; SSIM is unitless in [-1, 1].
 #pragma once
 
+#include "temporal/core/fwd.h"
+
 #include "temporal/core/error.h"
 
 #include <cstddef>
@@ -22,7 +24,6 @@
 
 namespace temporal {
 
-class Image;
 
 // --- Channel selection ------------------------------------------------------------------------------------
 

@@ -70,7 +70,8 @@ void cells_to_vertices(const SnappedGrid& grid, std::span<const float> cell_valu
 
 // What GridRasterizer::draw samples and writes.
 struct GridRaster {
-  // Source planes sampled bilinearly at the interpolated texture coordinate (width x height each).
+  // Source planes sampled at the interpolated texture coordinate (width x height each) with the bilinear fetch of
+  // temporal/core/reproject.h (edge taps repeated).
   std::span<const float* const> source;
   // Destination planes, one per source plane.
   std::span<float* const> target;
@@ -88,7 +89,7 @@ struct GridRaster {
   // pixels get attr_uncovered, as if uncovered. Saves drawing the whole grid for a sparse attribute.
   bool cull_zero_attributes = false;
   // Source depth (linear view depth, smaller is nearer), looked up at the nearest source pixel of every
-  // fragment for the depth test; nullptr disables the test (the last triangle drawn wins).
+  // fragment (reproject::nearest) for the depth test; nullptr disables the test (the last triangle drawn wins).
   const float* source_depth = nullptr;
 };
 

@@ -33,7 +33,8 @@ struct HoldBlurOptions {
 // Perceived image of frames[0] (the window frames[0 .. W-1]; fewer at the end of a sequence are accepted and
 // averaged over what is given). `channels` are float channels present in every frame; motion_x/motion_y are
 // the display-rate motion planes of frames[0]'s scene (width x height). Sampling is bilinear, clamped at the
-// image border. Errors: no frame, mismatched sizes, missing channels.
+// image border (the bilinear fetch of temporal/core/reproject.h). Errors: no frame, mismatched sizes, missing
+// channels.
 Expected<Image> perceive_hold(std::span<const Image* const> frames, const std::vector<std::string>& channels,
                               const float* motion_x, const float* motion_y, const HoldBlurOptions& options = {});
 

@@ -7,35 +7,40 @@
 // (n + k/factor) / fps. Slot 0 is the rendered frame itself (with `didyk`: high-frequency compensated),
 // slots k >= 1 are extrapolated from frame n and its motion, with no added latency (except `blend`).
 //
-// Methods (docs/morph-120hz.md has the details and every choice the paper leaves open):
-//  - Didyk:  snapped grid morph + depth test + selective blur + high-frequency compensation (sections 5-6).
-//  - Repeat: every slot shows frame n (a 40 Hz stream on a 120 Hz hold-type display).
-//  - Blend:  slot k = (1 - k/N) frame n + (k/N) frame n+1 in linear light; needs frame n+1, so it adds one
+// Methods are units listed in one registry (temporal/morph/methods.h: name, what each reads, its parameters and
+// latency, its factory); docs/morph-120hz.md has the details and every choice the paper leaves open:
+//  - didyk:  snapped grid morph + depth test + selective blur + high-frequency compensation (sections 5-6).
+//  - repeat: every slot shows frame n (a 40 Hz stream on a 120 Hz hold-type display).
+//  - blend:  slot k = (1 - k/N) frame n + (k/N) frame n+1 in linear light; needs frame n+1, so it adds one
 //            rendered frame of latency (the last frame, without a successor, is repeated).
-//  - Warp:   per-pixel forward warp of frame n with a depth test, holes left black (no hole filling).
+//  - warp:   per-pixel forward warp of frame n with a depth test, holes left black (no hole filling).
+// The sequence tool around them (frame numbering, fps, NaN policy, --perceive) is temporal/morph/morph_stage.h.
 #pragma once
 
 #include "temporal/core/error.h"
 #include "temporal/morph/grid_warp.h"
 #include "temporal/core/image.h"
+#include "temporal/core/viewing.h"  // pixels_per_degree (eye-tracking limit)
 #include "temporal/morph/blur_pyramid.h"
 
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
 
 namespace temporal {
 
-enum class MorphMethod { Didyk, Repeat, Blend, Warp };
-Expected<MorphMethod> parse_morph_method(const std::string& name);
-const char* morph_method_name(MorphMethod method);
+class MorphMethod;       // temporal/morph/methods.h
+struct MorphMethodInfo;  // temporal/morph/methods.h
 
+// The options of every method; each method reads the fields it needs (its parameters, methods.h).
 struct MorphOptions {
-  MorphMethod method = MorphMethod::Didyk;
+  std::string method = "didyk";  // a name of the registry, morph_methods() (temporal/morph/methods.h)
   int factor = 3;             // displayed frames per rendered frame, >= 2 (40 Hz -> 120 Hz: 3)
   float gamma = 2.2f;         // display gamma g: displayed light = value^g, value in [0, 1]
-  GridOptions grid;           // cell size, snapping, eye-tracking limit (pixels per degree, fps)
+  GridOptions grid;           // cell size, snapping, eye-tracking limit (pixels per degree and fps: the sequence
+                              // stage sets them from ViewingOptions and the input's rate, morph_stage.h)
   float blur_level = 2.0f;    // pyramid level read for the low-pass layer L (fractional allowed)
   // Smooth-step from cell distortion to blur strength of the in-between frames: 0 below distortion_low,
   // 1 above distortion_high (section 5.1, "Selective Blur").
@@ -45,6 +50,14 @@ struct MorphOptions {
   bool compensate = true;     // high-frequency compensation of the rendered frame (section 5.1)
   bool debug_layers = false;  // add debug.grid, debug.distortion, debug.blur, debug.H, debug.Hprime
 };
+
+// Usage error unless the options are valid for any input: a known method, factor >= 2, a grid cell that is a
+// power of two in [2, 32], gamma > 0, blur level in [0, 8]. Morpher::process checks them too.
+Status check_morph_options(const MorphOptions& options);
+
+// The debug layers every output carries with MorphOptions::debug_layers (zero where a method has nothing to show).
+inline constexpr const char* kMorphDebugLayers[5] = {"debug.grid", "debug.distortion", "debug.blur", "debug.H",
+                                                     "debug.Hprime"};
 
 // Milliseconds spent per stage for one rendered frame (all its in-between frames), seed 004 Table 1.
 struct MorphTimings {
@@ -76,36 +89,31 @@ struct CompensatedValue {
 // Values outside [0, 1] are passed through (top = low = original).
 CompensatedValue compensate_value(float original, float low, float blurred, float gamma);
 
-// Pixels per degree of visual angle of a screen `screen_width_m` wide showing `pixels_x` pixels across, seen
-// from `distance_m` (at the screen centre).
-float pixels_per_degree(float screen_width_m, float distance_m, int pixels_x);
-
 // Upsamples rendered frames one at a time. Full-resolution scratch buffers are kept between calls (no
 // per-pixel allocation; only grid-sized vectors are rebuilt per frame).
 class Morpher {
  public:
   explicit Morpher(MorphOptions options);
+  ~Morpher();
+  Morpher(Morpher&&) noexcept;
+  Morpher& operator=(Morpher&&) noexcept;
   const MorphOptions& options() const { return options_; }
 
-  // color: R,G,B (float, scene-linear) of rendered frame n; gbuffer: motion.X, motion.Y, depth.Z of frame n
-  // (Didyk and Warp; Repeat and Blend ignore it and accept nullptr); next: colour of frame n+1 (Blend only;
-  // nullptr repeats). Writes `factor` images (R,G,B and, with debug_layers, the debug layers) into `out`,
-  // slot k = out[k]. Metadata is left to the caller. Errors: missing channels, mismatched sizes, factor < 2.
+  // color: R,G,B (float, scene-linear) of rendered frame n; gbuffer: the layers the method reads (its registry
+  // entry: motion.X, motion.Y, depth.Z for didyk and warp; repeat and blend accept nullptr); next: colour of
+  // frame n+1 (methods with lookahead, blend; nullptr repeats, others ignore it). Writes `factor` images (R,G,B
+  // and, with debug_layers, the debug layers) into `out`, slot k = out[k]. Metadata is left to the caller.
+  // Values must be finite (the sequence stage replaces NaN/Inf by 0). Errors: unknown method, missing
+  // channels, mismatched sizes, factor < 2.
   Status process(const Image& color, const Image* gbuffer, const Image* next, std::vector<Image>& out,
                  MorphTimings* timings = nullptr);
 
  private:
   Status check(const Image& color, const Image* gbuffer, const Image* next) const;
-  void run_didyk(const Image& color, const Image& gbuffer, std::vector<Image>& out, MorphTimings& t);
-  void run_warp(const Image& color, const Image& gbuffer, std::vector<Image>& out);
 
   MorphOptions options_;
-  GridBuilder grid_builder_;
-  GridRasterizer rasterizer_;
-  BlurPyramid pyramid_;
-  SnappedGrid grid_;
-  std::vector<std::vector<float>> planes_;  // reusable full-resolution scratch planes
-  std::vector<std::uint64_t> warp_buffer_;
+  const MorphMethodInfo* info_ = nullptr;  // registry entry of options_.method (set on first use)
+  std::unique_ptr<MorphMethod> method_;    // its state (buffers kept between frames)
 };
 
 }  // namespace temporal

@@ -1,13 +1,14 @@
 // The plain exponential history buffer of seed 003 eq. 1, with reprojection and G-buffer rejection:
 //   h(t) = alpha h(t-1)(p + motion) + (1 - alpha) y(t)
-// alpha is the history weight. The history is fetched bilinearly at p + motion; it is rejected (h = y) when
-// that position is off-screen, when the material id at the nearest previous pixel differs from the current
-// one, or when the previous depth there differs from the current depth by more than `depth_tolerance`
-// (relative). Without G-buffer data only the off-screen test applies. NaN/Inf input never enters h: such a
-// pixel keeps (outputs) its reprojected history.
+// alpha is the history weight. The history is fetched at p + motion with the shared reprojection rules
+// (temporal/core/reproject.h): bilinear, each tap kept only when it is the same surface (material id and depth
+// within `depth_tolerance` of the larger depth); it is rejected (h = y) when the position is off screen or no tap
+// survives. Without G-buffer depth and ids only the off-screen rule applies. NaN/Inf input never enters h: such
+// a pixel keeps (outputs) its reprojected history.
 #pragma once
 
 #include "temporal/core/error.h"
+#include "temporal/core/reproject.h"
 #include "temporal/phlm/frame_filter.h"
 #include "temporal/core/image.h"
 
@@ -19,19 +20,20 @@ namespace temporal {
 
 struct EmaParams {
   float alpha = 0.9f;            // history weight of eq. 1
-  float depth_tolerance = 0.05f; // |d_prev - d| / d above this rejects the history
+  float depth_tolerance = reproject::kDepthTolerance;  // relative depth difference of the disocclusion test
 };
 
-class EmaFilter {
+class EmaFilter final : public FrameFilter {
  public:
   explicit EmaFilter(EmaParams params = {});
 
   // Filters one frame; `debug.reject` (1 where the history was rejected) is added when in.debug.
-  Status process(const FilterInput& in, Image& output, FilterStats* stats = nullptr);
+  Status process(const FilterInput& in, Image& output, FilterStats* stats = nullptr) override;
 
   // History `history.<c>` plus the previous frame's `history.depth` and `history.id` (when given).
   const Image& state() const { return history_; }
-  Status set_state(const Image& state, int channels);
+  Status set_state(const Image& state, int channels) override;
+  Image saved_state() const override { return history_; }
   static std::vector<std::string> state_channel_names(int channels);
 
  private:

@@ -1,5 +1,5 @@
-// What the temporal filters of `filter-phlm` (PHLM, TAA, EMA, FXAA) receive for one frame, and what they
-// report back. Shared by temporal/phlm/phlm.h, taa.h, ema.h and fxaa.h.
+// What the filters of `filter-phlm` receive for one frame (FilterInput), what they report (FilterStats) and the
+// interface every filter implements (FrameFilter). The registry of methods is temporal/phlm/filters.h.
 #pragma once
 
 #include "temporal/core/error.h"
@@ -45,5 +45,22 @@ struct FilterStats {
 // Checks that `in` is usable: a colour image with the named float channels (1 or 3 of them). Input error
 // naming the missing channel otherwise.
 Status validate_filter_input(const FilterInput& in);
+
+// A temporal (or spatial) filter of one frame at a time. Implementations keep their state between calls: pass the
+// same `output` image every frame to avoid allocations.
+class FrameFilter {
+ public:
+  virtual ~FrameFilter() = default;
+  // Filters one frame into `output` (same size; channels named like the input's; debug.* planes when in.debug).
+  virtual Status process(const FilterInput& in, Image& output, FilterStats* stats = nullptr) = 0;
+  // Persistent state for --state-out / --state-in (spatial filters have none).
+  virtual bool has_state() const { return true; }
+  // The state after the last frame as named planes, as --state-out writes it; empty before the first frame.
+  virtual Image saved_state() const = 0;
+  // Resumes from a state written by state() (the next frame continues bit for bit). `channels`: 1 or 3.
+  virtual Status set_state(const Image& state, int channels) = 0;
+  // Extra text for --verbose after a frame (e.g. PHLM's largest trace(P)); empty when none.
+  virtual std::string stats_text(const FilterStats& stats) const { return {}; }
+};
 
 }  // namespace temporal

@@ -7,7 +7,7 @@
 //
 // Luma: FXAA works on perceptual luma; for scene-linear input it is sqrt of the Rec. 709 luminance of values
 // clamped to [0, 1] (Lottes suggests luma in gamma space, and sqrt is the usual gamma-2 estimate).
-// NaN/Inf pixels are counted and passed through unchanged.
+// NaN/Inf pixels are counted and replaced by the mean of their finite 4-neighbours (0 when none is finite).
 #pragma once
 
 #include "temporal/core/error.h"
@@ -25,5 +25,22 @@ struct FxaaParams {
 // Antialiases one frame (`in.channels`; 1 or 3). `debug.edge` (1 where an edge was processed) is added when
 // in.debug.
 Status fxaa(const FilterInput& in, Image& output, const FxaaParams& params = {}, FilterStats* stats = nullptr);
+
+// fxaa() as a FrameFilter: spatial, no state.
+class FxaaFilter final : public FrameFilter {
+ public:
+  explicit FxaaFilter(FxaaParams params = {}) : params_(params) {}
+  Status process(const FilterInput& in, Image& output, FilterStats* stats = nullptr) override {
+    return fxaa(in, output, params_, stats);
+  }
+  bool has_state() const override { return false; }
+  Image saved_state() const override { return {}; }
+  Status set_state(const Image&, int) override {
+    return Error::usage("--method fxaa is spatial and has no state: drop --state-in / --state-out");
+  }
+
+ private:
+  FxaaParams params_;
+};
 
 }  // namespace temporal

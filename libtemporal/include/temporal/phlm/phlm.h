@@ -41,7 +41,7 @@ constexpr int phlm_state_floats(int channels) {
   return channels * n + n * (n + 1) / 2 + channels + 1;
 }
 
-class PhlmFilter {
+class PhlmFilter final : public FrameFilter {
  public:
   explicit PhlmFilter(PhlmParams params = {});
 
@@ -52,7 +52,7 @@ class PhlmFilter {
   // kept, 1 reset to input: off-screen/first frame/cut, 2 reset by the box test), debug.traceP).
   // The first frame after construction (or after a size or channel change) resets every model.
   // `output` is reused between calls: pass the same Image every frame to avoid allocations.
-  Status process(const FilterInput& in, Image& output, FilterStats* stats = nullptr);
+  Status process(const FilterInput& in, Image& output, FilterStats* stats = nullptr) override;
 
   // The models after the last frame, as an image of named planes (written by --state-out):
   //   beta.<c><k>  (c = channel suffix R, G, B or Y; k = 0..N-1: intercept then slopes)
@@ -63,7 +63,10 @@ class PhlmFilter {
   Image state_with_covariance() const;
   // Resumes from a state written by state(): the next frame continues the same models (the output is bit
   // for bit what an uninterrupted run gives). Input error when planes are missing or not finite.
-  Status set_state(const Image& state, int channels);
+  Status set_state(const Image& state, int channels) override;
+  // What --state-out writes: state_with_covariance().
+  Image saved_state() const override { return state_with_covariance(); }
+  std::string stats_text(const FilterStats& stats) const override;
 
   // Names of the state planes for C channels.
   static std::vector<std::string> state_channel_names(int channels);

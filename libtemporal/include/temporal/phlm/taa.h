@@ -30,17 +30,18 @@ struct TaaParams {
   float filter_sharpness = 2.29f; // Blackman-Harris approximation exp(-k d^2)
 };
 
-class TaaFilter {
+class TaaFilter final : public FrameFilter {
  public:
   explicit TaaFilter(TaaParams params = {});
 
   // Filters one frame; `debug.clip` (1 where the history was clipped) and `debug.noHistory` (1 off-screen or
   // reset) are added when in.debug.
-  Status process(const FilterInput& in, Image& output, FilterStats* stats = nullptr);
+  Status process(const FilterInput& in, Image& output, FilterStats* stats = nullptr) override;
 
   // History (the last output), planes `history.<c>`, for --state-out / --state-in.
   const Image& state() const { return history_; }
-  Status set_state(const Image& state, int channels);
+  Status set_state(const Image& state, int channels) override;
+  Image saved_state() const override { return history_; }
   static std::vector<std::string> state_channel_names(int channels);
 
  private:

@@ -75,9 +75,10 @@ class VirtualDisplay {
   bool had_previous_ = false;
 };
 
-// The charts of `--plot F.png`: the file name and the chart. F.png: per-frame PSNR (RGB); F-psnr-y.png,
-// F-ssim.png, F-flicker.png: the other per-frame metrics (flicker only when there are two frames or more);
-// F-speed.png: mean PSNR against mean compute time, when any test header has timings.
+// The charts of `--plot F.png`: the file name and the chart. One per measured metric, as its registry entry
+// names it (temporal/metrics/comparison.h): F.png per-frame PSNR (RGB); F-psnr-y.png, F-ssim.png,
+// F-flicker.png (only when there are two frames or more), F-flip.png with --flip; F-speed.png: mean PSNR against
+// mean compute time, when any test header has timings.
 std::vector<std::pair<std::string, Chart>> comparison_charts(const ComparisonReport& report,
                                                              const std::string& plot_path);
 

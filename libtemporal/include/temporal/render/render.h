@@ -72,11 +72,14 @@ struct PayloadOptions {
 
 // Sets the terms of `base` from "direct,shadow,ssao,gi" (any subset, any order, at least one).
 Expected<PayloadOptions> parse_payload_terms(const std::string& list, PayloadOptions base = {});
+// The enabled terms as parse_payload_terms reads them ("direct,shadow,ssao,gi").
+std::string payload_terms_string(const PayloadOptions& payload);
 
 struct RenderOutputs {
   bool gbuffer = true, shade = true, reference = true, color = true;
   // "gbuffer,shade,reference,color" (any subset, at least one).
   static Expected<RenderOutputs> parse(const std::string& list);
+  std::string to_string() const;
 };
 
 struct RenderOptions {
@@ -100,13 +103,24 @@ struct RenderOptions {
 // Checks sizes, factor and payload settings without touching OpenGL (Usage errors naming the option).
 Status validate(const RenderOptions& options);
 
+// Command-line forms of RenderOptions fields: "WIDTHxHEIGHT" and the shade mip bias ("auto" or a number).
+Status parse_size(const std::string& text, RenderOptions& options);
+std::string size_string(const RenderOptions& options);
+Status parse_shade_mip_bias(const std::string& text, RenderOptions& options);
+std::string shade_mip_bias_string(const RenderOptions& options);
+
 // The static part of a scene: what Scene::load returns (tests build it by hand).
 struct SceneGeometry {
   const std::vector<ScenePrimitive>* primitives = nullptr;
   const std::vector<SceneMaterial>* materials = nullptr;
   const std::vector<SceneTexture>* textures = nullptr;
   glm::vec3 bounds_min{-1.0f}, bounds_max{1.0f};  // world-space bounds (SSAO radius, VPL clamp defaults)
+  glm::vec3 ambient{0.0f};  // non-zero: the scene has a uniform environment (USD DomeLight), added to gi as
+                            // albedo (1 - metallic) * FrameState::ambient
 };
+
+// The geometry of a loaded scene (it must outlive the renderer).
+SceneGeometry geometry_of(const Scene& scene);
 
 struct FrameInput {
   int frame = 0;

@@ -1,14 +1,18 @@
-// Animated glTF 2.0 scenes, evaluated on the CPU at any time t.
+// Animated scenes (glTF 2.0 and text USD), evaluated on the CPU at any time t.
 //
-// A Scene is loaded once (tinygltf) and validated; evaluate(t) returns everything a rasteriser needs for
-// that instant: one PrimitiveInstance per drawn glTF primitive (in the same order at every t, so two
-// evaluations can be paired index by index for motion vectors), the camera and the lights.
-// Only what a primitive needs is computed: rigid primitives carry a model matrix and share their rest-pose
-// vertex buffers; only skinned or morphed primitives get deformed world-space vertices (CPU skinning,
-// glTF 2.0 section 3.7.3, and morph targets, section 3.7.2.2).
+// A Scene is loaded once and validated: Scene::load recognises the format by the file's content (a glTF
+// JSON document or .glb magic, or a `#usda 1.0` text layer; binary USD crate files are refused with a
+// message saying how to convert them), and each reader fills one format-neutral description
+// (docs/scenes.md, docs/usd.md). evaluate(t) returns everything a rasteriser needs for that instant: one
+// PrimitiveInstance per drawn primitive (in the same order at every t, so two evaluations can be paired index
+// by index for motion vectors), the camera and the lights. Only what a primitive needs is computed: rigid
+// primitives carry a model matrix and share their rest-pose vertex buffers; only skinned, morphed or
+// point-cached primitives get deformed world-space vertices (CPU linear blend skinning and morph targets /
+// blend shapes).
 #pragma once
 
 #include "temporal/core/error.h"
+#include "temporal/core/sequence.h"
 
 #include <glm/mat4x4.hpp>
 #include <glm/vec2.hpp>
@@ -25,8 +29,9 @@ namespace temporal {
 struct SceneTexture {
   int width = 0;
   int height = 0;
-  std::vector<std::uint8_t> rgba8;  // row 0 is the top row of the image (glTF UV v = 0 is the top)
-  bool srgb = true;                 // base colour textures are sRGB-encoded
+  std::vector<std::uint8_t> rgba8;  // row 0 is the top row of the image (glTF UV v = 0 is the top; USD
+                                    // readers flip st.t so that the same convention holds)
+  bool srgb = true;                 // base colour textures are sRGB-encoded (USD: unless sourceColorSpace "raw")
   bool repeat_s = true, repeat_t = true;
   bool mirror_s = false, mirror_t = false;
   bool nearest = false;             // magnification filter NEAREST
@@ -46,28 +51,29 @@ struct SceneMaterial {
   bool double_sided = false;
 };
 
-// Rest-pose geometry of one glTF primitive (triangles only; strips and fans are converted on load).
+// Rest-pose geometry of one drawn primitive (triangles only: glTF strips and fans and USD polygons are
+// triangulated on load).
 struct ScenePrimitive {
   std::vector<glm::vec3> positions;  // object space
   std::vector<glm::vec3> normals;    // object space; generated (flat) when the file has none
-  std::vector<glm::vec2> texcoords;  // TEXCOORD_n of the material's base colour texture (normally TEXCOORD_0),
-                                     // empty when absent
+  std::vector<glm::vec2> texcoords;  // TEXCOORD_n of the material's base colour texture (normally TEXCOORD_0;
+                                     // USD: primvars:st with t flipped to 1 - t), empty when absent
   std::vector<std::uint32_t> indices;
   int material = -1;                 // index into Scene::materials(); after load never -1: primitives without
                                      // a material get a "default" one appended to Scene::materials()
-  bool skinned = false;              // has JOINTS_0/WEIGHTS_0 and its node has a skin
-  bool morphed = false;              // has morph targets
+  bool skinned = false;              // has joint influences (JOINTS_0/WEIGHTS_0, UsdSkel) and a skin
+  bool morphed = false;              // has morph targets (glTF) or blend shapes (UsdSkel)
 };
 
 // One drawn primitive at one instant.
 struct PrimitiveInstance {
   int primitive = -1;                // index into Scene::primitives()
-  int node = -1;                     // glTF node that draws it
+  int node = -1;                     // node that draws it (glTF: the node index; USD: in prim traversal order)
   std::uint32_t id = 0;              // material id + 1 (0 is the background, docs/conventions.md)
   glm::mat4 model{1.0f};             // object to world (rigid primitives)
   bool deformed = false;             // true: use the world-space vertices below instead of model
-  std::vector<glm::vec3> world_positions;  // skinned/morphed only, world space
-  std::vector<glm::vec3> world_normals;    // skinned/morphed only, world space, normalised
+  std::vector<glm::vec3> world_positions;  // deformed only, world space
+  std::vector<glm::vec3> world_normals;    // deformed only, world space, normalised
 };
 
 struct CameraState {
@@ -84,7 +90,8 @@ struct LightState {
   glm::vec3 position{0.0f};          // world space (point, spot)
   glm::vec3 direction{0.0f, -1.0f, 0.0f};  // world space, direction the light travels (directional, spot)
   glm::vec3 color{1.0f};
-  float intensity = 1.0f;            // KHR_lights_punctual units (lux for directional, candela otherwise)
+  float intensity = 1.0f;            // KHR_lights_punctual units (lux for directional, candela otherwise;
+                                     // docs/usd.md gives the UsdLux conversion)
   float range = 0.0f;                // 0: infinite
   float inner_cone = 0.0f, outer_cone = 0.785398f;
 };
@@ -95,42 +102,61 @@ struct FrameState {
   CameraState camera;
   std::vector<LightState> lights;    // never empty: an automatic key light when the scene has none (directional,
                                      // white, intensity pi, from above and behind the camera's left at t = 0)
+  glm::vec3 ambient{0.0f};           // radiance of a uniform environment light (USD DomeLight), 0 for glTF
 };
 
 // How the camera is chosen and moved.
 struct CameraOptions {
-  std::string camera;                // glTF camera name or index; empty: the first perspective camera, or an
-                                     // automatic one. Orthographic cameras are refused (Usage error) and skipped
-                                     // when choosing the first camera.
+  std::string camera;                // camera name or index (USD: prim name or path); empty: the first
+                                     // perspective camera, or an automatic one. Orthographic cameras are
+                                     // refused (Usage error) and skipped when choosing the first camera.
   enum class Path { Fixed, Orbit, Dolly } path = Path::Fixed;  // a path forces the automatic camera
-  double path_period_s = 8.0;        // orbit: seconds per turn; dolly: seconds per back-and-forth
+  double path_period_s = 8.0;        // orbit: seconds per turn; dolly: seconds per back-and-forth (> 0)
   // The automatic camera frames the bounding sphere at t = 0 (yfov 0.8 rad) from direction (0.45, 0.35, 1)
   // of its centre; orbit turns it about the vertical axis through the centre, dolly moves it along its view
   // direction between 100 % and 65 % of the framing distance (cosine ease).
 };
 
+// "fixed", "orbit", "dolly" (render-gbuffer --camera-path).
+Expected<CameraOptions::Path> parse_camera_path(const std::string& text);
+const char* camera_path_name(CameraOptions::Path path);
+
 struct SceneLoadOptions {
-  std::string clip;                  // animation name or index; empty: the first animation (if any);
-                                     // "all": every animation of the file at once
+  std::string clip;                  // glTF animation name or index; empty: the first animation (if any);
+                                     // "all": every animation of the file at once. USD scenes have one
+                                     // timeline: only empty or "all" are accepted.
   CameraOptions camera;
 };
 
 class Scene {
  public:
-  // Loads .gltf or .glb. Errors (Input) name the file and what is wrong: malformed JSON, missing buffer or
-  // image, accessor out of range, unsupported required extension (named), no triangles to draw.
+  // Loads a glTF 2.0 (.gltf, .glb) or text USD (.usda, or .usd holding text) scene, recognised by its
+  // content. Errors (Input) name the file and what is wrong: malformed JSON, missing buffer or image,
+  // accessor out of range, unsupported required extension (named), `file:line:column: ...` for malformed
+  // USD text, an unresolvable USD reference, a crate (.usdc/.usdz) file, no triangles to draw.
   static Expected<Scene> load(const std::string& path, const SceneLoadOptions& options = {});
 
-  const std::vector<ScenePrimitive>& primitives() const { return primitives_; }
-  const std::vector<SceneMaterial>& materials() const { return materials_; }
-  const std::vector<SceneTexture>& textures() const { return textures_; }
+  const std::vector<ScenePrimitive>& primitives() const;
+  const std::vector<SceneMaterial>& materials() const;
+  const std::vector<SceneTexture>& textures() const;
   // Axis-aligned bounds of the scene in its rest pose at t = 0, world space.
-  glm::vec3 bounds_min() const { return bounds_min_; }
-  glm::vec3 bounds_max() const { return bounds_max_; }
-  // Duration of the selected animation clip in seconds (0 when static).
-  double clip_duration() const { return clip_duration_; }
+  glm::vec3 bounds_min() const;
+  glm::vec3 bounds_max() const;
+  // Duration of the selected animation clip in seconds (0 when static). USD: the stage's timeline,
+  // (endTimeCode - startTimeCode) / timeCodesPerSecond + 1 / framesPerSecond (the last frame is held for
+  // one frame), 0 when nothing is time-sampled.
+  double clip_duration() const;
   std::vector<std::string> clip_names() const;
   std::vector<std::string> camera_names() const;
+  // "glTF 2.0" or "USD".
+  const std::string& format() const;
+  // Radiance of a uniform environment light (USD DomeLight: intensity * 2^exposure * color); 0 for glTF.
+  glm::vec3 ambient() const;
+
+  // The frames render-gbuffer replays when no --frames are given: 0 .. ceil(S * fps) - 1 for S =
+  // duration_s when positive, else the clip's duration, else one camera-path period when a path is set;
+  // a static scene gives frame 0 only.
+  FrameRange default_frames(double fps, double duration_s = 0.0) const;
 
   // The scene at time t (seconds; animation time wraps at the clip's end, so sequences can run longer).
   // Thread-safe: const and allocation-local.
@@ -149,13 +175,9 @@ class Scene {
 
  private:
   static Expected<Scene> load_checked(const std::string& path, const SceneLoadOptions& options);
-  struct Impl;  // nodes, skins, animation samplers: see src/scene/scene_impl.h
+  Status finish(const SceneLoadOptions& options);  // bounds, camera and key light (scene_finish.cpp)
+  struct Impl;  // the format-neutral description and evaluation state: src/scene/scene_description.h
   std::unique_ptr<Impl> impl_;
-  std::vector<ScenePrimitive> primitives_;
-  std::vector<SceneMaterial> materials_;
-  std::vector<SceneTexture> textures_;
-  glm::vec3 bounds_min_{0.0f}, bounds_max_{0.0f};
-  double clip_duration_ = 0.0;
 };
 
 }  // namespace temporal

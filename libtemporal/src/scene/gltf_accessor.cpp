@@ -1,5 +1,5 @@
-// Bounds-checked accessor reads; see accessor.h.
-#include "accessor.h"
+// Bounds-checked glTF accessor reads; see gltf_accessor.h.
+#include "gltf_accessor.h"
 
 #include <algorithm>
 #include <cstring>

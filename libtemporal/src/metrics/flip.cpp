@@ -1,0 +1,874 @@
+// FLIP and HDR-FLIP (temporal/metrics/flip.h). The header gives the definitions and the paper steps; this file
+// explains the implementation choices.
+//
+// Layout of the work, per image: (1+2) one horizontal pass: each row goes to YyCxCz (exposure and tone mapping
+// for HDR-FLIP, sRGB decoding for LDR inputs) in a row buffer and all seven 1-D filters a row needs run on it
+// (CSF of Y, Cx, the two Gaussians of Cz, and the feature Gaussian with its two derivatives); (3) two vertical
+// passes over tiles finish the 2-D filters and turn them, strip by strip, into the five per-pixel quantities the
+// comparison needs (Hunt-adjusted CIELab, edge and point magnitudes). The test and the reference go through
+// them separately, so a reference could be kept for several tests; (4) a point-wise pass combines the two into
+// the FLIP map. Every pass is parallel (rows, tiles or chunks); the filters work on strips of kStrip pixels whose
+// accumulators stay in vector registers.
+#include "temporal/metrics/flip.h"
+
+#include "fast_math.h"
+#include "temporal/core/parallel.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <numbers>
+#include <string>
+
+namespace temporal {
+namespace flip {
+namespace {
+
+// D65 white of the reference's colour transforms, and its inverse (the reference's constants, 9 digits).
+constexpr Color kWhite = {0.950428545f, 1.0f, 1.088900371f};
+constexpr Color kInvWhite = {1.052156925f, 1.0f, 0.918357670f};
+// Linear Rec.709 -> XYZ: the exact rationals of the sRGB primaries and D65 white, as the reference has them.
+constexpr float kRgbToXyz[9] = {10135552.0f / 24577794.0f, 8788810.0f / 24577794.0f, 4435075.0f / 24577794.0f,
+                                2613072.0f / 12288897.0f,  8788810.0f / 12288897.0f, 887015.0f / 12288897.0f,
+                                1425312.0f / 73733382.0f,  8788810.0f / 73733382.0f, 70074185.0f / 73733382.0f};
+constexpr float kXyzToRgb[9] = {3.241003275f,  -1.537398934f, -0.498615861f, -0.969224334f, 1.875930071f,
+                                0.041554224f,  0.055639423f,  -0.204011202f, 1.057148933f};
+// CIELab's piecewise cube root: t^(1/3) above (6/29)^3, t / (3 (6/29)^2) + 4/29 below.
+constexpr float kLabDelta = 6.0f / 29.0f;
+constexpr float kLabDeltaCube = kLabDelta * kLabDelta * kLabDelta;
+constexpr float kLabFactor = 1.0f / (3.0f * kLabDelta * kLabDelta);
+constexpr float kLabTerm = 4.0f / 29.0f;
+constexpr float kPi = 3.14159265358979f;  // the reference's float pi (filter sizes depend on its rounding)
+
+// The tone mappers as rational functions (c^2 k0 + c k1 + k2) / (c^2 k3 + c k4 + k5), per channel; Reinhard
+// is handled apart (it divides by the luminance). ACES: Narkowicz's fit with the 0.6 pre-exposure cancelled.
+constexpr float kAces[6] = {0.6f * 0.6f * 2.51f, 0.6f * 0.03f, 0.0f, 0.6f * 0.6f * 2.43f, 0.6f * 0.59f, 0.14f};
+constexpr float kHable[6] = {0.231683f, 0.013791f, 0.0f, 0.18f, 0.3f, 0.018f};
+const float* rational_coefficients(FlipToneMapper t) { return t == FlipToneMapper::Hable ? kHable : kAces; }
+
+inline float clamp01(float v) { return std::min(std::max(v, 0.0f), 1.0f); }
+
+// CIELab from XYZ with a given cube root: the scalar API uses std::pow(t, 1/3) as the reference, the pixel
+// loops fast_math::cbrt.
+template <typename Cbrt>
+inline Color lab_from_xyz(float x, float y, float z, Cbrt cbrt) {
+  auto f = [&](float t) {  // both branches evaluated, then selected: the pixel loops stay branch-free
+    const float root = cbrt(t), linear = kLabFactor * t + kLabTerm;
+    return t > kLabDeltaCube ? root : linear;
+  };
+  const float fx = f(x * kInvWhite[0]), fy = f(y * kInvWhite[1]), fz = f(z * kInvWhite[2]);
+  return {116.0f * fy - 16.0f, 500.0f * (fx - fy), 200.0f * (fy - fz)};
+}
+
+inline float std_cbrt(float t) { return std::pow(t, 1.0f / 3.0f); }
+
+float color_max_distance() {
+  const Color green = hunt_adjust(xyz_to_lab(linear_rgb_to_xyz({0.0f, 1.0f, 0.0f})));
+  const Color blue = hunt_adjust(xyz_to_lab(linear_rgb_to_xyz({0.0f, 0.0f, 1.0f})));
+  return std::pow(hyab(green, blue), kQc);
+}
+
+}  // namespace
+
+float srgb_to_linear(float c) { return c <= 0.04045f ? c / 12.92f : std::pow((c + 0.055f) / 1.055f, 2.4f); }
+
+Color linear_rgb_to_xyz(const Color& c) {
+  const float* m = kRgbToXyz;
+  return {m[0] * c[0] + m[1] * c[1] + m[2] * c[2], m[3] * c[0] + m[4] * c[1] + m[5] * c[2],
+          m[6] * c[0] + m[7] * c[1] + m[8] * c[2]};
+}
+
+Color xyz_to_linear_rgb(const Color& c) {
+  const float* m = kXyzToRgb;
+  return {m[0] * c[0] + m[1] * c[1] + m[2] * c[2], m[3] * c[0] + m[4] * c[1] + m[5] * c[2],
+          m[6] * c[0] + m[7] * c[1] + m[8] * c[2]};
+}
+
+Color xyz_to_ycxcz(const Color& c) {
+  const float x = c[0] * kInvWhite[0], y = c[1] * kInvWhite[1], z = c[2] * kInvWhite[2];
+  return {116.0f * y - 16.0f, 500.0f * (x - y), 200.0f * (y - z)};
+}
+
+Color ycxcz_to_xyz(const Color& c) {
+  const float y = (c[0] + 16.0f) / 116.0f;
+  return {(y + c[1] / 500.0f) * kWhite[0], y * kWhite[1], (y - c[2] / 200.0f) * kWhite[2]};
+}
+
+Color xyz_to_lab(const Color& c) { return lab_from_xyz(c[0], c[1], c[2], std_cbrt); }
+
+Color hunt_adjust(const Color& lab) { return {lab[0], 0.01f * lab[0] * lab[1], 0.01f * lab[0] * lab[2]}; }
+
+float hyab(const Color& p, const Color& q) {
+  return std::fabs(p[0] - q[0]) + std::sqrt((p[1] - q[1]) * (p[1] - q[1]) + (p[2] - q[2]) * (p[2] - q[2]));
+}
+
+float max_color_difference() {
+  static const float cmax = color_max_distance();
+  return cmax;
+}
+
+float remap_color_difference(float distance) {
+  const float cmax = max_color_difference(), knee = kPc * cmax;
+  const float e = std::pow(distance, kQc);
+  return e < knee ? e * (kPt / knee) : kPt + ((e - knee) / (cmax - knee)) * (1.0f - kPt);
+}
+
+float feature_difference(float edge_t, float point_t, float edge_r, float point_r) {
+  const float d = std::max(std::fabs(edge_r - edge_t), std::fabs(point_r - point_t));
+  return std::pow(d * float(1.0 / std::numbers::sqrt2), kQf);
+}
+
+float combine(float color_difference, float feature_diff) { return std::pow(color_difference, 1.0f - feature_diff); }
+
+Color tone_map(FlipToneMapper t, const Color& c) {
+  if (t == FlipToneMapper::Reinhard) {
+    const float s = 1.0f / (1.0f + 0.2126f * c[0] + 0.7152f * c[1] + 0.0722f * c[2]);
+    return {c[0] * s, c[1] * s, c[2] * s};
+  }
+  const float* k = rational_coefficients(t);
+  Color out;
+  for (int i = 0; i < 3; ++i) out[std::size_t(i)] = (c[std::size_t(i)] * c[std::size_t(i)] * k[0] + c[std::size_t(i)] * k[1] + k[2]) /
+                                                    (c[std::size_t(i)] * c[std::size_t(i)] * k[3] + c[std::size_t(i)] * k[4] + k[5]);
+  return out;
+}
+
+int spatial_filter_radius(double ppd) {
+  // The widest of the CSF Gaussians decides (b = 0.04 of Cz): 3 standard deviations, sqrt(b / (2 pi^2)) degrees.
+  float max_b = 0.0f;
+  for (const auto& c : kCsf) max_b = std::max({max_b, c.b1, c.b2});
+  return int(std::ceil(3.0f * std::sqrt(max_b / (2.0f * float(kPi * kPi))) * float(ppd)));
+}
+
+int feature_filter_radius(double ppd) { return int(std::ceil(3.0f * (0.5f * kW * float(ppd)))); }
+
+SpatialFilters spatial_filters(double ppd) {
+  const int r = spatial_filter_radius(ppd);
+  const float dx = 1.0f / float(ppd), pi = kPi, pi2 = float(kPi * kPi);
+  auto gauss = [&](float x2, float a, float b) { return a * std::sqrt(pi / b) * std::exp(-pi2 * x2 / b); };
+  // Cz's kernel is a sum of two Gaussians: each is split into two equal 1-D factors, sqrt(a sqrt(pi/b)) each.
+  auto gauss_sqrt = [&](float x2, float a, float b) { return std::sqrt(a * std::sqrt(pi / b)) * std::exp(-pi2 * x2 / b); };
+  SpatialFilters f;
+  double sum[4] = {};
+  for (int i = -r; i <= r; ++i) {
+    const float x = float(i) * dx, x2 = x * x;
+    f.y.push_back(gauss(x2, kCsf[0].a1, kCsf[0].b1));
+    f.cx.push_back(gauss(x2, kCsf[1].a1, kCsf[1].b1));
+    f.cz1.push_back(gauss_sqrt(x2, kCsf[2].a1, kCsf[2].b1));
+    f.cz2.push_back(gauss_sqrt(x2, kCsf[2].a2, kCsf[2].b2));
+    sum[0] += f.y.back();
+    sum[1] += f.cx.back();
+    sum[2] += f.cz1.back();
+    sum[3] += f.cz2.back();
+  }
+  // The 2-D kernels must sum to 1: y (x) y and cx (x) cx each, and cz1 (x) cz1 + cz2 (x) cz2 together.
+  const double cz_norm = 1.0 / std::sqrt(sum[2] * sum[2] + sum[3] * sum[3]);
+  for (std::size_t i = 0; i < f.y.size(); ++i) {
+    f.y[i] = float(f.y[i] / sum[0]);
+    f.cx[i] = float(f.cx[i] / sum[1]);
+    f.cz1[i] = float(f.cz1[i] * cz_norm);
+    f.cz2[i] = float(f.cz2[i] * cz_norm);
+  }
+  return f;
+}
+
+FeatureFilters feature_filters(double ppd) {
+  const float sigma = 0.5f * kW * float(ppd);
+  const int r = int(std::ceil(3.0f * sigma));
+  FeatureFilters f;
+  double g_sum = 0, dg_pos = 0, dg_neg = 0, ddg_pos = 0, ddg_neg = 0;
+  for (int i = -r; i <= r; ++i) {
+    const float x = float(i);
+    const float g = std::exp(-(x * x) / (2.0f * sigma * sigma));
+    const float dg = -x * g;                                  // d/dx of the Gaussian (up to 1 / sigma^2)
+    const float ddg = (x * x / (sigma * sigma) - 1.0f) * g;  // d^2/dx^2 (up to 1 / sigma^2)
+    f.g.push_back(g);
+    f.dg.push_back(dg);
+    f.ddg.push_back(ddg);
+    g_sum += g;
+    (dg > 0 ? dg_pos : dg_neg) += std::fabs(dg);
+    (ddg > 0 ? ddg_pos : ddg_neg) += std::fabs(ddg);
+  }
+  // Gaussian to sum 1; each derivative kernel to +1 over its positive and -1 over its negative weights.
+  for (std::size_t i = 0; i < f.g.size(); ++i) {
+    f.g[i] = float(f.g[i] / g_sum);
+    f.dg[i] = float(f.dg[i] / (f.dg[i] > 0 ? dg_pos : dg_neg));
+    f.ddg[i] = float(f.ddg[i] / (f.ddg[i] > 0 ? ddg_pos : ddg_neg));
+  }
+  return f;
+}
+
+FlipExposures automatic_exposures(const FlipImage& ref, std::size_t count, FlipToneMapper tone_mapper,
+                                  const std::uint8_t* valid) {
+  // x_max: the input the tone mapper maps to t = 0.85, the larger root of (k0 - t k3) x^2 + (k1 - t k4) x +
+  // (k2 - t k5) = 0 (Reinhard's per-channel form has k = {0, 1, 0, 0, 1, 1}, as in the reference).
+  static constexpr float kReinhard[6] = {0.0f, 1.0f, 0.0f, 0.0f, 1.0f, 1.0f};
+  const float* k = tone_mapper == FlipToneMapper::Reinhard ? kReinhard : rational_coefficients(tone_mapper);
+  const float t = 0.85f;
+  const float a = k[0] - t * k[3], b = k[1] - t * k[4], c = k[2] - t * k[5];
+  float x_max;
+  if (a == 0.0f) {
+    x_max = -c / b;
+  } else {
+    const float d1 = -0.5f * (b / a);
+    x_max = d1 + std::sqrt(d1 * d1 - c / a);
+  }
+  std::vector<float> y(count);
+  float y_max = -std::numeric_limits<float>::infinity();
+  float y_min_positive = std::numeric_limits<float>::infinity();
+  for (std::size_t i = 0; i < count; ++i) {
+    const bool ok = !valid || valid[i];
+    const float v = ok ? 0.2126f * ref.r[i] + 0.7152f * ref.g[i] + 0.0722f * ref.b[i] : 0.0f;
+    y[i] = v;
+    y_max = std::max(y_max, v);
+    if (v > 0.0f) y_min_positive = std::min(y_min_positive, v);
+  }
+  FlipExposures e;
+  if (count == 0 || !(y_max > 0.0f)) {
+    e.count = 2;  // nothing lit: expose by 1 (the tone mapper sees the values as they are)
+    return e;
+  }
+  const std::size_t mid = count / 2;
+  std::nth_element(y.begin(), y.begin() + std::ptrdiff_t(mid), y.end());
+  float y_median = y[mid];
+  if (!(y_median > 0.0f)) y_median = y_min_positive;  // over half the pixels black (see flip.h)
+  e.start = std::log2(x_max / y_max);
+  e.stop = std::log2(x_max / y_median);
+  e.count = int(std::max(2.0f, std::ceil(e.stop - e.start)));
+  return e;
+}
+
+}  // namespace flip
+
+// ---------------------------------------------------------------------------------------------------------
+// Pixel loops
+
+namespace {
+
+using flip::Color;
+constexpr int kStrip = 64;  // pixels per filter strip: 4 AVX-512 (8 AVX2) registers per accumulator
+
+// How the input images become linear RGB in [0, 1] before YyCxCz.
+enum class Prepare { Srgb, Linear, ToneRational, ToneReinhard };
+
+// Plane storage: `margin` replicated rows above and below the image (so vertical filters need no clamping),
+// and kStrip floats of zeroed slack at the end, so strip loops may read (not use) past the last pixel.
+struct Plane {
+  std::vector<float> v;
+  std::size_t width = 0;
+  int margin = 0;
+  void resize(std::size_t w, int h, int m = 0) {
+    width = w;
+    margin = m;
+    v.assign(w * std::size_t(h + 2 * m) + kStrip, 0.0f);
+  }
+  float* data() { return v.data() + std::size_t(margin) * width; }  // row 0
+  const float* data() const { return v.data() + std::size_t(margin) * width; }
+  // Copies row 0 into the margin rows above and row h - 1 into those below.
+  void fill_margins(int h) {
+    for (int r = 1; r <= margin; ++r) {
+      std::memcpy(data() - std::size_t(r) * width, data(), width * sizeof(float));
+      std::memcpy(data() + std::size_t(h - 1 + r) * width, data() + std::size_t(h - 1) * width, width * sizeof(float));
+    }
+  }
+};
+
+// GCC vector types for the filters: with plain loops GCC vectorised the vertical filter across its taps, with
+// gathers, at a tenth of the speed. A strip of kStrip floats is four Vec16 (four AVX-512 registers, or eight
+// AVX2 ones once lowered).
+using Vec16 = float __attribute__((vector_size(64)));
+static_assert(kStrip == 64, "a strip is four Vec16");
+inline Vec16 load16(const float* p) {
+  Vec16 v;
+  std::memcpy(&v, p, sizeof v);
+  return v;
+}
+inline void store16(float* p, const Vec16& v) { std::memcpy(p, &v, sizeof v); }
+
+// Step (1) on `count` pixels: linear RGB in [0, 1] (decoded, or exposed by `scale` and tone-mapped, then
+// clamped) -> YyCxCz, and Yf = (Y + 16) / 116 for the feature filters. Invalid pixels are black. The pixel
+// loops are free functions with restrict parameters: inside the parallel lambdas GCC could not prove that the
+// outputs do not alias the captured pointers; `valid` is a template choice because a load under a null test
+// keeps a loop from vectorising.
+template <Prepare P, bool Valid>
+[[gnu::noinline]] void prepare_span(const float* __restrict R, const float* __restrict G, const float* __restrict Bl,
+                                    const std::uint8_t* __restrict valid, float scale, const float* __restrict k,
+                                    float* __restrict Y, float* __restrict Cx, float* __restrict Cz,
+                                    float* __restrict Yf, std::size_t count) {
+  const float* m = flip::kRgbToXyz;
+  const float k0 = k[0], k1 = k[1], k2 = k[2], k3 = k[3], k4 = k[4], k5 = k[5];
+  for (std::size_t i = 0; i < count; ++i) {
+    bool ok = true;
+    if constexpr (Valid) ok = valid[i] != 0;
+    float c[3] = {ok ? R[i] : 0.0f, ok ? G[i] : 0.0f, ok ? Bl[i] : 0.0f};
+    if constexpr (P == Prepare::Srgb) {
+      for (float& v : c) {
+        const float curve = fast_math::pow((v + 0.055f) / 1.055f, 2.4f), linear = v / 12.92f;
+        v = v <= 0.04045f ? linear : curve;
+      }
+    } else if constexpr (P == Prepare::ToneRational) {
+      for (float& v : c) {
+        v *= scale;
+        v = (v * v * k0 + v * k1 + k2) / (v * v * k3 + v * k4 + k5);
+      }
+    } else if constexpr (P == Prepare::ToneReinhard) {
+      for (float& v : c) v *= scale;
+      const float s = 1.0f / (1.0f + 0.2126f * c[0] + 0.7152f * c[1] + 0.0722f * c[2]);
+      for (float& v : c) v *= s;
+    }
+    for (float& v : c) v = std::min(std::max(v, 0.0f), 1.0f);
+    const float x = (m[0] * c[0] + m[1] * c[1] + m[2] * c[2]) * flip::kInvWhite[0];
+    const float y = (m[3] * c[0] + m[4] * c[1] + m[5] * c[2]) * flip::kInvWhite[1];
+    const float z = (m[6] * c[0] + m[7] * c[1] + m[8] * c[2]) * flip::kInvWhite[2];
+    const float luma = 116.0f * y - 16.0f;
+    Y[i] = luma;
+    Cx[i] = 500.0f * (x - y);
+    Cz[i] = 200.0f * (y - z);
+    Yf[i] = luma * (1.0f / 116.0f) + 16.0f / 116.0f;  // the feature filters' input, Y normalised to [0, 1]
+  }
+}
+
+// Step (1) for one row: the input pointers at the row's first pixel, the outputs where the row goes.
+using PrepareRow = void (*)(const float*, const float*, const float*, const std::uint8_t*, float, const float*,
+                            float*, float*, float*, float*, std::size_t);
+
+PrepareRow prepare_row(Prepare how, bool valid) {
+  switch (how) {
+    case Prepare::Srgb: return valid ? prepare_span<Prepare::Srgb, true> : prepare_span<Prepare::Srgb, false>;
+    case Prepare::Linear: return valid ? prepare_span<Prepare::Linear, true> : prepare_span<Prepare::Linear, false>;
+    case Prepare::ToneRational:
+      return valid ? prepare_span<Prepare::ToneRational, true> : prepare_span<Prepare::ToneRational, false>;
+    case Prepare::ToneReinhard:
+      return valid ? prepare_span<Prepare::ToneReinhard, true> : prepare_span<Prepare::ToneReinhard, false>;
+  }
+  return nullptr;
+}
+
+// Step (3) per pixel of a strip: filtered YyCxCz -> XYZ -> linear RGB clamped to [0, 1] (the reference's order)
+// -> XYZ -> CIELab -> Hunt. Not inlined: in the caller's tile loop GCC loses the restrict guarantees and does
+// not vectorise it.
+[[gnu::noinline]] void lab_span(const float* __restrict fy, const float* __restrict fcx, const float* __restrict fcz1,
+                                const float* __restrict fcz2, float* __restrict L, float* __restrict A,
+                                float* __restrict B, int count) {
+  const float* mi = flip::kXyzToRgb;
+  const float* mf = flip::kRgbToXyz;
+  const auto fast_cbrt = [](float t) { return fast_math::cbrt(t); };
+  for (int i = 0; i < count; ++i) {
+    const float yy = (fy[i] + 16.0f) * (1.0f / 116.0f);
+    const float X = (yy + fcx[i] * (1.0f / 500.0f)) * flip::kWhite[0];
+    const float Yv = yy * flip::kWhite[1];
+    const float Z = (yy - (fcz1[i] + fcz2[i]) * (1.0f / 200.0f)) * flip::kWhite[2];
+    const float r = flip::clamp01(mi[0] * X + mi[1] * Yv + mi[2] * Z);
+    const float g = flip::clamp01(mi[3] * X + mi[4] * Yv + mi[5] * Z);
+    const float b = flip::clamp01(mi[6] * X + mi[7] * Yv + mi[8] * Z);
+    const Color lab = flip::lab_from_xyz(mf[0] * r + mf[1] * g + mf[2] * b, mf[3] * r + mf[4] * g + mf[5] * b,
+                                         mf[6] * r + mf[7] * g + mf[8] * b, fast_cbrt);
+    L[i] = lab[0];
+    A[i] = 0.01f * lab[0] * lab[1];
+    B[i] = 0.01f * lab[0] * lab[2];
+  }
+}
+
+// Edge and point magnitudes from the filtered first and second derivatives.
+[[gnu::noinline]] void feature_span(const float* __restrict dx, const float* __restrict ddx,
+                                    const float* __restrict dy, const float* __restrict ddy, float* __restrict E,
+                                    float* __restrict P, int count) {
+  for (int i = 0; i < count; ++i) {
+    E[i] = std::sqrt(dx[i] * dx[i] + dy[i] * dy[i]);
+    P[i] = std::sqrt(ddx[i] * ddx[i] + ddy[i] * ddy[i]);
+  }
+}
+
+// out_k[i] = sum_t w_k[t] src[t * step + i] for the kStrip pixels of a strip, K outputs from one input (each
+// input vector loaded once for all K): along a row (step 1) or down a column (step = plane width).
+template <int K>
+inline void strip_fir(const float* src, std::ptrdiff_t step, int taps, const float* const (&w)[K],
+                      float* const (&out)[K]) {
+  Vec16 acc[K][4] = {};
+  for (int t = 0; t < taps; ++t) {
+    const float* s = src + std::ptrdiff_t(t) * step;
+    const Vec16 v[4] = {load16(s), load16(s + 16), load16(s + 32), load16(s + 48)};
+    for (int k = 0; k < K; ++k) {
+      const float wt = w[k][t];
+      for (int j = 0; j < 4; ++j) acc[k][j] += wt * v[j];
+    }
+  }
+  for (int k = 0; k < K; ++k)
+    for (int j = 0; j < 4; ++j) store16(out[k] + 16 * j, acc[k][j]);
+}
+
+struct Filters {
+  double ppd = 0.0;
+  int rs = 0, rf = 0;  // radii: spatial (CSF), feature
+  int ry = 0, rcx = 0;  // radii of the Y and Cx kernels once their negligible outer taps are dropped
+  flip::SpatialFilters spatial;
+  flip::FeatureFilters feature;
+
+  void set(double pixels_per_degree) {
+    ppd = pixels_per_degree;
+    rs = flip::spatial_filter_radius(ppd);
+    rf = flip::feature_filter_radius(ppd);
+    spatial = flip::spatial_filters(ppd);
+    feature = flip::feature_filters(ppd);
+    ry = trim(spatial.y);
+    rcx = trim(spatial.cx);
+  }
+
+  // The narrow Y and Cx Gaussians (sigma about 1 pixel at 67 ppd) span the radius of the widest CSF Gaussian
+  // (Cz's, 10 pixels), as in the reference. Their outer taps below 2^-24 of the centre tap move a filtered value
+  // by less than its own float rounding, so they are dropped (after the normalisation over all taps): 11 and 13
+  // taps instead of 21 at 67 ppd.
+  static int trim(std::vector<float>& taps) {
+    int r = int(taps.size() / 2);
+    const float limit = taps[std::size_t(r)] * 0x1p-24f;
+    while (r > 0 && taps.front() < limit && taps.back() < limit) {
+      taps.erase(taps.begin());
+      taps.pop_back();
+      --r;
+    }
+    return r;
+  }
+};
+
+// The seven horizontal outputs and the five per-image quantities.
+enum { kHY, kHCx, kHCz1, kHCz2, kHG, kHDG, kHDDG, kHorizontal };
+enum { kL, kA, kB, kEdge, kPoint, kProducts };
+
+// Steps (1) and (2): each row goes to YyCxCz (and Yf, Y normalised to [0, 1] for the feature filters) in row
+// buffers extended by `margin` pixels on both sides with the edge values (the reference's clamped borders), and
+// every 1-D horizontal filter runs on those buffers. The outputs' margin rows are filled afterwards, for the
+// vertical filters. Preparing rows here rather than in a pass of its own saves writing and reading four planes.
+struct RowInput {
+  const FlipImage* image;
+  const std::uint8_t* valid;
+  PrepareRow prepare;
+  float scale;
+  const float* k;
+};
+
+void horizontal_pass(const RowInput& in, int w, int h, const Filters& f, Plane (&out)[kHorizontal]) {
+  parallel_rows(h, [&](int y0, int y1) {
+    const int margin = std::max(f.rs, f.rf);
+    const std::size_t len = std::size_t(w + 2 * margin + kStrip);
+    std::vector<float> rows(4 * len);
+    float* const buf[4] = {rows.data(), rows.data() + len, rows.data() + 2 * len, rows.data() + 3 * len};  // Y Cx Cz Yf
+    alignas(64) float sink[kHorizontal][kStrip];  // the last strip's overhang
+    for (int y = y0; y < y1; ++y) {
+      const std::size_t o = std::size_t(y) * std::size_t(w);
+      const std::uint8_t* valid = in.valid ? in.valid + o : nullptr;
+      in.prepare(in.image->r + o, in.image->g + o, in.image->b + o, valid, in.scale, in.k, buf[0] + margin,
+                 buf[1] + margin, buf[2] + margin, buf[3] + margin, std::size_t(w));
+      for (float* b : buf) {
+        std::fill(b, b + margin, b[margin]);
+        std::fill(b + margin + w, b + 2 * margin + w, b[margin + w - 1]);
+      }
+      for (int x0 = 0; x0 < w; x0 += kStrip) {
+        // Full strips write in place; the last one through `sink` so nothing past the row is overwritten.
+        const bool full = x0 + kStrip <= w;
+        float* dst[kHorizontal];
+        for (int p = 0; p < kHorizontal; ++p) dst[p] = full ? out[p].data() + o + std::size_t(x0) : sink[p];
+        auto window = [&](int b, int r) { return buf[b] + margin + x0 - r; };
+        strip_fir<1>(window(0, f.ry), 1, 2 * f.ry + 1, {f.spatial.y.data()}, {dst[kHY]});
+        strip_fir<1>(window(1, f.rcx), 1, 2 * f.rcx + 1, {f.spatial.cx.data()}, {dst[kHCx]});
+        strip_fir<2>(window(2, f.rs), 1, 2 * f.rs + 1, {f.spatial.cz1.data(), f.spatial.cz2.data()},
+                     {dst[kHCz1], dst[kHCz2]});
+        strip_fir<3>(window(3, f.rf), 1, 2 * f.rf + 1, {f.feature.g.data(), f.feature.dg.data(), f.feature.ddg.data()},
+                     {dst[kHG], dst[kHDG], dst[kHDDG]});
+        if (!full)
+          for (int p = 0; p < kHorizontal; ++p) std::copy(sink[p], sink[p] + (w - x0), out[p].data() + o + std::size_t(x0));
+      }
+    }
+  });
+  for (auto& p : out) p.fill_margins(h);
+}
+
+// Tiles of kStrip columns by kBand rows, each walked down its rows: the 2 r + 1 tap rows of one output row,
+// kStrip wide (about 21 kB for the four colour planes at 67 ppd), stay in the 32 kB L1 cache from one output
+// row to the next, which needs one new row per plane. Whole image rows instead (seven planes times 21 taps of
+// 1920 pixels, 1 MB) made the vertical pass wait on memory.
+template <typename Body>
+void for_tiles(int w, int h, Body&& body) {
+  constexpr int kBand = 64;
+  const int strips = (w + kStrip - 1) / kStrip, bands = (h + kBand - 1) / kBand;
+  parallel_chunks(
+      std::size_t(strips) * std::size_t(bands),
+      [&](std::size_t t0, std::size_t t1) {
+        for (std::size_t tile = t0; tile < t1; ++tile) {
+          const int x0 = int(tile % std::size_t(strips)) * kStrip, y0 = int(tile / std::size_t(strips)) * kBand;
+          body(x0, std::min(kStrip, w - x0), y0, std::min(y0 + kBand, h));
+        }
+      },
+      4);
+}
+
+// Two consecutive output rows of a vertical filter on a strip: out0 from input rows 0 .. taps - 1 of `src`,
+// out1 from rows 1 .. taps. Each input row is loaded once for both (taps + 1 loads for two outputs instead of
+// 2 taps), which halves the loads of the vertical passes; the multiply-adds stay.
+template <int K>
+inline void column_fir2(const float* src, std::ptrdiff_t step, int taps, const float* const (&w)[K],
+                        float* const (&out0)[K], float* const (&out1)[K]) {
+  Vec16 a[K][4] = {}, b[K][4] = {};
+  auto load = [&](int t, Vec16 (&v)[4]) {
+    const float* s = src + std::ptrdiff_t(t) * step;
+    for (int j = 0; j < 4; ++j) v[j] = load16(s + 16 * j);
+  };
+  Vec16 v[4];
+  load(0, v);
+  for (int k = 0; k < K; ++k)
+    for (int j = 0; j < 4; ++j) a[k][j] += w[k][0] * v[j];
+  for (int t = 1; t < taps; ++t) {
+    load(t, v);
+    for (int k = 0; k < K; ++k) {
+      const float wa = w[k][t], wb = w[k][t - 1];
+      for (int j = 0; j < 4; ++j) {
+        a[k][j] += wa * v[j];
+        b[k][j] += wb * v[j];
+      }
+    }
+  }
+  load(taps, v);
+  for (int k = 0; k < K; ++k)
+    for (int j = 0; j < 4; ++j) b[k][j] += w[k][taps - 1] * v[j];
+  for (int k = 0; k < K; ++k)
+    for (int j = 0; j < 4; ++j) {
+      store16(out0[k] + 16 * j, a[k][j]);
+      store16(out1[k] + 16 * j, b[k][j]);
+    }
+}
+
+// Runs `rows(y, pair)` down a tile: pairs of output rows where two remain, then a single one.
+template <typename Rows>
+void down_tile(int y0, int y1, Rows&& rows) {
+  int y = y0;
+  for (; y + 1 < y1; y += 2) rows(y, true);
+  if (y < y1) rows(y, false);
+}
+
+// Step (3a): the vertical CSF filters and, per pixel, the Hunt-adjusted CIELab of the filtered colour.
+void vertical_color_pass(const Plane (&in)[kHorizontal], int w, int h, const Filters& f, Plane (&out)[kProducts]) {
+  for_tiles(w, h, [&](int x0, int m, int y0, int y1) {
+    alignas(64) float acc[2][4][kStrip];
+    down_tile(y0, y1, [&](int y, bool pair) {
+      const std::ptrdiff_t step = w;
+      auto filter = [&](int plane, int r, const std::vector<float>& taps, int slot) {
+        const float* top = in[plane].data() + std::ptrdiff_t(y - r) * w + x0;
+        if (pair) column_fir2<1>(top, step, 2 * r + 1, {taps.data()}, {acc[0][slot]}, {acc[1][slot]});
+        else strip_fir<1>(top, step, 2 * r + 1, {taps.data()}, {acc[0][slot]});
+      };
+      filter(kHY, f.ry, f.spatial.y, 0);
+      filter(kHCx, f.rcx, f.spatial.cx, 1);
+      filter(kHCz1, f.rs, f.spatial.cz1, 2);
+      filter(kHCz2, f.rs, f.spatial.cz2, 3);
+      for (int k = 0; k < (pair ? 2 : 1); ++k) {
+        const std::size_t o = std::size_t(y + k) * std::size_t(w) + std::size_t(x0);
+        lab_span(acc[k][0], acc[k][1], acc[k][2], acc[k][3], out[kL].data() + o, out[kA].data() + o,
+                 out[kB].data() + o, m);
+      }
+    });
+  });
+}
+
+// Step (3b): the vertical feature filters (Gaussian down the x-derivatives, derivatives down the x-Gaussian)
+// and, per pixel, the edge and point magnitudes.
+void vertical_feature_pass(const Plane (&in)[kHorizontal], int w, int h, const Filters& f, Plane (&out)[kProducts]) {
+  for_tiles(w, h, [&](int x0, int m, int y0, int y1) {
+    const int r = f.rf, taps = 2 * r + 1;
+    alignas(64) float acc[2][4][kStrip];
+    down_tile(y0, y1, [&](int y, bool pair) {
+      const std::ptrdiff_t top = std::ptrdiff_t(y - r) * w + x0, step = w;
+      const float* g = f.feature.g.data();
+      if (pair) {
+        column_fir2<1>(in[kHDG].data() + top, step, taps, {g}, {acc[0][0]}, {acc[1][0]});   // d/dx
+        column_fir2<1>(in[kHDDG].data() + top, step, taps, {g}, {acc[0][1]}, {acc[1][1]});  // d2/dx2
+        column_fir2<2>(in[kHG].data() + top, step, taps, {f.feature.dg.data(), f.feature.ddg.data()},
+                       {acc[0][2], acc[0][3]}, {acc[1][2], acc[1][3]});  // d/dy, d2/dy2
+      } else {
+        strip_fir<1>(in[kHDG].data() + top, step, taps, {g}, {acc[0][0]});
+        strip_fir<1>(in[kHDDG].data() + top, step, taps, {g}, {acc[0][1]});
+        strip_fir<2>(in[kHG].data() + top, step, taps, {f.feature.dg.data(), f.feature.ddg.data()},
+                     {acc[0][2], acc[0][3]});
+      }
+      for (int k = 0; k < (pair ? 2 : 1); ++k) {
+        const std::size_t o = std::size_t(y + k) * std::size_t(w) + std::size_t(x0);
+        feature_span(acc[k][0], acc[k][1], acc[k][2], acc[k][3], out[kEdge].data() + o, out[kPoint].data() + o, m);
+      }
+    });
+  });
+}
+
+// Step (4): FLIP per pixel from the two images' quantities, on pixels [begin, end). Max: HDR-FLIP's running
+// maximum over exposures (strictly greater replaces, as the reference), recording `exposure` in `which`.
+struct CombineConstants {
+  float knee, below, above;
+};
+
+template <bool Max, bool Valid>
+[[gnu::noinline]] void combine_span(const float* __restrict L1, const float* __restrict A1, const float* __restrict B1,
+                  const float* __restrict E1, const float* __restrict P1, const float* __restrict L2,
+                  const float* __restrict A2, const float* __restrict B2, const float* __restrict E2,
+                  const float* __restrict P2, const std::uint8_t* __restrict valid, float* __restrict out,
+                  float* __restrict which, float exposure, CombineConstants k, std::size_t begin, std::size_t end) {
+  const float half = float(1.0 / std::numbers::sqrt2);
+  for (std::size_t i = begin; i < end; ++i) {
+    const float da = A1[i] - A2[i], db = B1[i] - B2[i];
+    const float distance = std::fabs(L1[i] - L2[i]) + std::sqrt(da * da + db * db);  // HyAB
+    const float c = fast_math::pow(distance, flip::kQc);
+    const float color = c < k.knee ? c * k.below : flip::kPt + (c - k.knee) * k.above;
+    const float feature = std::sqrt(std::max(std::fabs(E1[i] - E2[i]), std::fabs(P1[i] - P2[i])) * half);  // ^q_f
+    float v = fast_math::pow(color, 1.0f - feature);
+    if constexpr (Valid) v = valid[i] ? v : 0.0f;
+    if constexpr (Max) {
+      const bool larger = v > out[i];
+      out[i] = larger ? v : out[i];
+      which[i] = larger ? exposure : which[i];
+    } else {
+      out[i] = v;
+    }
+  }
+}
+
+template <bool Max, bool Valid>
+void combine_pass(const Plane (&ref)[kProducts], const Plane (&test)[kProducts], std::size_t n,
+                  const std::uint8_t* valid, float* map, float* exposure_map, float exposure) {
+  const float cmax = flip::max_color_difference(), knee = flip::kPc * cmax;
+  const CombineConstants k{knee, flip::kPt / knee, (1.0f - flip::kPt) / (cmax - knee)};
+  parallel_chunks(n, [&](std::size_t b, std::size_t e) {
+    combine_span<Max, Valid>(ref[kL].data(), ref[kA].data(), ref[kB].data(), ref[kEdge].data(), ref[kPoint].data(),
+                             test[kL].data(), test[kA].data(), test[kB].data(), test[kEdge].data(),
+                             test[kPoint].data(), valid, map, exposure_map, exposure, k, b, e);
+  });
+}
+
+Status check_inputs(const FlipImage& test, const FlipImage& ref, int width, int height, const float* map,
+                    const FlipOptions& o) {
+  if (!(o.pixels_per_degree > 0.0) || !std::isfinite(o.pixels_per_degree))
+    return Error::usage("FLIP needs a positive, finite number of pixels per degree (got " +
+                        std::to_string(o.pixels_per_degree) + "); the default is 67.0206");
+  if (width <= 0 || height <= 0) return Error::input({}, "FLIP of an empty image: give images of at least 1x1 pixels");
+  for (const FlipImage* im : {&test, &ref})
+    if (!im->r || !im->g || !im->b) return Error::input({}, "FLIP needs three planes (R, G, B) per image; pass one plane three times for grey");
+  if (!map) return Error::internal("FLIP: no output map given");
+  return {};
+}
+
+}  // namespace
+
+// ---------------------------------------------------------------------------------------------------------
+// The evaluator
+
+struct FlipEvaluator::Workspace {
+  int width = 0, height = 0;
+  Plane horizontal[kHorizontal];
+  Plane products[2][kProducts];  // [0]: reference, [1]: test
+  Plane exposure_scratch;
+  Filters filters;
+
+  void ensure(int w, int h, double ppd) {
+    if (filters.ppd != ppd) filters.set(ppd);
+    const int margin = std::max(filters.rs, filters.rf);
+    if (w != width || h != height || margin != horizontal[0].margin) {
+      for (auto& p : horizontal) p.resize(std::size_t(w), h, margin);
+      for (auto& image : products)
+        for (auto& p : image) p.resize(std::size_t(w), h);
+      exposure_scratch.resize(std::size_t(w), h);
+      width = w;
+      height = h;
+    }
+  }
+
+  // Steps (1)-(3) for one image into products[slot].
+  void image(const FlipImage& in, int w, int h, const std::uint8_t* valid, Prepare how, float scale,
+             FlipToneMapper tone, int slot) {
+    const RowInput rows{&in, valid, prepare_row(how, valid != nullptr), scale, flip::rational_coefficients(tone)};
+    horizontal_pass(rows, w, h, filters, horizontal);
+    vertical_color_pass(horizontal, w, h, filters, products[slot]);
+    vertical_feature_pass(horizontal, w, h, filters, products[slot]);
+  }
+};
+
+FlipEvaluator::FlipEvaluator(FlipOptions options) : options_(options), work_(std::make_unique<Workspace>()) {}
+FlipEvaluator::~FlipEvaluator() = default;
+FlipEvaluator::FlipEvaluator(FlipEvaluator&&) noexcept = default;
+FlipEvaluator& FlipEvaluator::operator=(FlipEvaluator&&) noexcept = default;
+
+Status FlipEvaluator::ldr(const FlipImage& test, const FlipImage& reference, int width, int height,
+                          const std::uint8_t* valid, float* map) {
+  if (auto st = check_inputs(test, reference, width, height, map, options_); !st) return st;
+  const std::size_t n = std::size_t(width) * std::size_t(height);
+  work_->ensure(width, height, options_.pixels_per_degree);
+  const Prepare how = options_.ldr_input == FlipLdrInput::Srgb ? Prepare::Srgb : Prepare::Linear;
+  work_->image(reference, width, height, valid, how, 1.0f, options_.tone_mapper, 0);
+  work_->image(test, width, height, valid, how, 1.0f, options_.tone_mapper, 1);
+  if (valid) combine_pass<false, true>(work_->products[0], work_->products[1], n, valid, map, nullptr, 0.0f);
+  else combine_pass<false, false>(work_->products[0], work_->products[1], n, valid, map, nullptr, 0.0f);
+  return {};
+}
+
+Expected<FlipExposures> FlipEvaluator::hdr(const FlipImage& test, const FlipImage& reference, int width, int height,
+                                           const std::uint8_t* valid, float* map, float* exposure_map) {
+  if (auto st = check_inputs(test, reference, width, height, map, options_); !st) return st.error();
+  const std::size_t n = std::size_t(width) * std::size_t(height);
+  FlipExposures e;
+  if (!options_.start_exposure || !options_.stop_exposure)
+    e = flip::automatic_exposures(reference, n, options_.tone_mapper, valid);
+  if (options_.start_exposure) e.start = *options_.start_exposure;
+  if (options_.stop_exposure) e.stop = *options_.stop_exposure;
+  if (!(e.start <= e.stop))
+    return Error::usage("HDR-FLIP: the start exposure (" + std::to_string(e.start) + ") must not exceed the stop exposure (" +
+                        std::to_string(e.stop) + ")");
+  if (options_.exposures == 1 || options_.exposures < 0)
+    return Error::usage("HDR-FLIP needs at least 2 exposures (got " + std::to_string(options_.exposures) +
+                        "); 0 chooses max(2, ceil(stop - start))");
+  e.count = options_.exposures > 0 ? options_.exposures : int(std::max(2.0f, std::ceil(e.stop - e.start)));
+  work_->ensure(width, height, options_.pixels_per_degree);
+  std::fill(map, map + n, 0.0f);
+  // Without a caller's exposure map the running one goes to scratch (a store under a null test would keep the
+  // combine loop from vectorising).
+  float* exposures = exposure_map ? exposure_map : work_->exposure_scratch.data();
+  std::fill(exposures, exposures + n, 0.0f);
+  const Prepare how = options_.tone_mapper == FlipToneMapper::Reinhard ? Prepare::ToneReinhard : Prepare::ToneRational;
+  const float step = (e.stop - e.start) / float(e.count - 1);
+  for (int i = 0; i < e.count; ++i) {
+    const float scale = std::pow(2.0f, e.start + float(i) * step);
+    work_->image(reference, width, height, valid, how, scale, options_.tone_mapper, 0);
+    work_->image(test, width, height, valid, how, scale, options_.tone_mapper, 1);
+    const float which = float(i) / float(e.count - 1);
+    if (valid) combine_pass<true, true>(work_->products[0], work_->products[1], n, valid, map, exposures, which);
+    else combine_pass<true, false>(work_->products[0], work_->products[1], n, valid, map, exposures, which);
+  }
+  return e;
+}
+
+// ---------------------------------------------------------------------------------------------------------
+// Pooling
+
+FlipStats flip_statistics(std::span<const float> map, const std::uint8_t* valid) {
+  // Two parallel passes over fixed chunks (merged in chunk order, so the result does not depend on the thread
+  // count). A value's bucket grows with the value, so the bucket holding each weighted percentile follows from
+  // the cumulative bucket sums of pass 1, and pass 2 collects only those buckets' values, which are sorted.
+  constexpr int kBuckets = 1024;
+  constexpr std::size_t kChunks = 32;
+  constexpr std::size_t kLanes = 4;  // FLIP values crowd into few buckets: four interleaved histograms keep the
+                                     // additions to one bucket from waiting on each other
+  const std::size_t n = map.size();
+  auto bucket_of = [](float v) { return std::clamp(int(v * float(kBuckets)), 0, kBuckets - 1); };
+  auto valid_at = [&](std::size_t i) { return !valid || valid[i] != 0; };
+  struct Chunk {
+    std::vector<double> sum;
+    std::size_t count = 0;
+    float min = std::numeric_limits<float>::infinity(), max = -std::numeric_limits<float>::infinity();
+    std::vector<float> picked[3];
+  };
+  std::vector<Chunk> chunks(kChunks);
+  parallel_chunks(
+      kChunks,
+      [&](std::size_t c0, std::size_t c1) {
+        for (std::size_t c = c0; c < c1; ++c) {
+          Chunk& ch = chunks[c];
+          std::vector<double> lanes(kLanes * kBuckets, 0.0);
+          for (std::size_t i = n * c / kChunks; i < n * (c + 1) / kChunks; ++i) {
+            if (!valid_at(i)) continue;
+            const float v = map[i];
+            lanes[(i % kLanes) * kBuckets + std::size_t(bucket_of(v))] += v;
+            ++ch.count;
+            ch.min = std::min(ch.min, v);
+            ch.max = std::max(ch.max, v);
+          }
+          ch.sum.assign(kBuckets, 0.0);
+          for (std::size_t l = 0; l < kLanes; ++l)
+            for (std::size_t b = 0; b < kBuckets; ++b) ch.sum[b] += lanes[l * kBuckets + b];
+        }
+      },
+      1);
+  FlipStats s;
+  std::vector<double> bucket(kBuckets, 0.0);
+  float mn = std::numeric_limits<float>::infinity(), mx = -mn;
+  for (const Chunk& ch : chunks) {
+    for (int b = 0; b < kBuckets; ++b) bucket[std::size_t(b)] += ch.sum[std::size_t(b)];
+    s.pixels += ch.count;
+    mn = std::min(mn, ch.min);
+    mx = std::max(mx, ch.max);
+  }
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  if (s.pixels == 0) return {nan, nan, nan, nan, nan, nan, 0};
+  double total = 0.0;
+  for (double v : bucket) total += v;
+  s.mean = total / double(s.pixels);
+  s.min = mn;
+  s.max = mx;
+  // The bucket where the running sum first exceeds p * total, and the sum of the buckets below it.
+  const double fractions[3] = {0.25, 0.5, 0.75};
+  int target[3];
+  double before[3];
+  for (int q = 0; q < 3; ++q) {
+    double sum = 0.0;
+    int b = 0;
+    while (b < kBuckets && !(sum + bucket[std::size_t(b)] > fractions[q] * total)) sum += bucket[std::size_t(b++)];
+    target[q] = b;  // kBuckets: every value is 0, nothing exceeds 0 (the reference answers 0 too)
+    before[q] = sum;
+  }
+  parallel_chunks(
+      kChunks,
+      [&](std::size_t c0, std::size_t c1) {
+        for (std::size_t c = c0; c < c1; ++c) {
+          const std::size_t i0 = n * c / kChunks, i1 = n * (c + 1) / kChunks;
+          const int t0 = target[0], t1 = target[1], t2 = target[2];
+          // Blocks of 64 values: a vectorised test whether any is in a target bucket (rarely), then a scalar
+          // look at the blocks that have one.
+          for (std::size_t b0 = i0; b0 < i1; b0 += 64) {
+            const std::size_t b1 = std::min(i1, b0 + 64);
+            int hit = 0;
+            for (std::size_t i = b0; i < b1; ++i) {
+              const int b = bucket_of(map[i]);
+              hit |= (b == t0) | (b == t1) | (b == t2);
+            }
+            if (!hit) continue;
+            for (std::size_t i = b0; i < b1; ++i) {
+              if (!valid_at(i)) continue;
+              const int b = bucket_of(map[i]);
+              for (int q = 0; q < 3; ++q)
+                if (b == target[q]) chunks[c].picked[q].push_back(map[i]);
+            }
+          }
+        }
+      },
+      1);
+  double result[3];
+  for (int q = 0; q < 3; ++q) {
+    std::vector<float> values;
+    for (const Chunk& ch : chunks) values.insert(values.end(), ch.picked[q].begin(), ch.picked[q].end());
+    std::sort(values.begin(), values.end());
+    result[q] = target[q] == kBuckets || values.empty() ? 0.0 : double(values.back());  // fallback: see below
+    double running = before[q];
+    for (float v : values)
+      if ((running += v) > fractions[q] * total) {
+        result[q] = v;
+        break;
+      }
+    // Without a break, the bucket sums' rounding differs from this running sum: the bucket's largest value.
+  }
+  s.weighted_quartile_1 = result[0];
+  s.weighted_median = result[1];
+  s.weighted_quartile_3 = result[2];
+  return s;
+}
+
+Expected<FlipStats> evaluate_flip(FlipRange range, const FlipImage& test, const FlipImage& reference, int width,
+                                  int height, const FlipOptions& options, float* map, FlipExposures* exposures) {
+  std::vector<float> own;
+  if (!map && width > 0 && height > 0) {
+    own.resize(std::size_t(width) * std::size_t(height));
+    map = own.data();
+  }
+  FlipEvaluator evaluator(options);
+  if (range == FlipRange::Ldr) {
+    if (auto st = evaluator.ldr(test, reference, width, height, nullptr, map); !st) return st.error();
+  } else {
+    auto e = evaluator.hdr(test, reference, width, height, nullptr, map);
+    if (!e) return e.error();
+    if (exposures) *exposures = *e;
+  }
+  return flip_statistics({map, std::size_t(width) * std::size_t(height)});
+}
+
+}  // namespace temporal

@@ -1,0 +1,47 @@
+// Registry entry `flicker` (docs/compare.md, "Flicker"): RMS of the difference between the test's and the
+// reference's motion-compensated change of luminance (temporal/metrics/flicker.h). The engine provides the two
+// changes; there is no value at the first frame and at camera cuts. Error map: error.flicker = |d_t|.
+#include "registry.h"
+
+#include "temporal/core/image.h"
+#include "temporal/metrics/flicker.h"
+
+namespace temporal {
+namespace {
+
+class Flicker final : public FrameMeasure {
+ public:
+  Status measure(const FrameInputs& in, MetricSample& out) override {
+    float* map = in.maps ? in.maps->add_channel("error.flicker") : nullptr;  // 0 where there is no value
+    out.values = {kNoValue};
+    if (!in.test_change || !in.reference_change) return {};
+    const FlickerResult f = flicker(in.test_change, in.reference_change, in.width, in.height, in.valid, in.mask, map);
+    out.count = f.pixels;
+    if (f.pixels) out.values[0] = f.rms();
+    if (in.mask) {
+      if (f.pixels_inside) out.inside = f.rms_inside();
+      if (f.pixels_outside) out.outside = f.rms_outside();
+    }
+    return {};
+  }
+};
+
+}  // namespace
+
+MetricDefinition flicker_metric() {
+  MetricDefinition d;
+  d.name = "flicker";
+  d.higher_is_better = false;
+  d.columns = {{"flicker", ""}};
+  d.mask_columns = {"flicker_in", "flicker_out"};
+  d.historical_csv = true;
+  d.threshold_option = "flicker";
+  d.threshold_help = "Exit 3 when a sequence's flicker is above this";
+  d.chart = {"-flicker", "Temporal instability per frame{motion}", "flicker (RMS of luminance change difference)", true};
+  d.table_width = 11;
+  d.table_format = "%.5g";
+  d.make = [](const ComparisonSetup&) -> std::unique_ptr<FrameMeasure> { return std::make_unique<Flicker>(); };
+  return d;
+}
+
+}  // namespace temporal

@@ -1,0 +1,15 @@
+// The entries of compare's metric registry (temporal/metrics/comparison.h), one function per metric source
+// file. Private to the metrics stage.
+#pragma once
+
+#include "temporal/metrics/comparison.h"
+
+namespace temporal {
+
+MetricDefinition psnr_rgb_metric();  // metric_psnr.cpp
+MetricDefinition psnr_y_metric();    // metric_psnr.cpp
+MetricDefinition ssim_metric();      // metric_ssim.cpp
+MetricDefinition flicker_metric();   // metric_flicker.cpp
+MetricDefinition flip_metric();      // metric_flip.cpp
+
+}  // namespace temporal

@@ -1,0 +1,235 @@
+// morph-120hz as a stage of the sequence runner (temporal/morph/morph_stage.h).
+#include "temporal/morph/morph_stage.h"
+
+#include "method_common.h"
+#include "temporal/core/color.h"
+#include "temporal/morph/methods.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <optional>
+
+namespace temporal {
+namespace {
+
+using namespace morph_detail;
+
+// NaN/Inf policy of the morph stage (conventions: counted, reported, never propagated): the runner counts and
+// reports them; here they become 0. Returns `image` itself when its `channels` are finite (the common case, no
+// copy), else a copy in `scratch` with the non-finite values replaced.
+const Image* finite_copy(const Image* image, const std::vector<std::string>& channels, Image& scratch) {
+  if (!image) return nullptr;
+  bool finite = true;
+  for (const auto& ch : channels)
+    if (const float* p = image->plane(ch)) finite = finite && count_non_finite({p, image->pixel_count()}) == 0;
+  if (finite) return image;
+  scratch = *image;
+  for (const auto& ch : channels) {
+    float* p = scratch.plane(ch);
+    if (!p) continue;
+    for (std::size_t i = 0; i < scratch.pixel_count(); ++i) p[i] = std::isfinite(p[i]) ? p[i] : 0.0f;
+  }
+  return &scratch;
+}
+
+const std::vector<std::string> kColor = {"R", "G", "B"};
+
+std::vector<std::string> gbuffer_channels(const std::vector<std::string>& layers) {
+  std::vector<std::string> channels;
+  for (const auto& l : layers)
+    for (auto& c : morph_gbuffer_channels(l)) channels.push_back(std::move(c));
+  return channels;
+}
+
+std::string layer_list(const std::vector<std::string>& layers) {
+  std::string s;
+  for (std::size_t i = 0; i < layers.size(); ++i) s += (i == 0 ? "" : i + 1 == layers.size() ? " and " : ", ") + layers[i];
+  return s;
+}
+
+// Frame-rate conversion with a method of the registry: `factor` outputs per input frame.
+class UpsampleStage final : public FrameStage {
+ public:
+  UpsampleStage(const MorphStageOptions& options, const MorphMethodInfo& info)
+      : options_(options), info_(info), gbuffer_channels_(gbuffer_channels(info.gbuffer_layers)) {
+    inputs_.input_layers = {"rgb"};
+    for (const auto& l : info.gbuffer_layers) inputs_.gbuffer_layers.push_back({l, true});
+    inputs_.gbuffer_required = !info.gbuffer_layers.empty();
+    inputs_.gbuffer_purpose = "--method " + info.name + " reads its " + layer_list(info.gbuffer_layers);
+    inputs_.lookahead = info.lookahead;
+    inputs_.lookahead_past_range = false;  // the last selected frame repeats, as at the end of the sequence
+    inputs_.outputs_per_frame = options.morph.factor;
+  }
+
+  const StageInputs& inputs() const override { return inputs_; }
+
+  Status process(const StageFrame& f, std::vector<StageOutput>& out) override {
+    const Image* color = finite_copy(f.input, kColor, color_);
+    const Image* gbuffer = finite_copy(f.gbuffer, gbuffer_channels_, gbuffer_);
+    const Image* next = f.next.empty() ? nullptr : finite_copy(f.next.front(), kColor, next_);
+    double fps = options_.fps;
+    if (fps <= 0.0) {
+      if (!color->metadata().fps)
+        return Error::input(f.input_path, "no temporal:fps in the header: pass --fps (the rate it was rendered at)");
+      fps = *color->metadata().fps;
+    }
+    if (!morpher_) {  // the viewing geometry and rate of the first frame set the eye-tracking limit
+      MorphOptions mo = options_.morph;
+      mo.grid.pixels_per_degree = tracking_pixels_per_degree(options_.viewing, color->width());
+      mo.grid.fps = fps;
+      morpher_.emplace(mo);
+    }
+    const auto t0 = std::chrono::steady_clock::now();
+    Status s = morpher_->process(*color, gbuffer, next, slots_, &timings_);
+    total_ms_ = ms_since(t0);
+    if (!s) {
+      Error e = s.error();
+      if (e.file.empty()) e.file = gbuffer && e.message.find("G-buffer") != std::string::npos ? f.gbuffer_path : f.input_path;
+      return e;
+    }
+    const int n = options_.morph.factor;
+    for (int k = 0; k < n; ++k) {
+      const int frame = f.frame * n + k;
+      FrameMetadata md = f.input->metadata();
+      md.fps = fps * n;
+      md.time = double(frame) / (fps * n);
+      if (k > 0) {  // the rendered frame's camera and jitter do not describe an extrapolated frame
+        md.world_to_camera.reset();
+        md.world_to_ndc.reset();
+        md.jitter.reset();
+        md.camera_cut.reset();
+      }
+      Image& img = slots_[std::size_t(k)];
+      img.metadata() = std::move(md);
+      StageOutput o;
+      o.frame = frame;
+      o.image = &img;
+      o.compute_ms = total_ms_ / n;  // the rendered frame's work produces all its slots: each gets an equal share
+      o.timings_ms = {{"flow", timings_.flow_ms}, {"morph", timings_.morph_ms}, {"blur", timings_.blur_ms}};
+      o.extra = {{"method", info_.name},
+                 {"latencyFrames", std::to_string(info_.latency_frames)},
+                 {"sourceFrame", std::to_string(f.frame)},
+                 {"slot", std::to_string(k)}};
+      o.keep_input_metadata = false;
+      out.push_back(std::move(o));
+    }
+    return Status::ok();
+  }
+
+  std::string frame_summary() const override {
+    char line[200];
+    std::snprintf(line, sizeof line,
+                  "%s, %d slots, %.2f ms (flow %.2f, morph %.2f, blur %.2f), gamma %.3g, %.2f pixels/degree",
+                  info_.name.c_str(), options_.morph.factor, total_ms_, timings_.flow_ms, timings_.morph_ms,
+                  timings_.blur_ms, double(options_.morph.gamma),
+                  double(morpher_ ? morpher_->options().grid.pixels_per_degree : 0.0f));
+    return line;
+  }
+
+ private:
+  MorphStageOptions options_;
+  const MorphMethodInfo& info_;
+  std::vector<std::string> gbuffer_channels_;
+  StageInputs inputs_;
+  std::optional<Morpher> morpher_;
+  std::vector<Image> slots_;
+  Image color_, gbuffer_, next_;  // finite copies (only of frames with NaN/Inf)
+  MorphTimings timings_;
+  double total_ms_ = 0.0;
+};
+
+// --perceive: the image an eye tracking the motion perceives on a hold-type display (hold_blur.h), one output per
+// input frame, integrating the window of displayed frames that starts at it.
+class PerceiveStage final : public FrameStage {
+ public:
+  explicit PerceiveStage(const HoldBlurOptions& hold) : hold_(hold) {
+    inputs_.input_layers = {"rgb"};
+    inputs_.gbuffer_layers = {{"motion", true}};
+    inputs_.gbuffer_required = true;
+    inputs_.gbuffer_purpose = "--perceive reads the display-rate motion";
+    inputs_.lookahead = hold.window - 1;  // read past the selected frames while files exist: the eye keeps integrating
+    scratch_.resize(std::size_t(hold.window));
+  }
+
+  const StageInputs& inputs() const override { return inputs_; }
+
+  Status process(const StageFrame& f, std::vector<StageOutput>& out) override {
+    std::vector<const Image*> window = {finite_copy(f.input, kColor, scratch_[0])};
+    for (std::size_t i = 0; i < f.next.size() && i + 1 < scratch_.size(); ++i)
+      window.push_back(finite_copy(f.next[i], kColor, scratch_[i + 1]));
+    const Image* g = finite_copy(f.gbuffer, {"motion.X", "motion.Y"}, gbuffer_);
+    const auto t0 = std::chrono::steady_clock::now();
+    auto p = perceive_hold(window, kColor, g->plane("motion.X"), g->plane("motion.Y"), hold_);
+    if (!p) return p.error();
+    result_ = std::move(*p);
+    StageOutput o;
+    o.frame = f.frame;
+    o.image = &result_;
+    o.compute_ms = ms_since(t0);
+    o.extra = {{"perceivedWindow", std::to_string(window.size())}};
+    out.push_back(std::move(o));
+    return Status::ok();
+  }
+
+ private:
+  HoldBlurOptions hold_;
+  StageInputs inputs_;
+  std::vector<Image> scratch_;  // finite copies of the window (only of frames with NaN/Inf)
+  Image gbuffer_, result_;
+};
+
+}  // namespace
+
+float tracking_pixels_per_degree(const ViewingOptions& v, int image_width) {
+  if (!v.tracking_limit) return 0.0f;
+  if (v.ppd > 0.0f) return v.ppd;
+  return pixels_per_degree(v.screen_width_m, v.distance_m, v.pixels_x > 0 ? v.pixels_x : image_width);
+}
+
+ParamList morph_stage_params(MorphStageOptions& o) {
+  std::vector<std::string> names;
+  for (const auto& m : morph_methods()) names.push_back(m.name);
+  ParamList params = {
+      Param::choice("--method", "Method (the registry's: morph-120hz --list-methods)", &o.morph.method, names),
+      Param::integer("--factor", "Output frames per input frame (40 Hz -> 120 Hz: 3)", &o.morph.factor, 2, 32),
+      {.flag = "--fps", .help = "Input frame rate; 0 reads temporal:fps from the input header", .value = &o.fps,
+       .min = 0.0, .max = 1e4},
+      Param::flag_on("--debug-layers", "Add debug.grid, debug.distortion, debug.blur, debug.H, debug.Hprime (didyk)",
+                     &o.morph.debug_layers),
+      Param::flag_on("--perceive",
+                     "Instead of upsampling: write the image perceived on a hold-type display under smooth pursuit "
+                     "(--input at its display rate, --gbuffer its display-rate motion)",
+                     &o.perceive),
+      Param::integer("--window", "--perceive: displayed frames integrated by the eye", &o.hold.window, 1, 64),
+  };
+  for (const auto& m : morph_methods()) {
+    if (!m.params) continue;
+    for (auto& p : m.params(o)) {
+      const bool listed = std::any_of(params.begin(), params.end(), [&](const Param& q) { return q.flag == p.flag; });
+      if (!listed) params.push_back(std::move(p));
+    }
+  }
+  return params;
+}
+
+Expected<std::unique_ptr<FrameStage>> make_morph_stage(const MorphStageOptions& options) {
+  if (options.perceive) {
+    if (options.hold.window < 1) return Error::usage("--window must be at least 1");
+    return std::unique_ptr<FrameStage>(std::make_unique<PerceiveStage>(options.hold));
+  }
+  auto info = find_morph_method(options.morph.method);
+  if (!info) return info.error();
+  MorphStageOptions resolved = options;
+  if (!options.display.empty()) {
+    auto config = ColorConfig::load(options.ocio);
+    if (!config) return config.error();
+    auto gamma = config->display_gamma(options.display);
+    if (!gamma) return gamma.error();
+    resolved.morph.gamma = *gamma;
+  }
+  if (Status s = check_morph_options(resolved.morph); !s) return s.error();
+  return std::unique_ptr<FrameStage>(std::make_unique<UpsampleStage>(resolved, **info));
+}
+
+}  // namespace temporal

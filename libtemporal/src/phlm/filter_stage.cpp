@@ -1,0 +1,112 @@
+// filter-phlm's stage of the sequence runner (temporal/phlm/filters.h): the layer's channels, the G-buffer planes
+// the method reads, timing, and the state files.
+#include "temporal/phlm/filters.h"
+
+#include <chrono>
+
+namespace temporal {
+namespace {
+
+std::string dims(int w, int h) { return std::to_string(w) + "x" + std::to_string(h); }
+
+// Channels of the filtered layer: R,G,B for `rgb`, else every `NAME.*` channel; 1 or 3 of them.
+Expected<std::vector<std::string>> layer_channels(const Image& img, const std::string& layer, const std::string& file) {
+  std::vector<std::string> names = layer == "rgb" ? std::vector<std::string>{"R", "G", "B"} : img.layer_channels(layer);
+  for (const auto& n : names)
+    if (!img.plane(n))
+      return Error::input(file, "no float channel '" + n + "' for --layer " + layer + "; pick a layer the file has");
+  if (names.size() != 1 && names.size() != 3)
+    return Error::usage("--layer " + layer + " has " + std::to_string(names.size()) +
+                        " channels; the filters take 1 (e.g. ssao) or 3 (rgb, direct)");
+  return names;
+}
+
+class FilterStage final : public FrameStage {
+ public:
+  FilterStage(const FilterOptions& options, const FilterMethod& method)
+      : options_(options), method_(method), filter_(method.create(options)) {
+    inputs_.input_layers = {options.layer};
+    inputs_.gbuffer_layers = method.gbuffer_layers;
+  }
+  const StageInputs& inputs() const override { return inputs_; }
+  bool has_state() const override { return filter_->has_state(); }
+
+  Expected<Image> save_state() const override {
+    Image state = filter_->saved_state();
+    state.metadata().extra["phlmStateOf"] = method_.name;
+    return state;
+  }
+  // The channel count is known at the first frame: the state is applied there.
+  Status load_state(const Image& state) override {
+    auto of = state.metadata().extra.find("phlmStateOf");
+    if (of != state.metadata().extra.end() && of->second != method_.name)
+      return Error::usage("the state was written by --method " + of->second + ", not " + method_.name +
+                          ": resume with the same method");
+    pending_state_ = state;
+    return Status::ok();
+  }
+
+  Status process(const StageFrame& f, std::vector<StageOutput>& out) override {
+    auto channels = layer_channels(*f.input, options_.layer, f.input_path);
+    if (!channels) return channels.error();
+    if (pending_state_) {
+      const Image& state = *pending_state_;
+      if (state.width() != f.input->width() || state.height() != f.input->height())
+        return Error::input(f.input_path, "the --state-in state is " + dims(state.width(), state.height()) +
+                                              " but the input is " + dims(f.input->width(), f.input->height()));
+      if (Status s = filter_->set_state(state, int(channels->size())); !s) return s;
+      pending_state_.reset();
+    }
+    FilterInput in;
+    in.color = f.input;
+    in.channels = *channels;
+    in.debug = options_.debug_layers;
+    in.jitter = f.input->metadata().jitter.value_or(glm::vec2(0.0f));
+    in.reset = f.cut;
+    if (f.gbuffer) {
+      in.motion_x = f.gbuffer->plane("motion.X");
+      in.motion_y = f.gbuffer->plane("motion.Y");
+      in.depth = f.gbuffer->plane("depth.Z");
+      in.id = f.gbuffer->uint_plane("id");
+    }
+    const auto t0 = std::chrono::steady_clock::now();
+    stats_ = {};
+    if (Status s = filter_->process(in, output_, &stats_); !s) return s;
+    ms_ = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    StageOutput o;
+    o.frame = f.frame;
+    o.image = &output_;
+    o.compute_ms = ms_;
+    o.timings_ms = {{"filter", ms_}};
+    o.extra = {{"method", method_.name}};
+    out.push_back(std::move(o));
+    return Status::ok();
+  }
+
+  std::string frame_summary() const override {
+    return std::to_string(ms_) + " ms, resets " + std::to_string(stats_.history_resets) + ", box " +
+           std::to_string(stats_.clamped) + filter_->stats_text(stats_);
+  }
+
+ private:
+  FilterOptions options_;
+  const FilterMethod& method_;
+  std::unique_ptr<FrameFilter> filter_;
+  StageInputs inputs_;
+  std::optional<Image> pending_state_;
+  Image output_;
+  FilterStats stats_;
+  double ms_ = 0.0;
+};
+
+}  // namespace
+
+Expected<std::unique_ptr<FrameStage>> make_filter_stage(const FilterOptions& options) {
+  const FilterMethod* method = find_filter_method(options.method);
+  if (!method) return Error::usage("--method must be " + filter_method_names() + " (got " + options.method + ")");
+  FilterOptions copy = options;
+  if (Status s = check_params(method->params(copy)); !s) return s.error();
+  return std::unique_ptr<FrameStage>(std::make_unique<FilterStage>(options, *method));
+}
+
+}  // namespace temporal

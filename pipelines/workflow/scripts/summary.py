@@ -1,0 +1,90 @@
+#!/usr/bin/env python3
+"""An experiment's summary table from compare's JSON files (one per scene): per variant the mean of each metric
+with its 95 % interval, the mean compute time from the output headers, whether the variant is on the Pareto front
+of compute time against PSNR, and its paired PSNR difference against the baseline with the interval. It only
+formats what compare computed (docs/pipelines.md)."""
+import argparse
+import json
+import math
+import os
+
+
+def num(v):
+    if v is None:
+        return None
+    if isinstance(v, str):
+        return math.inf if v == "inf" else -math.inf if v == "-inf" else None
+    return float(v)
+
+
+def fmt(v, digits=2):
+    v = num(v)
+    if v is None:
+        return "-"
+    if math.isinf(v):
+        return "inf" if v > 0 else "-inf"
+    return f"{v:.{digits}f}"
+
+
+def with_ci(m, digits=2):
+    if not m:
+        return "-"
+    ci = m.get("ci95") or [None, None]
+    return f"{fmt(m.get('mean'), digits)} [{fmt(ci[0], digits)}, {fmt(ci[1], digits)}]"
+
+
+def pareto(points):
+    """Names of the points not dominated in (lower cost, higher score)."""
+    front = []
+    for name, cost, score in points:
+        if cost is None or score is None:
+            continue
+        dominated = any(c2 <= cost and s2 >= score and (c2 < cost or s2 > score)
+                        for n2, c2, s2 in points if n2 != name and c2 is not None and s2 is not None)
+        if not dominated:
+            front.append(name)
+    return front
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__)
+    ap.add_argument("--title", default="")
+    ap.add_argument("--baseline", default="")
+    ap.add_argument("--out", required=True)
+    ap.add_argument("json", nargs="+")
+    a = ap.parse_args()
+    lines = [f"# {a.title}", ""]
+    for path in a.json:
+        scene = os.path.basename(os.path.dirname(path))
+        report = json.load(open(path))
+        seqs = report["sequences"]
+        points = [(s["name"], num(s.get("compute_ms")), num((s.get("psnr_rgb") or {}).get("mean"))) for s in seqs]
+        front = set(pareto(points))
+        lines += [f"## {scene}", "",
+                  "| variant | PSNR dB [95% CI] | SSIM | flicker | compute ms | Pareto | PSNR - " + (a.baseline or "baseline") + " [95% CI] |",
+                  "|---|---|---|---|---|---|---|"]
+        paired = {}
+        for p in report.get("paired", []):
+            if p["metric"] != "psnr_rgb":
+                continue
+            if p["b"] == a.baseline:
+                paired[p["a"]] = (num(p["mean_difference"]), p["ci95"])
+            elif p["a"] == a.baseline:
+                ci = p["ci95"]
+                paired[p["b"]] = (-num(p["mean_difference"]), [-(num(ci[1]) or 0), -(num(ci[0]) or 0)])
+        for s in seqs:
+            d = paired.get(s["name"])
+            diff = "-" if not d else f"{fmt(d[0])} [{fmt(d[1][0])}, {fmt(d[1][1])}]"
+            lines.append(f"| {s['name']} | {with_ci(s.get('psnr_rgb'))} | {with_ci(s.get('ssim'), 4)} | "
+                         f"{with_ci(s.get('flicker'), 4)} | {fmt(s.get('compute_ms'), 3)} | "
+                         f"{'yes' if s['name'] in front else ''} | {diff} |")
+        plots = os.path.join(os.path.dirname(path), "plots")
+        lines += ["", f"Charts: `{os.path.relpath(plots, os.path.dirname(a.out))}/` (metrics-speed.png: compute time "
+                      "against PSNR)", ""]
+    with open(a.out + ".tmp", "w") as f:
+        f.write("\n".join(lines) + "\n")
+    os.replace(a.out + ".tmp", a.out)
+
+
+if __name__ == "__main__":
+    main()
