@@ -119,8 +119,8 @@ TEST(Upsample, HerzogStaticSceneConverges) {
   const Err e = error(r.output, r.frame.reference, interior(scene));
   std::printf("herzog static (period 20), after k*k frames: mean %.5f max %.5f; spatial mean %.5f max %.5f\n",
               e.mean, e.max, es.mean, es.max);
-  // The published image kernel (fall-off gamma * w_f at most 4 over the low-res diagonal) keeps ~1/7 of
-  // the weight on the pixel's own sample at convergence, so a slight blur remains: below 0.06 here
+  // The published image kernel (fall-off gamma * w_f at most 4 over the low-res diagonal, times the spatial hat)
+  // keeps ~1/4 of the weight on the pixel's own sample at convergence, so a slight blur remains: below 0.06 here
   // (payload amplitude 0.3), and below the spatial method's error.
   EXPECT_LE(e.max, 0.06);
   EXPECT_LT(e.mean, 0.85 * es.mean);
@@ -137,6 +137,53 @@ TEST(Upsample, HerzogStaticSceneConverges) {
   std::printf("herzog static (period 40), gamma cap 64, after 2 k*k frames: mean %.5f max %.5f\n", e2.mean, e2.max);
   EXPECT_LE(e2.mean, 0.001);
   EXPECT_LE(e2.max, 0.02);
+}
+
+TEST(Upsample, HerzogFallbackIsSpatialUpsampling) {
+  // Seed 000 sections 3.3 and 3.5: where gamma w_f = 0 the method "falls back to spatial upsampling". With a = 0
+  // (eq. 8: w_f = 0 everywhere) the image kernel is the spatial baseline's hat and eq. 7 gives the history no
+  // weight, so every frame must equal `spatial`'s; with the default a, the first frame (no history, w_f = 0) must.
+  // Tolerance 1e-6: the two compute the same weights with products in another order.
+  SyntheticScene scene;
+  scene.object = true;
+  scene.object_velocity = {2.0f, 1.0f};
+  scene.camera_velocity = {0.5f, -0.25f};
+  up::Upsampler spatial(options_for("spatial")), herzog_a0(options_for("herzog", {"--a", "0"}));
+  up::Upsampler herzog(options_for("herzog")), literal(options_for("herzog", {"--fallback", "flat", "--a", "0"}));
+  auto max_diff = [](const Image& a, const Image& b) {
+    double d = 0;
+    for (const auto& c : kRGB)
+      for (std::size_t i = 0; i < a.pixel_count(); ++i)
+        d = std::max(d, std::abs(double(a.plane(c)[i]) - double(b.plane(c)[i])));
+    return d;
+  };
+  for (int t = 0; t < 8; ++t) {
+    SyntheticFrame f = make_frame(scene, t);
+    auto s = spatial.process(f.gbuffer, f.low, kRGB, false);
+    auto h0 = herzog_a0.process(f.gbuffer, f.low, kRGB, false);
+    auto h = herzog.process(f.gbuffer, f.low, kRGB, false);
+    auto fl = literal.process(f.gbuffer, f.low, kRGB, false);
+    ASSERT_TRUE(s && h0 && h && fl);
+    EXPECT_LE(max_diff(**s, **h0), 1e-6) << "frame " << t;
+    if (t == 0) {
+      EXPECT_LE(max_diff(**s, **h), 1e-6);
+    }
+    // The literal reading (eq. 3 alone, a box at gamma = 0) is not the spatial baseline.
+    EXPECT_GT(max_diff(**s, **fl), 1e-3) << "frame " << t;
+    if (t == 0) {
+      // By hand at pixel (1, 1) of frame 0 (sub-pixel (0, 0)): its taps are samples (0, 0), (1, 0), (0, 1), (1, 1)
+      // of the background plane (equal depth and normal: equal geometric weights), 1/4 of the low-resolution
+      // spacing from the first. Hat: (3/4 3/4, 1/4 3/4, 3/4 1/4, 1/4 1/4); box: 1/4 each.
+      const int lw = f.low.width();
+      for (const auto& c : kRGB) {
+        const float* l = f.low.plane(c);
+        const double v00 = l[0], v10 = l[1], v01 = l[lw], v11 = l[lw + 1];
+        const std::size_t p = std::size_t(scene.width) + 1;
+        EXPECT_NEAR((*h)->plane(c)[p], (9 * v00 + 3 * v10 + 3 * v01 + v11) / 16, 1e-6) << c;
+        EXPECT_NEAR((*fl)->plane(c)[p], (v00 + v10 + v01 + v11) / 4, 1e-6) << c;
+      }
+    }
+  }
 }
 
 TEST(Upsample, DrobotRefreshStaticSceneIsExactAfterKSquaredFrames) {

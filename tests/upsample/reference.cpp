@@ -206,6 +206,7 @@ void PlainUpsampler::temporal(const Frame& f, Image& out) {
 void PlainUpsampler::herzog(const Frame& f, Image& out) {
   const float gamma = float(param(options_, "--kernel-gamma")), cap = float(param(options_, "--max-kernel-gamma"));
   const float floor_g = float(param(options_, "--min-kernel-gamma"));
+  const bool hat = text_param(options_, "--fallback") == "spatial";  // k = hat * eq. 3, else eq. 3 alone
   const float a = param(options_, "--favor-spatial") != 0 ? up::kFavorSpatialA : float(param(options_, "--a"));
   const int gs = int(param(options_, "--gradient-scale"));
   const float mip = float(param(options_, "--gradient-mip-level"));
@@ -246,8 +247,9 @@ void PlainUpsampler::herzog(const Frame& f, Image& out) {
         const float dx = float(X - (f.k * x[j] + f.sx)), dy = float(Y - (f.k * y[j] + f.sy));
         const float dist = std::sqrt(dx * dx + dy * dy);
         const float g = f.geometric(X, Y, x[j], y[j], inv_sn2, inv_sd2);
-        const float w = g * up::image_kernel(dist, r, fall_off);
-        wsharp += g * up::image_kernel(dist, r, up::kernel_gamma(gamma, 1.0f, cap));
+        const float base = hat ? up::hat_kernel(dx, dy, f.k) : 1.0f;
+        const float w = g * base * up::image_kernel(dist, r, fall_off);
+        wsharp += g * base * up::image_kernel(dist, r, up::kernel_gamma(gamma, 1.0f, cap));
         if (!(w > 0)) continue;
         wsum += w;
         for (int c = 0; c < f.C; ++c) sum[c] += w * f.low[c][std::size_t(y[j]) * f.lw + x[j]];

@@ -158,6 +158,7 @@ TEST(UpsampleReference, NoIdsAndOtherParameters) {
       {"herzog", "--no-ids", "--depth-tolerance", "0.2"},
       {"herzog", "--kernel-gamma", "9", "--max-kernel-gamma", "6", "--min-kernel-gamma", "1", "--a", "0.8"},
       {"herzog", "--gradient-scale", "4", "--gradient-mip-level", "3", "--max-history-weight", "10"},
+      {"herzog", "--fallback", "flat", "--min-kernel-gamma", "0.5"},
       {"drobot", "--cache-point", "--miss-threshold", "0.05", "--max-frames", "8"},
       {"drobot", "--mode", "refresh", "--no-ids", "--depth-only"},
   };

@@ -2,7 +2,7 @@
 //
 // Per frame, three passes (run row by row in one sweep, see HerzogFrame::build_schedule):
 //  A (full resolution): spatial estimate h~ and its weight w~ (eq. 6) with the
-//    image kernel k = g(|x(i) - x(j)|, r, min(gamma w_f, 4)) (section 3.3/3.5); motion-compensated fetch
+//    image kernel k = hat g(|x(i) - x(j)|, r, min(gamma w_f, 4)) (section 3.3/3.5, the fallback below); motion-compensated fetch
 //    of the history h_r, h_w (temporal/core/reproject.h); relative temporal gradient of the payload's luminance
 //    (section 3.5.1), set to its maximum where the history is disoccluded (Figure 6), averaged into the
 //    intermediate-resolution gradient buffer (section 4: "compute it at an intermediate resolution").
@@ -16,7 +16,15 @@
 //
 // The kernel's fall-off needs w_f before h~ exists, and w_f needs h~ (the paper approximates h(i, t) by h~);
 // we break the cycle by shaping the kernel with the previous frame's w_f at the motion-compensated position
-// (0 where there is no history: a flat kernel, i.e. spatial upsampling), and use this frame's w_f in eq. 7.
+// (0 where there is no history), and use this frame's w_f in eq. 7.
+//
+// The fallback (`--fallback`): section 3.3 says that for gamma = 0 "the results approach spatial upsampling" and
+// section 3.5 that the method "falls back to spatial filtering", but eq. 3 at gamma = 0 is a constant kernel (a box
+// over the four taps), not the spatial baseline's hat (section 3.1, [Yang et al. 2008]); the box is 0.65-1.9 dB
+// below the hat on the built-in scenes (issue 15). By default k is the hat times eq. 3,
+// k(i, j) = hat(x(i) - x(j)) g(||x(i) - x(j)||, r, gamma w_f): at gamma w_f = 0 it is exactly the spatial baseline's
+// kernel, and as gamma w_f grows it still tends to the dirac of temporally-amortised upsampling (both factors are 1
+// at distance 0). `--fallback flat` keeps eq. 3 alone, the literal reading.
 #include "method.h"
 
 #include "temporal/upsample/history.h"
@@ -193,7 +201,8 @@ struct RowScratch {
 struct HerzogOptions {
   float kernel_gamma = kMaxKernelGamma;      // gamma of k; 4 so that w_f = 1 reaches the cap
   float max_kernel_gamma = kMaxKernelGamma;  // cap of gamma * w_f (section 3.5: 4)
-  float min_kernel_gamma = 0.0f;             // floor of the fall-off (the paper: 0, a flat kernel where w_f = 0)
+  float min_kernel_gamma = 0.0f;             // floor of the fall-off (the paper: 0)
+  std::string fallback = "spatial";          // k at gamma w_f = 0: spatial's hat (default) or flat (eq. 3 alone)
   float a = 1.0f;                            // eq. 8 sensitivity
   bool favor_spatial = false;                // a = 0.7, the paper's elephant scene
   int gradient_scale = 2;                    // the gradient at full / scale (section 4: "e.g. at 2x2 pixels")
@@ -208,8 +217,13 @@ struct HerzogOptions {
                     &kernel_gamma, 0.0, 1000.0),
         Param::real("--max-kernel-gamma", "cap of gamma w_f (seed 000 section 3.5: 4)", &max_kernel_gamma, 0.0, 1000.0),
         Param::real("--min-kernel-gamma",
-                    "floor of the fall-off, max(G0, min(gamma w_f, cap)); the paper's 0 makes k flat where w_f = 0",
-                    &min_kernel_gamma, 0.0, 1000.0),
+                    "floor of the fall-off, max(G0, min(gamma w_f, cap)) (the paper: 0)", &min_kernel_gamma, 0.0,
+                    1000.0),
+        Param::choice("--fallback",
+                      "k at gamma w_f = 0 (seed 000 sections 3.3, 3.5: \"falls back to spatial upsampling\"): "
+                      "spatial = the spatial baseline's hat times eq. 3; flat = eq. 3 alone (the literal reading: "
+                      "a box)",
+                      &fallback, {"spatial", "flat"}),
         Param::real("--a", "sensitivity a of eq. 8 (w_f = a (1 - |grad|)^2)", &a, 0.0, 1.0),
         Param::flag_on("--favor-spatial", "a = 0.7 (the paper's elephant scene)", &favor_spatial),
         Param::integer("--gradient-scale",
@@ -256,7 +270,7 @@ struct HerzogState : MethodState {
   std::vector<float> w_tilde, w_conf, hw_fetch;  // pass A results of the chunk-boundary rows (three-pass mode)
   std::vector<std::vector<float>> hr_fetch;
   std::vector<float> dcur, dcount, grad_smooth;
-  std::vector<float> kern_lb, kern_ks;  // image-kernel tables expanded to full-resolution columns (per dy, tap)
+  std::vector<float> kern_lb, kern_ks, kern_hat;  // image-kernel tables expanded to full-resolution columns (per dy, tap)
   std::vector<std::vector<float>> pyramid;
   std::vector<int> pyr_w, pyr_h;
   std::vector<float> pyr_hx[2];  // the two sampled pyramid levels, rows resampled to the gradient's columns
@@ -410,33 +424,39 @@ HerzogFrame::HerzogFrame(HerzogState& st, const FrameContext& fc, bool history_f
 }
 
 // log2 of the image-kernel base max(eps, 1 - dist / r) for the four taps at every offset (dx, dy) in the k x k
-// cell; r is the low-resolution pixel diagonal (section 3.3). The kernel is then exp2(gamma * log).
+// cell; r is the low-resolution pixel diagonal (section 3.3). The kernel is then hat * exp2(gamma * log), with
+// hat the spatial baseline's bilinear weight (--fallback spatial) or 1 (--fallback flat; see the file comment).
 void HerzogFrame::build_kernel_tables() {
   const float r = float(k) * std::sqrt(2.0f);
-  std::vector<float> logb(std::size_t(4) * k * k);
+  const bool hat_base = ho.fallback != "flat";
+  std::vector<float> logb(std::size_t(4) * k * k), hat(logb.size());
   for (int j = 0; j < 4; ++j)
     for (int dy = 0; dy < k; ++dy)
       for (int dx = 0; dx < k; ++dx) {
         const float ox = float(dx - k * (j & 1)), oy = float(dy - k * (j >> 1));
         logb[std::size_t(j) * k * k + dy * k + dx] =
             std::log2(std::max(kKernelEpsilon, 1.0f - std::sqrt(ox * ox + oy * oy) / r));
+        hat[std::size_t(j) * k * k + dy * k + dx] = hat_base ? hat_kernel(ox, oy, k) : 1.0f;
       }
   // The same kernel at the full fall-off min(gamma, cap) (w_f = 1): the weight a sample keeps in the history.
   std::vector<float> ksharp(logb.size());
   const float gamma_full = kernel_gamma(ho.kernel_gamma, 1.0f, ho.max_kernel_gamma);
-  for (std::size_t j = 0; j < logb.size(); ++j) ksharp[j] = std::exp2(gamma_full * logb[j]);
-  // Both tables expanded to full-resolution columns, once per frame: plane (dy, j) holds the entry of tap j
+  for (std::size_t j = 0; j < logb.size(); ++j) ksharp[j] = hat[j] * std::exp2(gamma_full * logb[j]);
+  // The tables expanded to full-resolution columns, once per frame: plane (dy, j) holds the entry of tap j
   // at offset (cols.d[X], dy) for every column X, so the kernel loops read them with unit stride.
   s.kern_lb.resize(std::size_t(k) * 4 * W);
   s.kern_ks.resize(std::size_t(k) * 4 * W);
+  s.kern_hat.resize(std::size_t(k) * 4 * W);
   for (int dy = 0; dy < k; ++dy)
     for (int j = 0; j < 4; ++j) {
       const std::size_t t = std::size_t(j) * k * k + std::size_t(dy) * k;
       float* __restrict elb = s.kern_lb.data() + (std::size_t(dy) * 4 + j) * W;
       float* __restrict eks = s.kern_ks.data() + (std::size_t(dy) * 4 + j) * W;
+      float* __restrict eh = s.kern_hat.data() + (std::size_t(dy) * 4 + j) * W;
       for (int X = 0; X < W; ++X) {
         elb[X] = logb[t + f.cols.d[X]];
         eks[X] = ksharp[t + f.cols.d[X]];
+        eh[X] = hat[t + f.cols.d[X]];
       }
     }
 }
@@ -605,6 +625,10 @@ void HerzogFrame::spatial_estimate_row(ChunkScratch& ts, int Y, const RowScratch
   const float* __restrict ks1 = s.kern_ks.data() + (std::size_t(dy) * 4 + 1) * w;
   const float* __restrict ks2 = s.kern_ks.data() + (std::size_t(dy) * 4 + 2) * w;
   const float* __restrict ks3 = s.kern_ks.data() + (std::size_t(dy) * 4 + 3) * w;
+  const float* __restrict kh0 = s.kern_hat.data() + (std::size_t(dy) * 4 + 0) * w;
+  const float* __restrict kh1 = s.kern_hat.data() + (std::size_t(dy) * 4 + 1) * w;
+  const float* __restrict kh2 = s.kern_hat.data() + (std::size_t(dy) * 4 + 2) * w;
+  const float* __restrict kh3 = s.kern_hat.data() + (std::size_t(dy) * 4 + 3) * w;
   // The two low rows' samples expanded to the full-resolution columns (cached over the k rows using them).
   const float *e0 = nullptr, *e1 = nullptr;
   ts.low_rows.get(f, r0, r1, e0, e1);
@@ -624,10 +648,10 @@ void HerzogFrame::spatial_estimate_row(ChunkScratch& ts, int Y, const RowScratch
 #pragma GCC ivdep
   for (int X = 0; X < w; ++X) {
     const float e = ekr[X];
-    w00[X] = w00[X] * fast_exp2(e * lb0[X]);
-    w01[X] = w01[X] * fast_exp2(e * lb1[X]);
-    w10[X] = w10[X] * fast_exp2(e * lb2[X]);
-    w11[X] = w11[X] * fast_exp2(e * lb3[X]);
+    w00[X] = w00[X] * (kh0[X] * fast_exp2(e * lb0[X]));
+    w01[X] = w01[X] * (kh1[X] * fast_exp2(e * lb1[X]));
+    w10[X] = w10[X] * (kh2[X] * fast_exp2(e * lb2[X]));
+    w11[X] = w11[X] * (kh3[X] * fast_exp2(e * lb3[X]));
     wt[X] = w00[X] + w01[X] + w10[X] + w11[X];
   }
   for (int c = 0; c < C; ++c) {  // eq. 6
