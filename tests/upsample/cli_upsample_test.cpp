@@ -4,6 +4,7 @@
 
 #include "temporal/core/exr.h"
 #include "temporal/upsample/methods.h"
+#include "temporal/upsample/upsample.h"
 
 #include <gtest/gtest.h>
 #include <test_support.h>
@@ -11,6 +12,7 @@
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
+#include <sstream>
 #include <string>
 
 using temporal::test::make_frame;
@@ -75,6 +77,40 @@ TEST(UpsampleCli, WritesFramesWithHeaders) {
       }
     }
   }
+}
+
+TEST(UpsampleCli, HeaderRecordsTheMethodParameters) {
+  // `temporal:methodParameters`: every parameter of the method with its value, defaults included (issue 15: a
+  // and the cap of gamma w_f), so that make_options of it reproduces the run's options.
+  const fs::path dir = write_sequence("upsample_cli_params", 2);
+  std::string output;
+  const std::string cmd = tool() + " --gbuffer " + (dir / "gbuffer.####.exr").string() + " --input " +
+                          (dir / "shade.####.exr").string() + " --out " + (dir / "h.####.exr").string() +
+                          " --method herzog --a 0.7 --max-kernel-gamma 8";
+  ASSERT_EQ(temporal::test::run_command(cmd, &output), 0) << output;
+  auto img = temporal::read_exr((dir / "h.0001.exr").string());
+  ASSERT_TRUE(img.has_value()) << img.error().message;
+  ASSERT_TRUE(img->metadata().extra.count("methodParameters"));
+  const std::string text = img->metadata().extra.at("methodParameters");
+  for (const char* expected : {"--a 0.7", "--max-kernel-gamma 8", "--kernel-gamma 4", "--fallback spatial"})
+    EXPECT_NE((" " + text + " ").find(std::string(" ") + expected + " "), std::string::npos) << expected << " in " << text;
+  EXPECT_EQ(text.find("--favor-spatial"), std::string::npos) << "flags appear only when on: " << text;
+  std::vector<std::string> args;
+  std::stringstream in(text);
+  for (std::string a; in >> a;) args.push_back(a);
+  auto o = temporal::upsample::make_options("herzog", args);
+  ASSERT_TRUE(o.has_value()) << o.error().message;
+  EXPECT_EQ(temporal::upsample::method_parameters(*o), text);
+  // A method without parameters writes none.
+  ASSERT_EQ(temporal::test::run_command(tool() + " --gbuffer " + (dir / "gbuffer.####.exr").string() + " --input " +
+                                            (dir / "shade.####.exr").string() + " --out " +
+                                            (dir / "s.####.exr").string() + " --method spatial",
+                                        &output),
+            0)
+      << output;
+  auto s = temporal::read_exr((dir / "s.0001.exr").string());
+  ASSERT_TRUE(s.has_value());
+  EXPECT_EQ(s->metadata().extra.count("methodParameters"), 0u);
 }
 
 TEST(UpsampleCli, BadInputExitCodes) {

@@ -151,6 +151,21 @@ Expected<Options> make_options(const std::string& method, const std::vector<std:
   return o;
 }
 
+std::string method_parameters(const Options& o) {
+  Options copy = o;  // params() points at the fields it is given
+  MethodOptions* m = copy.per_method.find(o.method);
+  if (!m) return {};
+  std::string text;
+  for (const Param& p : m->params()) {
+    const std::string value = param_value_text(p);
+    const bool flag = std::holds_alternative<bool*>(p.value);
+    if (flag && value != "on") continue;
+    text += (text.empty() ? "" : " ") + p.flag;
+    if (!flag) text += " " + value;
+  }
+  return text;
+}
+
 std::vector<std::string> gbuffer_layers(const Options& o) {
   std::vector<std::string> layers;
   if (const MethodEntry* e = find_entry(o.method))

@@ -65,6 +65,7 @@ Status UpsampleStage::process(const StageFrame& frame, std::vector<StageOutput>&
   output.timings_ms["upsample"] = last_.compute_ms;
   const MethodEntry* entry = find_entry(o.method);
   output.extra["method"] = entry && entry->header_name ? entry->header_name(o) : o.method;
+  if (const std::string p = method_parameters(o); !p.empty()) output.extra["methodParameters"] = p;
   output.extra["holePixels"] = std::to_string(last_.hole_pixels);
   output.extra["historyPixels"] = std::to_string(last_.history_pixels);
   output.extra["nonFiniteInput"] = std::to_string(last_.non_finite_input);

@@ -108,6 +108,13 @@ ParamList params(Options& options);
 // make_options("drobot", {"--mode", "refresh"}). Usage error for an unknown method or parameter.
 Expected<Options> make_options(const std::string& method, const std::vector<std::string>& args = {});
 
+// The selected method's own parameters as the arguments that set them, every one with its value (defaults
+// included; flags only when on), e.g. "--kernel-gamma 4 --max-kernel-gamma 4 ... --a 0.7 --gradient-scale 2":
+// the `temporal:methodParameters` header of every output, so a result says which a, cap, mode, ... made it.
+// make_options(method, split(text)) gives the same options (values to 6 significant digits). Empty for a method
+// without parameters.
+std::string method_parameters(const Options& options);
+
 // Usage error unless every value is valid: the method exists, every parameter is inside its range, and each
 // method's own checks pass.
 Status check(const Options& options);
