@@ -12,9 +12,11 @@
 #   SCENE      scenes to run (default: the built-in walkers (the horses scene), tower and fan of assets/scenes)
 # Environment: SIZE (default 640x512; the paper used 1280x1024), FRAMES (default 0-47), FPS (default 30),
 #   FACTOR (default 4), METHODS (default "spatial temporal herzog herzog-favor-spatial drobot spatial-demod
-#   herzog-demod"; a method name takes variant suffixes: -lagged = herzog --lagged-wf, -favor-spatial =
-#   herzog --favor-spatial (a = 0.7, as the paper's elephant scene), -refresh = drobot --mode refresh, -demod =
-#   --demodulate (lighting upsampled, albedo from the G-buffer; seed 000 section 4)), REFERENCE_SPP (default 0: none; N > 0 also renders an N-spp supersampled reference and
+#   herzog-demod"; names of the method table as `upsample-st --list-methods` prints them: a method, a named variant
+#   such as herzog-lagged (--lagged-wf), herzog-favor-spatial (a = 0.7, the paper's elephant scene) or
+#   drobot-refresh (--mode refresh), optionally with a suffix the table lists, such as -demod (--demodulate:
+#   lighting upsampled, albedo from the G-buffer; seed 000 section 4)), REFERENCE_SPP (default 0: none; N > 0 also
+#   renders an N-spp supersampled reference and
 #   adds a PSNR column against it), RENDER_ARGS (extra render-gbuffer options; default "--payload
 #   direct,shadow,ssao,gi", Table 1's "Horses (AO+GI)"), UPSAMPLE_ARGS (extra upsample-st options for every method).
 #
@@ -51,6 +53,31 @@ for t in "$render" "$upsample" "$compare"; do
     exit 2
   fi
 done
+
+# The method table: NAME<TAB>ARGUMENTS<TAB>SUMMARY per method and variant, and *SUFFIX<TAB>ARGUMENTS for the name
+# suffixes any method takes.
+catalogue="$("$upsample" --list-methods)"
+# Arguments of a METHODS name: the table's arguments, after stripping (and adding the arguments of) suffixes.
+method_args() {
+  local name="$1" extra=""
+  while true; do
+    local n args summary suffix=""
+    while IFS=$'\t' read -r n args summary; do
+      if [[ "$n" == "$name" ]]; then
+        echo "$args$extra"
+        return 0
+      fi
+      if [[ "$n" == \** && "$name" == *"${n#\*}" ]]; then suffix="${n#\*}"$'\t'"$args"; fi
+    done <<< "$catalogue"
+    if [[ -z "$suffix" ]]; then
+      echo "upsample-st.sh: unknown method '$1' in METHODS (upsample-st --list-methods lists the names)" >&2
+      return 1
+    fi
+    name="${name%"${suffix%%$'\t'*}"}"
+    extra=" ${suffix#*$'\t'}$extra"
+  done
+}
+for m in $METHODS; do method_args "$m" > /dev/null || exit 2; done
 
 scenes=("$@")
 if [[ ${#scenes[@]} -eq 0 ]]; then
@@ -98,14 +125,7 @@ for scene in "${scenes[@]}"; do
   tests=()
   names=""
   for m in $METHODS; do
-    # METHOD[-VARIANT...]: lagged = --lagged-wf, favor-spatial = --favor-spatial (a = 0.7), refresh = drobot
-    # --mode refresh, demod = --demodulate (lighting upsampled, albedo from the G-buffer).
-    args="--method ${m%%-*}"
-    rest="${m#"${m%%-*}"}"
-    [[ "$rest" == *-lagged* ]] && args+=" --lagged-wf"
-    [[ "$rest" == *-favor-spatial* ]] && args+=" --favor-spatial"
-    [[ "$rest" == *-refresh* ]] && args+=" --mode refresh"
-    [[ "$rest" == *-demod* ]] && args+=" --demodulate"
+    args="$(method_args "$m")"
     echo "== $name: upsample-st $args" >&2
     # shellcheck disable=SC2086
     "$upsample" --gbuffer "$dir/render/gbuffer.####.exr" --input "$dir/render/shade.####.exr" \

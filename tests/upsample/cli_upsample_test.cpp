@@ -3,12 +3,16 @@
 #include "synthetic.h"
 
 #include "temporal/core/exr.h"
+#include "temporal/upsample/methods.h"
+#include "temporal/upsample/upsample.h"
 
 #include <gtest/gtest.h>
 #include <test_support.h>
 
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
+#include <sstream>
 #include <string>
 
 using temporal::test::make_frame;
@@ -75,6 +79,40 @@ TEST(UpsampleCli, WritesFramesWithHeaders) {
   }
 }
 
+TEST(UpsampleCli, HeaderRecordsTheMethodParameters) {
+  // `temporal:methodParameters`: every parameter of the method with its value, defaults included (issue 15: a
+  // and the cap of gamma w_f), so that make_options of it reproduces the run's options.
+  const fs::path dir = write_sequence("upsample_cli_params", 2);
+  std::string output;
+  const std::string cmd = tool() + " --gbuffer " + (dir / "gbuffer.####.exr").string() + " --input " +
+                          (dir / "shade.####.exr").string() + " --out " + (dir / "h.####.exr").string() +
+                          " --method herzog --a 0.7 --max-kernel-gamma 8";
+  ASSERT_EQ(temporal::test::run_command(cmd, &output), 0) << output;
+  auto img = temporal::read_exr((dir / "h.0001.exr").string());
+  ASSERT_TRUE(img.has_value()) << img.error().message;
+  ASSERT_TRUE(img->metadata().extra.count("methodParameters"));
+  const std::string text = img->metadata().extra.at("methodParameters");
+  for (const char* expected : {"--a 0.7", "--max-kernel-gamma 8", "--kernel-gamma 4", "--fallback spatial"})
+    EXPECT_NE((" " + text + " ").find(std::string(" ") + expected + " "), std::string::npos) << expected << " in " << text;
+  EXPECT_EQ(text.find("--favor-spatial"), std::string::npos) << "flags appear only when on: " << text;
+  std::vector<std::string> args;
+  std::stringstream in(text);
+  for (std::string a; in >> a;) args.push_back(a);
+  auto o = temporal::upsample::make_options("herzog", args);
+  ASSERT_TRUE(o.has_value()) << o.error().message;
+  EXPECT_EQ(temporal::upsample::method_parameters(*o), text);
+  // A method without parameters writes none.
+  ASSERT_EQ(temporal::test::run_command(tool() + " --gbuffer " + (dir / "gbuffer.####.exr").string() + " --input " +
+                                            (dir / "shade.####.exr").string() + " --out " +
+                                            (dir / "s.####.exr").string() + " --method spatial",
+                                        &output),
+            0)
+      << output;
+  auto s = temporal::read_exr((dir / "s.0001.exr").string());
+  ASSERT_TRUE(s.has_value());
+  EXPECT_EQ(s->metadata().extra.count("methodParameters"), 0u);
+}
+
 TEST(UpsampleCli, BadInputExitCodes) {
   const fs::path dir = write_sequence("upsample_cli_bad", 2, /*drop_motion=*/true);
   std::string output;
@@ -86,4 +124,71 @@ TEST(UpsampleCli, BadInputExitCodes) {
   EXPECT_EQ(temporal::test::run_command(base + " --method spatial", &output), 0) << output;
   EXPECT_EQ(temporal::test::run_command(base + " --method nonsense", &output), 1) << output;
   EXPECT_EQ(temporal::test::run_command(base + " --method spatial --layer ssao", &output), 2) << output;
+}
+
+TEST(UpsampleCli, StateFilesResumeBitIdentically) {
+  // Frames 0-5 in one run, and as two runs chained by --state-out / --state-in (the way a long sequence runs as a
+  // chain of jobs): frames 3-5 must be the same files, pixel for pixel.
+  const fs::path dir = write_sequence("upsample_cli_state", 6);
+  const std::string base = tool() + " --gbuffer " + (dir / "gbuffer.####.exr").string() + " --input " +
+                           (dir / "shade.####.exr").string() + " --debug-layers";
+  for (const temporal::upsample::MethodVariant& v : temporal::upsample::method_variants()) {
+    std::string args = " --method " + v.method;
+    for (const auto& a : v.args) args += " " + a;
+    std::string output;
+    const fs::path whole = dir / (v.name + "_whole"), parts = dir / (v.name + "_parts");
+    const std::string state = (dir / (v.name + ".state.exr")).string();
+    const std::string first = base + args + " --out " + (parts / "o.####.exr").string() + " --frames 0-2";
+    if (!temporal::upsample::find_method(v.method)->has_state) {
+      EXPECT_EQ(temporal::test::run_command(first + " --state-out " + state, &output), 1) << output;
+      EXPECT_NE(output.find("no state"), std::string::npos) << output;
+      continue;
+    }
+    ASSERT_EQ(temporal::test::run_command(base + args + " --out " + (whole / "o.####.exr").string(), &output), 0)
+        << output;
+    ASSERT_EQ(temporal::test::run_command(first + " --state-out " + state, &output), 0) << output;
+    ASSERT_EQ(temporal::test::run_command(base + args + " --out " + (parts / "o.####.exr").string() +
+                                              " --frames 3-5 --state-in " + state,
+                                          &output),
+              0)
+        << output;
+    for (const char* frame : {"0003", "0004", "0005"}) {
+      auto a = temporal::read_exr((whole / ("o." + std::string(frame) + ".exr")).string());
+      auto b = temporal::read_exr((parts / ("o." + std::string(frame) + ".exr")).string());
+      ASSERT_TRUE(a && b) << v.name;
+      ASSERT_EQ(a->channel_names(), b->channel_names()) << v.name;
+      std::size_t differ = 0;
+      for (const auto& c : a->channel_names())
+        if (const float *pa = a->plane(c), *pb = b->plane(c); pa && pb)
+          for (std::size_t i = 0; i < a->pixel_count(); ++i) differ += std::memcmp(pa + i, pb + i, 4) != 0;
+      EXPECT_EQ(differ, 0u) << v.name << " frame " << frame;
+      // The resumed run does not restart its history: the header says so.
+      EXPECT_FALSE(b->metadata().camera_cut.value_or(false)) << v.name << " frame " << frame;
+    }
+    // A state resumed at a frame other than the next one is refused (its history belongs to frame 2).
+    EXPECT_EQ(temporal::test::run_command(base + args + " --out " + (dir / "x.####.exr").string() +
+                                              " --frames 4-5 --state-in " + state,
+                                          &output),
+              1)
+        << output;
+    EXPECT_NE(output.find("--frames 3-"), std::string::npos) << output;
+    // A state of another method is refused with exit code 1 and names both methods.
+    const std::string other = v.method == "temporal" ? "herzog" : "temporal";
+    EXPECT_EQ(temporal::test::run_command(base + " --method " + other + " --out " + (dir / "x.####.exr").string() +
+                                              " --frames 3-5 --state-in " + state,
+                                          &output),
+              1)
+        << output;
+    EXPECT_NE(output.find("--method " + v.method), std::string::npos) << output;
+  }
+}
+
+TEST(UpsampleCli, ListMethods) {
+  std::string output;
+  ASSERT_EQ(temporal::test::run_command(tool() + " --list-methods", &output), 0) << output;
+  // One tab-separated line per method and variant: name, arguments, summary.
+  for (const temporal::upsample::MethodVariant& v : temporal::upsample::method_variants())
+    EXPECT_NE(output.find(v.name + "\t--method " + v.method), std::string::npos) << output;
+  EXPECT_NE(output.find("herzog-lagged\t--method herzog --lagged-wf\t"), std::string::npos) << output;
+  EXPECT_NE(output.find("*-demod\t--demodulate\t"), std::string::npos) << output;
 }

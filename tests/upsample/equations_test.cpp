@@ -35,6 +35,25 @@ TEST(UpsampleEquations, Eq2NormalAndDepthTerms) {
   EXPECT_NEAR(up::depth_weight(10.0f, 50.0f, sd), 1e-9f, 1e-12f);
 }
 
+TEST(UpsampleEquations, Eq2GeometricWeightIsTheProductOfItsTerms) {
+  // The per-pixel form every kernel runs: n . n = 0.9 (0.421875, above) and |dz| = sigma_d / 2 (0.421875):
+  // 0.421875^2 = 0.177978515625.
+  const float sd = 0.03f * (100.0f - 0.1f);
+  const float inv_sn2 = 1.0f / (0.2f * 0.2f), inv_sd2 = 1.0f / (sd * sd);
+  EXPECT_NEAR(up::geometric_weight(0.9f, 0.5f * sd, inv_sn2, inv_sd2), 0.177978515625f, 1e-6f);
+  // Both terms clamped at epsilon: eps^3 * eps^3.
+  EXPECT_NEAR(up::geometric_weight(-1.0f, 10.0f * sd, inv_sn2, inv_sd2), 1e-18f, 1e-21f);
+  // Equal to normal_weight * depth_weight over a grid of inputs. The two forms round 1 - x^2 / sigma^2 differently
+  // (a product with 1 / sigma^2 against a quotient); near the edge of the tent the cancellation makes that a few
+  // 1e-6 relative (measured: at most 2.9e-6 on this grid), hence 1e-5.
+  for (float dot = -0.2f; dot <= 1.0f; dot += 0.05f)
+    for (float dz = -1.2f * sd; dz <= 1.2f * sd; dz += 0.1f * sd) {
+      const float product = up::normal_weight(dot) * up::depth_weight(10.0f, 10.0f - dz, sd);
+      EXPECT_NEAR(up::geometric_weight(dot, dz, inv_sn2, inv_sd2), product, 1e-5f * product + 1e-30f)
+          << "dot " << dot << " dz " << dz;
+    }
+}
+
 TEST(UpsampleEquations, ImageKernelsSection33) {
   const float r = 4.0f * std::sqrt(2.0f);  // low-res pixel diagonal for k = 4
   // distance 1, gamma 4: (1 - 1/5.656854)^4 = 0.823223^4 = 0.459273
@@ -61,6 +80,11 @@ TEST(UpsampleEquations, Eq7HistoryBlend) {
   EXPECT_FLOAT_EQ(up::history_blend(0.2f, 1.0f, 0.5f, 4.0f, 0.8f), 0.6f);
   EXPECT_FLOAT_EQ(up::history_blend(0.2f, 1.0f, 0.0f, 4.0f, 0.8f), 0.2f);  // w_f = 0: spatial only
   EXPECT_FLOAT_EQ(up::history_blend(0.3f, 0.0f, 0.0f, 0.0f, 0.8f), 0.3f);  // no weight at all
+  // The per-pixel form with w_hist = w_f h_w = 2 multiplied out: the same 0.6.
+  EXPECT_FLOAT_EQ(up::history_blend_weighted(0.2f, 1.0f, 2.0f, 0.8f), 0.6f);
+  EXPECT_FLOAT_EQ(up::history_blend_weighted(0.3f, 0.0f, 0.0f, 0.8f), 0.3f);
+  EXPECT_FLOAT_EQ(up::bounded_history_weight(1.0f, 2.0f, 32.0f), 3.0f);
+  EXPECT_FLOAT_EQ(up::bounded_history_weight(1.0f, 40.0f, 32.0f), 32.0f);
   // h_w := w~ + w_f h_w, bounded
   EXPECT_FLOAT_EQ(up::history_weight_update(1.0f, 0.5f, 4.0f, 32.0f), 3.0f);
   EXPECT_FLOAT_EQ(up::history_weight_update(1.0f, 1.0f, 32.0f, 32.0f), 32.0f);

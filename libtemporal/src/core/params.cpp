@@ -1,8 +1,10 @@
 // Method parameters (temporal/core/params.h): text forms and range checks.
 #include "temporal/core/params.h"
 
+#include <cerrno>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 
 namespace temporal {
 namespace {
@@ -83,6 +85,44 @@ Status check_param(const Param& p) {
 Status check_params(const ParamList& params) {
   for (const auto& p : params)
     if (Status s = check_param(p); !s) return s;
+  return Status::ok();
+}
+
+Status apply_args(const ParamList& params, const std::vector<std::string>& args) {
+  for (std::size_t i = 0; i < args.size(); ++i) {
+    const Param* p = nullptr;
+    for (const auto& candidate : params)
+      if (candidate.flag == args[i]) p = &candidate;
+    if (!p) return Error::usage("unknown parameter '" + args[i] + "'");
+    if (auto* b = std::get_if<bool*>(&p->value)) {
+      **b = true;
+      continue;
+    }
+    if (i + 1 == args.size()) return Error::usage(p->flag + " needs a value");
+    const std::string& text = args[++i];
+    char* end = nullptr;
+    errno = 0;
+    const double v = std::strtod(text.c_str(), &end);
+    const bool number = !text.empty() && end == text.c_str() + text.size() && errno == 0;
+    Status status = std::visit(
+        [&](auto* field) -> Status {
+          using T = std::remove_pointer_t<decltype(field)>;
+          if constexpr (std::is_same_v<T, std::string>) {
+            *field = text;
+          } else if constexpr (std::is_same_v<T, int>) {
+            if (!number || v != std::floor(v) || std::abs(v) > 2e9)
+              return Error::usage(p->flag + " needs an integer (got '" + text + "')");
+            *field = int(v);
+          } else if constexpr (std::is_arithmetic_v<T>) {
+            if (!number) return Error::usage(p->flag + " needs a number (got '" + text + "')");
+            *field = T(v);
+          }
+          return Status::ok();
+        },
+        p->value);
+    if (!status) return status;
+    if (Status s = check_param(*p); !s) return s;
+  }
   return Status::ok();
 }
 

@@ -142,7 +142,11 @@ class InputWindow {
 Status check_gbuffer_size(const Image& g, const Image& input, const StageInputs& needs, const std::string& gpath,
                           const std::string& ipath) {
   int k = needs.gbuffer_scale;
-  if (k == 0) k = input.metadata().jitter_factor.value_or(1);
+  if (k == 0 && !input.metadata().jitter_factor)
+    return Error::input(ipath, "no temporal:jitterFactor in the header: the G-buffer's size is k times this input's, "
+                               "with k from that attribute (render-gbuffer --outputs shade writes it; "
+                               "docs/conventions.md, Jitter)");
+  if (k == 0) k = *input.metadata().jitter_factor;
   if (g.width() == k * input.width() && g.height() == k * input.height()) return Status::ok();
   if (k == 1)
     return Error::input(gpath, "G-buffer is " + dims(g.width(), g.height()) + " but " + ipath + " is " +
@@ -196,6 +200,7 @@ Status check_gbuffer_layers(const Image& g, const std::vector<LayerNeed>& needs,
     if (!ok) {
       std::string how = "; render the G-buffer with render-gbuffer --outputs gbuffer";
       if (need.layer == "id" && g.has_channel("id")) how = "; `id` must be stored as uint32 (render-gbuffer writes it so)";
+      if (!need.alternative.empty()) how += " (" + need.alternative + ")";
       return Error::input(path, "no layer '" + need.layer + "' (have: " + join(g.channel_names()) + ")" + how);
     }
   }

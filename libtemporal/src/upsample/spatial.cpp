@@ -1,9 +1,9 @@
 // `spatial`: joint-bilateral upsampling, seed 000 section 3.1 (eq. 1-3) with the hat image kernel of
 // [Yang et al. 2008]. Whole frames read the two low rows of each full row expanded to full-resolution columns
 // (ExpandedLowRows, shared with herzog's pass A): unit-stride loads instead of ~32 gathers per pixel. The
-// gathering version (spatial_row, in upsampler.cpp) serves `temporal`'s sparse hole runs; both compute the
+// gathering version (spatial_row, in frame.cpp) serves `temporal`'s sparse hole runs; both compute the
 // same weights in the same order, so their results are bit-identical.
-#include "upsample_internal.h"
+#include "method.h"
 
 #include "temporal/core/parallel.h"
 
@@ -12,20 +12,21 @@ namespace {
 
 // Eq. 1-3 for full row Y from the expanded low rows e0 (row i0) and e1 (row i1), plane stride es: out[c] and
 // (when not null) the sum of weights.
-void spatial_row_expanded(const Upsampler::State& s, const FrameContext& f, const Options& o, int Y, const float* e0,
-                          const float* e1, std::size_t es, float* const* out, float* wsum, float* w4) {
+void spatial_row_expanded(const FrameContext& f, int Y, const float* e0, const float* e1, std::size_t es,
+                          float* const* out, float* wsum, float* w4) {
+  const Options& o = *f.options;
   const int W = f.W, k = f.grid.k;
   float* __restrict w00 = w4;
   float* __restrict w01 = w00 + W;
   float* __restrict w10 = w01 + W;
   float* __restrict w11 = w10 + W;
-  const float fy = float(s.rows.d[Y]) / float(k), inv_k = 1.0f / float(k);
+  const float fy = float(f.rows.d[Y]) / float(k), inv_k = 1.0f / float(k);
   const float inv_sn2 = 1.0f / (o.sigma_normal * o.sigma_normal), inv_sd2 = 1.0f / (f.sigma_d * f.sigma_d);
-  const int* __restrict cd = s.cols.d.data();
+  const int* __restrict cd = f.cols.d.data();
   // Plane q, tap t (0: column i0, 1: column i1 = the i0 expansion shifted by k) of an expanded low row.
   auto ex = [es, k](const float* e, int q, int t) { return e + std::size_t(q) * es + std::size_t(t) * k; };
   // Geometric weights (eq. 2-3) times tap existence, then the hat image kernel (bilinear in the offset).
-  expanded_geometric_weights(s, f, inv_sn2, inv_sd2, Y, e0, e1, es, w00, w01, w10, w11);
+  expanded_geometric_weights(f, inv_sn2, inv_sd2, Y, e0, e1, es, w00, w01, w10, w11);
 #pragma GCC ivdep
   for (int X = 0; X < W; ++X) {
     const float fx = float(cd[X]) * inv_k;
@@ -55,30 +56,63 @@ void spatial_row_expanded(const Upsampler::State& s, const FrameContext& f, cons
     for (int X = 0; X < W; ++X) wsum[X] = w00[X] + w01[X] + w10[X] + w11[X];
 }
 
+
+// Spatial upsampling keeps nothing between frames: its state is its output image.
+class SpatialState : public MethodState {
+ public:
+  explicit SpatialState(const Geometry& g) : out_(g), channels_(g.channels) {}
+
+  Image& run(const FrameContext& f, bool, FrameStats& stats) override {
+    Image& out = out_.next();
+    const std::vector<float*> planes = payload_planes(out, channels_);
+    float* conf = f.debug ? out.add_channel("debug.confidence") : nullptr;
+    // Bands of 16 rows: the k rows that share a pair of low rows reuse their expansion.
+    parallel_rows(f.H, [&](int y0, int y1) {
+      thread_local ExpandedLowRows low_rows;
+      thread_local std::vector<float> w4;
+      low_rows.reset(f.W, f.grid.k, f.grid.sx, f.C);
+      w4.resize(std::size_t(f.W) * 4);
+      float* rows[16];
+      for (int Y = y0; Y < y1; ++Y) {
+        const std::size_t off = std::size_t(Y) * f.W;
+        for (std::size_t c = 0; c < planes.size(); ++c) rows[c] = planes[c] + off;
+        const float *e0 = nullptr, *e1 = nullptr;
+        low_rows.get(f, f.rows.i0[Y] * f.lw, f.rows.i1[Y] * f.lw, e0, e1);
+        spatial_row_expanded(f, Y, e0, e1, low_rows.stride(), rows, conf ? conf + off : nullptr, w4.data());
+      }
+    }, 16);
+    stats.hole_pixels = 0;
+    stats.history_pixels = 0;
+    return out;
+  }
+  void save(Image&) const override {}
+  Status load(const Image&) override { return Status::ok(); }
+
+ private:
+  OutputPair out_;
+  std::vector<std::string> channels_;
+};
+
+std::vector<LayerNeed> layers(const Options&) { return {{"depth"}, {"N"}}; }
+
+// Reads depth + N (4 planes) and the payload, writes the output; nothing else.
+std::size_t streamed_bytes(const Options&, int W, int H, int k, int C) {
+  const std::size_t full = std::size_t(W) * H * 4, low = full / (std::size_t(k) * k);
+  return 4 * full + C * low + C * full;
+}
+
 }  // namespace
 
-void run_spatial(Upsampler::State& s, const FrameContext& f, const Options& o, FrameStats& stats) {
-  Image& out = s.result[s.cur];
-  std::vector<float*> planes;
-  for (const auto& c : s.channels) planes.push_back(out.plane(c));
-  float* conf = o.debug_layers ? out.add_channel("debug.confidence") : nullptr;
-  // Bands of 16 rows: the k rows that share a pair of low rows reuse their expansion.
-  parallel_rows(f.H, [&](int y0, int y1) {
-    thread_local ExpandedLowRows low_rows;
-    thread_local std::vector<float> w4;
-    low_rows.reset(f.W, f.grid.k, f.grid.sx, f.C);
-    w4.resize(std::size_t(f.W) * 4);
-    float* rows[16];
-    for (int Y = y0; Y < y1; ++Y) {
-      const std::size_t off = std::size_t(Y) * f.W;
-      for (std::size_t c = 0; c < planes.size(); ++c) rows[c] = planes[c] + off;
-      const float *e0 = nullptr, *e1 = nullptr;
-      low_rows.get(s, f, s.rows.i0[Y] * f.lw, s.rows.i1[Y] * f.lw, e0, e1);
-      spatial_row_expanded(s, f, o, Y, e0, e1, low_rows.stride(), rows, conf ? conf + off : nullptr, w4.data());
-    }
-  }, 16);
-  stats.hole_pixels = 0;
-  stats.history_pixels = 0;
+const MethodEntry& spatial_method() {
+  static const MethodEntry entry{
+      {"spatial", "joint-bilateral upsampling of this frame's samples (seed 000 section 3.1, eq. 1-3, hat kernel)",
+       false, {}},
+      nullptr,
+      layers,
+      [](const Options&, const Geometry& g) -> std::unique_ptr<MethodState> { return std::make_unique<SpatialState>(g); },
+      streamed_bytes,
+      nullptr};
+  return entry;
 }
 
 }  // namespace temporal::upsample

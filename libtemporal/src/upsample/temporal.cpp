@@ -3,7 +3,7 @@
 // its motion-compensated position. Disocclusions (warped depth + material id, Figure 3) and pixels that
 // leave the screen have no history: the paper re-renders them in a second pass; we count them
 // (FrameStats::hole_pixels, `temporal:holePixels`) and fill them with the joint-bilateral result (eq. 1-3).
-#include "upsample_internal.h"
+#include "method.h"
 
 #include "temporal/core/parallel.h"
 
@@ -11,19 +11,17 @@
 
 namespace temporal::upsample {
 
-void run_temporal(Upsampler::State& s, const FrameContext& f, const Options& o, FrameStats& stats) {
-  Image& out = s.result[s.cur];
-  const Image& prev = s.result[1 - s.cur];
+namespace {
+
+// Eq. 4 for one frame: the new samples, the previous output at p + motion elsewhere, the spatial result in the
+// holes.
+void temporal_frame(const FrameContext& f, const PreviousGeometry& prev_geo, bool history, Image& out,
+                    const Image& prev, const std::vector<std::string>& channels, FrameStats& stats) {
   const int C = f.C;
-  std::vector<float*> planes;
-  std::vector<const float*> prev_planes;
-  for (const auto& c : s.channels) {
-    planes.push_back(out.plane(c));
-    prev_planes.push_back(prev.plane(c));
-  }
-  float* dbg_disocc = o.debug_layers ? out.add_channel("debug.disocclusion") : nullptr;
-  float* dbg_conf = o.debug_layers ? out.add_channel("debug.confidence") : nullptr;
-  const bool history = s.have_history;
+  const std::vector<float*> planes = payload_planes(out, channels);
+  const std::vector<const float*> prev_planes = payload_planes(prev, channels);
+  float* dbg_disocc = f.debug ? out.add_channel("debug.disocclusion") : nullptr;
+  float* dbg_conf = f.debug ? out.add_channel("debug.confidence") : nullptr;
   std::atomic<std::size_t> holes{0}, hits{0};
   parallel_rows(f.H, [&](int y0, int y1) {
     thread_local std::vector<float> fill, computed, hole;
@@ -36,13 +34,13 @@ void run_temporal(Upsampler::State& s, const FrameContext& f, const Options& o, 
     std::size_t band_holes = 0, band_hits = 0;
     for (int Y = y0; Y < y1; ++Y) {
       const std::size_t row = std::size_t(Y) * f.W;
-      const bool row_computed = s.rows.d[Y] == 0;
-      const std::size_t lrow = std::size_t(s.rows.i0[Y]) * f.lw;
+      const bool row_computed = f.rows.d[Y] == 0;
+      const std::size_t lrow = std::size_t(f.rows.i0[Y]) * f.lw;
       // w_t of eq. 4: 1 where this frame shaded the pixel (and the sample is finite).
       for (int X = 0; X < f.W; ++X)
-        computed[X] = (row_computed && s.cols.d[X] == 0 && s.lvalid[lrow + s.cols.i0[X]] > 0) ? 1.0f : 0.0f;
+        computed[X] = (row_computed && f.cols.d[X] == 0 && f.lvalid[lrow + f.cols.i0[X]] > 0) ? 1.0f : 0.0f;
       if (history) {
-        history_row(s, f, o, Y, hist);
+        history_row(f, prev_geo, Y, hist);
       } else {
         hist.resize(f.W);
         std::fill(hist.hit.begin(), hist.hit.end(), 0.0f);
@@ -68,14 +66,14 @@ void run_temporal(Upsampler::State& s, const FrameContext& f, const Options& o, 
       for (int c = 0; c < C; ++c) {
         float* out_row = planes[c] + row;
         const float* l = f.low[c] + lrow;
-        const int* ci0 = s.cols.i0.data();
+        const int* ci0 = f.cols.i0.data();
         for (int X = 0; X < f.W; ++X) {
           const float h = history && hist.hit[X] > 0 ? out_row[X] : 0.0f;
           out_row[X] = computed[X] > 0 ? l[ci0[X]] : h;  // eq. 4, w_t = 1
         }
       }
       if (dbg_conf) {
-        spatial_row(s, f, o, Y, fill_rows.data(), dbg_conf + row);
+        spatial_row(f, Y, fill_rows.data(), dbg_conf + row);
         for (int c = 0; c < C; ++c)
           for (int X = 0; X < f.W; ++X)
             if (hole[X] > 0) planes[c][row + X] = fill_rows[c][X];
@@ -97,7 +95,7 @@ void run_temporal(Upsampler::State& s, const FrameContext& f, const Options& o, 
             }
           }
           X = b;
-          spatial_row(s, f, o, Y, fill_rows.data(), nullptr, a, b);
+          spatial_row(f, Y, fill_rows.data(), nullptr, a, b);
           for (int c = 0; c < C; ++c)
             for (int x = a; x < b; ++x)
               if (hole[x] > 0) planes[c][row + x] = fill_rows[c][x];
@@ -113,6 +111,62 @@ void run_temporal(Upsampler::State& s, const FrameContext& f, const Options& o, 
   });
   stats.hole_pixels = holes;
   stats.history_pixels = hits;
+}
+
+// The previous output (the history) and the previous frame's depth and ids.
+class TemporalState : public MethodState {
+ public:
+  explicit TemporalState(const Geometry& g) : out_(g), g_(g) {}
+
+  Image& run(const FrameContext& f, bool history, FrameStats& stats) override {
+    Image& out = out_.next();
+    temporal_frame(f, prev_, history, out, out_.previous(), g_.channels, stats);
+    prev_.store(f);
+    return out;
+  }
+  void save(Image& state) const override {
+    for (const auto& c : g_.channels) put_plane(state, "history." + c, out_.current().plane(c), g_.W, g_.H);
+    put_previous(state, prev_, g_.W, g_.H);
+  }
+  Status load(const Image& state) override {
+    Image& out = out_.next();
+    for (const auto& c : g_.channels)
+      if (Status s = get_plane(state, "history." + c, out.plane(c), g_.W, g_.H); !s) return s;
+    return get_previous(state, prev_, g_.W, g_.H);
+  }
+
+ private:
+  OutputPair out_;
+  Geometry g_;
+  PreviousGeometry prev_;
+};
+
+std::vector<LayerNeed> layers(const Options& o) {
+  std::vector<LayerNeed> l = {{"depth"}, {"N"}, {"motion"}};
+  if (!o.no_ids) l.push_back({"id", true, "or pass --no-ids"});
+  return l;
+}
+
+// depth + N, payload in and out; motion, id; the previous depth and id read and written; the history read.
+std::size_t streamed_bytes(const Options&, int W, int H, int k, int C) {
+  const std::size_t full = std::size_t(W) * H * 4, low = full / (std::size_t(k) * k);
+  return 4 * full + C * low + C * full + 2 * full + full + 2 * (2 * full) + C * full;
+}
+
+}  // namespace
+
+const MethodEntry& temporal_method() {
+  static const MethodEntry entry{
+      {"temporal",
+       "temporally-amortised upsampling (seed 000 section 3.2, eq. 4): new samples kept, the previous output at "
+       "p + motion elsewhere, holes filled spatially",
+       true, {}},
+      nullptr,
+      layers,
+      [](const Options&, const Geometry& g) -> std::unique_ptr<MethodState> { return std::make_unique<TemporalState>(g); },
+      streamed_bytes,
+      nullptr};
+  return entry;
 }
 
 }  // namespace temporal::upsample

@@ -1,9 +1,9 @@
-// Internal state and per-frame context shared by the upsampling methods (not installed).
+// The per-frame context and the kernels shared by the upsampling methods (not installed).
 #pragma once
 
 #include "temporal/core/image.h"
-#include "temporal/upsample/joint_bilateral.h"
 #include "temporal/core/reproject.h"
+#include "temporal/upsample/joint_bilateral.h"
 #include "temporal/upsample/upsample.h"
 
 #include <bit>
@@ -42,7 +42,18 @@ inline float fast_exp2(float x) {
   return p * scale;
 }
 
-// Everything one frame needs, resolved and validated by Upsampler::process().
+// Per-column and per-row tap tables of the jittered low-resolution grid: taps x0 = floor((X - sx) / k) and
+// x0 + 1, clamped read indices, 0/1 validity (a tap outside the low image does not exist), offset X - (k x0 + sx).
+struct TapTable {
+  std::vector<int> i0, i1, d;
+  std::vector<float> v0, v1;
+  void build(int full, int low, int k, int s);
+};
+
+// Everything one frame needs, resolved and validated by Upsampler::process(), shared by every method: the frame's
+// planes, the constants derived from the options and headers, and where this frame's low-resolution samples lie
+// (tap tables) with their geometry read from the G-buffer. Owned by the Upsampler and refilled every frame (its
+// buffers are reused).
 struct FrameContext {
   int W = 0, H = 0;      // full (G-buffer) resolution
   int lw = 0, lh = 0;    // low resolution
@@ -54,69 +65,38 @@ struct FrameContext {
   float sigma_d = 1.0f;      // world units
   float depth_range = 1.0f;  // far - near (world units), for the Listing 7.1 depth weight
   std::vector<float> luma;   // C weights of the gradient's scalar "norm" (Rec.709 luminance for R,G,B)
-};
-
-// Per-column and per-row tap tables of the jittered low-resolution grid: taps x0 = floor((X - sx) / k) and
-// x0 + 1, clamped read indices, 0/1 validity (a tap outside the low image does not exist), offset X - (k x0 + sx).
-struct TapTable {
-  std::vector<int> i0, i1, d;
-  std::vector<float> v0, v1;
-  void build(int full, int low, int k, int s);
-};
-
-struct Upsampler::State {
-  int W = 0, H = 0, k = 0, C = 0, lw = 0, lh = 0;
-  bool have_history = false;
-  int prev_sx = 0, prev_sy = 0;
-  std::vector<std::string> channels;
+  const Options* options = nullptr;
+  bool debug = false;        // add the debug.* layers
+  // This frame's samples: tap tables of the jittered grid and the geometry (z, N) of each low-resolution sample
+  // at its full-resolution pixel, with its validity (0 for a non-finite payload or geometry).
   TapTable cols, rows;
-  // Geometry of this frame's low-resolution samples, gathered from the G-buffer, and payload validity.
   std::vector<float> lz, lnx, lny, lnz, lvalid;
-  // Full-resolution results, ping-pong: result[cur] is this frame's, result[1 - cur] the previous one
-  // (the history of `temporal`, `herzog` and drobot `refresh`).
-  Image result[2];
-  int cur = 0;
-  Image aa;  // antialiasing variant: downsampled output
-  // Previous G-buffer depth and id (for the disocclusion tests).
-  std::vector<float> prev_z;
-  std::vector<std::uint32_t> prev_id;
-  // herzog: history weights (ping-pong), scratch of pass A, gradient state at the intermediate resolution.
-  std::vector<float> hw[2];
-  std::vector<float> w_tilde, w_conf, hw_fetch;
-  std::vector<std::vector<float>> hr_fetch;
-  int GW = 0, GH = 0;
-  std::vector<float> dcur, dcount;
-  std::vector<float> dhist[2][3];  // relative gradients of t-1, t-2, t-3 (ping-pong)
-  std::vector<float> wf[2], grad_smooth;
-  std::vector<float> kern_lb, kern_ks;  // image-kernel tables expanded to full-resolution columns (per dy, tap)
-  std::vector<std::vector<float>> pyramid;
-  std::vector<int> pyr_w, pyr_h;
-  std::vector<float> pyr_hx[2];  // the two sampled pyramid levels, rows resampled to the gradient's columns
-  // drobot cache mode: low-resolution history (value, depth, frame count), ping-pong, and filter scratch.
-  std::vector<std::vector<float>> hb_val[2];
-  std::vector<float> hb_z[2], hb_n[2];
-  std::vector<std::vector<float>> cb_val, cb_tmp;
-  std::vector<float> cb_conf, cb_hit, cb_w, cb_strength, cb_avail, cb_avail_h;
-  std::vector<float> bilinear_table;
-  // drobot cache grid: one sample per k x k block at its centre.
-  TapTable cache_cols, cache_rows;
-  std::vector<float> cz, cnx, cny, cnz, cache_table;
 };
 
-// The history taps of full-resolution row Y (temporal/core/reproject.h): the previous frame's depth and ids kept
-// by the state, this frame's G-buffer, the method's disocclusion settings.
+// Fills the sample geometry of `f` (lz .. lvalid) from its G-buffer and payload planes.
+void gather_low_geometry(FrameContext& f);
+
+// Depth and ids of the previous frame, for the disocclusion test of the history fetch.
+struct PreviousGeometry {
+  std::vector<float> z;
+  std::vector<std::uint32_t> id;  // empty when the G-buffer has no ids
+  void store(const FrameContext& f);
+};
+
+// The history taps of full-resolution row Y (temporal/core/reproject.h): the previous frame's depth and ids, this
+// frame's G-buffer, the disocclusion settings of the options.
 using reproject::HistoryRow;
-inline void history_row(const Upsampler::State& s, const FrameContext& f, const Options& o, int Y, HistoryRow& h) {
+inline void history_row(const FrameContext& f, const PreviousGeometry& prev, int Y, HistoryRow& h) {
   reproject::Frames fr;
   fr.width = f.W;
   fr.height = f.H;
   fr.motion_x = f.mx;
   fr.motion_y = f.my;
   fr.z = f.z;
-  fr.prev_z = s.prev_z.data();
+  fr.prev_z = prev.z.data();
   fr.id = f.id;
-  fr.prev_id = s.prev_id.empty() ? nullptr : s.prev_id.data();
-  fr.test = {o.depth_tolerance, o.use_ids};
+  fr.prev_id = prev.id.empty() ? nullptr : prev.id.data();
+  fr.test = f.options->surface_test();
   reproject::reproject_row(fr, Y, h);
 }
 
@@ -141,16 +121,16 @@ class ExpandedLowRows {
   }
   std::size_t stride() const { return std::size_t(WE_); }
   // Slot pointers for the low rows starting at offsets r0 and r1 (row * lw), filled when not cached.
-  void get(const Upsampler::State& s, const FrameContext& f, int r0, int r1, const float*& p0, const float*& p1) {
+  void get(const FrameContext& f, int r0, int r1, const float*& p0, const float*& p1) {
     int a = find(r0);
     if (a < 0) {
       a = slot_[0].key == r1 ? 1 : 0;
-      fill(s, f, r0, slot_[a]);
+      fill(f, r0, slot_[a]);
     }
     int b = find(r1);
     if (b < 0) {
       b = 1 - a;
-      fill(s, f, r1, slot_[b]);
+      fill(f, r1, slot_[b]);
     }
     p0 = slot_[a].v.data();
     p1 = slot_[b].v.data();
@@ -162,9 +142,9 @@ class ExpandedLowRows {
     std::vector<float> v;
   };
   int find(int r) const { return slot_[0].key == r ? 0 : (slot_[1].key == r ? 1 : -1); }
-  void fill(const Upsampler::State& s, const FrameContext& f, int r, Slot& sl) {
-    const float* src[5 + 16] = {s.lz.data() + r, s.lnx.data() + r, s.lny.data() + r, s.lnz.data() + r,
-                                s.lvalid.data() + r};
+  void fill(const FrameContext& f, int r, Slot& sl) {
+    const float* src[5 + 16] = {f.lz.data() + r, f.lnx.data() + r, f.lny.data() + r, f.lnz.data() + r,
+                                f.lvalid.data() + r};
     for (int c = 0; c < f.C; ++c) src[5 + c] = f.low[c] + r;
     for (int q = 0; q < planes_; ++q) expand(src[q], sl.v.data() + std::size_t(q) * WE_, f.lw);
     sl.key = r;
@@ -200,35 +180,31 @@ class ExpandedLowRows {
 };
 
 // Geometric weight of one low-resolution sample (normal nl, depth lz, validity lv: 0 for a non-finite sample)
-// for a pixel of depth zi and normal a: the normal and depth tri-weight tents of seed 000 eq. 2-3, cubed; 0 when
-// the pixel's own geometry is NaN. Every joint-bilateral kernel uses it, so they agree to the bit.
-inline float geometric_weight(float zi, float ax, float ay, float az, float lx, float ly, float lnz, float lz, float lv,
-                              float inv_sn2, float inv_sd2) {
+// for a pixel of depth zi and normal a: eq. 2's n * d (geometric_weight of joint_bilateral.h) times the validity;
+// 0 when the pixel's own geometry is NaN. Every joint-bilateral kernel uses it, so they agree to the bit.
+inline float sample_weight(float zi, float ax, float ay, float az, float lx, float ly, float lnz, float lz, float lv,
+                           float inv_sn2, float inv_sd2) {
   const float dot = ax * lx + ay * ly + az * lnz;
-  const float xn = std::max(0.0f, 1.0f - dot);
-  const float tn = std::max(kKernelEpsilon, 1.0f - xn * xn * inv_sn2);
-  const float dz = zi - lz;
-  const float td = std::max(kKernelEpsilon, 1.0f - dz * dz * inv_sd2);
-  const float w = tn * tn * tn * td * td * td * lv;
+  const float w = geometric_weight(dot, zi - lz, inv_sn2, inv_sd2) * lv;
   return w >= 0.0f ? w : 0.0f;
 }
 
 // For every pixel of full row Y, the geometric weights of its four taps (00, 01: low row i0, columns i0, i1;
 // 10, 11: low row i1) times the taps' existence (TapTable v0 / v1), read from the expanded low rows e0 / e1
 // (ExpandedLowRows, plane stride es) with unit stride: g_j[X] = geometric_weight(tap j) * cv_j[X] * vy_j.
-inline void expanded_geometric_weights(const Upsampler::State& s, const FrameContext& f, float inv_sn2, float inv_sd2,
+inline void expanded_geometric_weights(const FrameContext& f, float inv_sn2, float inv_sd2,
                                        int Y, const float* e0, const float* e1, std::size_t es,
                                        float* __restrict g00, float* __restrict g01, float* __restrict g10,
                                        float* __restrict g11) {
   const int W = f.W, k = f.grid.k;
   const std::size_t row = std::size_t(Y) * W;
-  const float vy0 = s.rows.v0[Y], vy1 = s.rows.v1[Y];
+  const float vy0 = f.rows.v0[Y], vy1 = f.rows.v1[Y];
   const float* __restrict z = f.z + row;
   const float* __restrict nx = f.nx + row;
   const float* __restrict ny = f.ny + row;
   const float* __restrict nz = f.nz + row;
-  const float* __restrict cv0 = s.cols.v0.data();
-  const float* __restrict cv1 = s.cols.v1.data();
+  const float* __restrict cv0 = f.cols.v0.data();
+  const float* __restrict cv1 = f.cols.v1.data();
   // Plane q (0..4: z, nx, ny, nz, valid) of tap t (0: column i0; 1: column i1, the i0 expansion shifted by k).
   auto ex = [es, k](const float* e, int q, int t) { return e + std::size_t(q) * es + std::size_t(t) * k; };
   const float *__restrict z00 = ex(e0, 0, 0), *__restrict z01 = ex(e0, 0, 1), *__restrict z10 = ex(e1, 0, 0),
@@ -244,24 +220,16 @@ inline void expanded_geometric_weights(const Upsampler::State& s, const FrameCon
 #pragma GCC ivdep
   for (int X = 0; X < W; ++X) {
     const float zi = z[X], ax = nx[X], ay = ny[X], az = nz[X];
-    g00[X] = geometric_weight(zi, ax, ay, az, x00[X], y00[X], n00[X], z00[X], v00[X], inv_sn2, inv_sd2) * cv0[X] * vy0;
-    g01[X] = geometric_weight(zi, ax, ay, az, x01[X], y01[X], n01[X], z01[X], v01[X], inv_sn2, inv_sd2) * cv1[X] * vy0;
-    g10[X] = geometric_weight(zi, ax, ay, az, x10[X], y10[X], n10[X], z10[X], v10[X], inv_sn2, inv_sd2) * cv0[X] * vy1;
-    g11[X] = geometric_weight(zi, ax, ay, az, x11[X], y11[X], n11[X], z11[X], v11[X], inv_sn2, inv_sd2) * cv1[X] * vy1;
+    g00[X] = sample_weight(zi, ax, ay, az, x00[X], y00[X], n00[X], z00[X], v00[X], inv_sn2, inv_sd2) * cv0[X] * vy0;
+    g01[X] = sample_weight(zi, ax, ay, az, x01[X], y01[X], n01[X], z01[X], v01[X], inv_sn2, inv_sd2) * cv1[X] * vy0;
+    g10[X] = sample_weight(zi, ax, ay, az, x10[X], y10[X], n10[X], z10[X], v10[X], inv_sn2, inv_sd2) * cv0[X] * vy1;
+    g11[X] = sample_weight(zi, ax, ay, az, x11[X], y11[X], n11[X], z11[X], v11[X], inv_sn2, inv_sd2) * cv1[X] * vy1;
   }
 }
-
-// Per-method implementations (one .cpp each). Each fills s.result[s.cur] and stats.
-void gather_low_geometry(Upsampler::State& s, const FrameContext& f);
-void run_spatial(Upsampler::State& s, const FrameContext& f, const Options& o, FrameStats& stats);
-void run_temporal(Upsampler::State& s, const FrameContext& f, const Options& o, FrameStats& stats);
-void run_herzog(Upsampler::State& s, const FrameContext& f, const Options& o, FrameStats& stats);
-void run_drobot(Upsampler::State& s, const FrameContext& f, const Options& o, FrameStats& stats);
 
 // Joint-bilateral upsampling (eq. 1-3, hat kernel) of full-resolution row Y, columns [X0, X1) (X1 < 0: to the
 // end of the row), into out[c][X0 .. X1) (out rows are indexed by X); `wsum` (a row indexed by X) receives the
 // sum of weights when not null. Shared by `spatial` and the hole filling of `temporal` (only the hole runs).
-void spatial_row(const Upsampler::State& s, const FrameContext& f, const Options& o, int Y, float* const* out,
-                 float* wsum, int X0 = 0, int X1 = -1);
+void spatial_row(const FrameContext& f, int Y, float* const* out, float* wsum, int X0 = 0, int X1 = -1);
 
 }  // namespace temporal::upsample

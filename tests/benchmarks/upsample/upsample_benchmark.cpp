@@ -1,4 +1,5 @@
-// ms per frame of each upsampling method at 1280x1024 (factor 4, R,G,B payload) and, in the same run, the
+// ms per frame of each upsampling method and named variant of the method table (temporal/upsample/methods.h) at
+// 1280x1024 (factor 4, R,G,B payload) and, in the same run, the
 // time to stream the bytes the method must read and write (Upsampler::streamed_bytes: G-buffer planes,
 // payload in and out, full-resolution histories read and written once), measured as a parallel memcpy
 // moving that many bytes (half read, half written). Targets (issue 4): herzog <= 1.5x spatial, and within
@@ -7,6 +8,7 @@
 #include "upsample_variants.h"
 
 #include "temporal/core/parallel.h"
+#include "temporal/upsample/methods.h"
 #include "temporal/upsample/upsample.h"
 
 #include <benchmark/benchmark.h>
@@ -58,9 +60,16 @@ const Inputs& small_inputs() {
   return in;
 }
 
-up::Options options(int method) { return temporal::test::upsample_variant(method); }
-
-const auto& kNames = temporal::test::kUpsampleVariantNames;
+// Benchmark argument m: variant m of the method table.
+const up::MethodVariant& variant(int m) { return up::method_variants()[std::size_t(m)]; }
+up::Options options(int m) { return temporal::test::upsample_variant(variant(m).name); }
+const char* name(int m) { return variant(m).name.c_str(); }
+int variant_index(const char* n) {
+  const auto& all = up::method_variants();
+  for (std::size_t i = 0; i < all.size(); ++i)
+    if (all[i].name == n) return int(i);
+  return 0;
+}
 
 void BM_Upsample(benchmark::State& state) {
   const int m = int(state.range(0));
@@ -73,7 +82,7 @@ void BM_Upsample(benchmark::State& state) {
     auto r = u.process(in.gbuffer, in.low[t++ % in.low.size()], kRGB, false);
     benchmark::DoNotOptimize(r);
   }
-  state.SetLabel(kNames[m]);
+  state.SetLabel(name(m));
   const std::size_t bytes = up::Upsampler::streamed_bytes(options(m), kW, kH, kK, 3);
   state.counters["MB"] = double(bytes) / 1e6;
 }
@@ -91,7 +100,7 @@ void BM_PerPixel(benchmark::State& state) {
     auto r = u.process(in.gbuffer, in.low[t++ % in.low.size()], kRGB, false);
     benchmark::DoNotOptimize(r);
   }
-  state.SetLabel(std::string(kNames[m]) + (scale == 1 ? " full size, 1 thread" : " L3-resident size, 1 thread"));
+  state.SetLabel(std::string(name(m)) + (scale == 1 ? " full size, 1 thread" : " L3-resident size, 1 thread"));
   const double pixels = double(in.gbuffer.width()) * in.gbuffer.height();
   // Seconds per pixel (printed with an SI prefix, e.g. 9.5n = 9.5 ns).
   state.counters["per_pixel"] =
@@ -110,7 +119,7 @@ void BM_Stream(benchmark::State& state) {
                               1 << 16);
     benchmark::ClobberMemory();
   }
-  state.SetLabel(std::string("stream bound of ") + kNames[m]);
+  state.SetLabel(std::string("stream bound of ") + name(m));
   state.counters["MB"] = double(bytes) / 1e6;
 }
 
@@ -121,10 +130,13 @@ void BM_Stream(benchmark::State& state) {
 int main(int argc, char** argv) {
   const char* fixed = std::getenv("UPSAMPLE_BENCH_ITERATIONS");
   const benchmark::IterationCount n = fixed ? std::atoll(fixed) : 0;
-  auto* u = benchmark::RegisterBenchmark("BM_Upsample", BM_Upsample)->DenseRange(0, 5)->Unit(benchmark::kMillisecond)->UseRealTime();
-  auto* m = benchmark::RegisterBenchmark("BM_Stream", BM_Stream)->DenseRange(0, 5)->Unit(benchmark::kMillisecond)->UseRealTime();
+  const int last = int(up::method_variants().size()) - 1;
+  auto* u = benchmark::RegisterBenchmark("BM_Upsample", BM_Upsample)->DenseRange(0, last)->Unit(benchmark::kMillisecond)->UseRealTime();
+  auto* m = benchmark::RegisterBenchmark("BM_Stream", BM_Stream)->DenseRange(0, last)->Unit(benchmark::kMillisecond)->UseRealTime();
+  // One thread's time per pixel of spatial, temporal and herzog.
+  const std::vector<int64_t> per_pixel = {variant_index("spatial"), variant_index("temporal"), variant_index("herzog")};
   auto* p = benchmark::RegisterBenchmark("BM_PerPixel", BM_PerPixel)
-                ->ArgsProduct({{0, 1, 2}, {1, 4}})
+                ->ArgsProduct({per_pixel, {1, 4}})
                 ->Unit(benchmark::kMillisecond)
                 ->UseRealTime();
   if (n > 0) {

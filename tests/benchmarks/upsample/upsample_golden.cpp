@@ -1,7 +1,9 @@
-// Regression helper for optimisation work (not a test): runs every upsampling method on synthetic sequences
-// (the benchmark's 1280x1024 pan; small scenes with a moving object and per-frame G-buffers, debug layers on,
-// k = 4, 3 (odd width) and 2 (gradient scale 4)) and writes every output float to FILE (`write FILE`), or compares against FILE
-// (`check FILE`), printing the largest absolute and relative differences per method.
+// Regression helper for optimisation work on one machine (not a test: float bits differ across CPUs with
+// -march=native and FMA; tests/upsample/reference_test.cpp is the check CTest runs): runs the variants of kNames
+// (the method table's, in the order of the file) on synthetic sequences (the benchmark's 1280x1024 pan; small
+// scenes with a moving object and per-frame G-buffers, debug layers on, k = 4, 3 (odd width) and 2 (gradient
+// scale 4)) and writes every output float to FILE (`write FILE`), or compares against FILE (`check FILE`), printing
+// the largest absolute and relative differences per variant ("max abs 0": bit-identical).
 #include "synthetic.h"
 #include "upsample_variants.h"
 
@@ -12,6 +14,7 @@
 #include <cstdio>
 #include <cstring>
 #include <fstream>
+#include <iterator>
 #include <string>
 #include <vector>
 
@@ -22,8 +25,14 @@ namespace {
 
 const std::vector<std::string> kRGB = {"R", "G", "B"};
 
-up::Options options(int method) { return temporal::test::upsample_variant(method); }
-const auto& kNames = temporal::test::kUpsampleVariantNames;
+// The variants of the file, in its order (the file has no names: a file written before a variant was added stays
+// comparable). Each must be a variant of the method table.
+const char* const kNames[] = {"spatial", "temporal", "herzog", "drobot", "drobot-refresh", "herzog-lagged"};
+constexpr int kVariants = int(std::size(kNames));
+
+up::Options options(int m, std::vector<std::string> extra = {}) {
+  return temporal::test::upsample_variant(kNames[m], std::move(extra));
+}
 
 void append(std::vector<float>& v, const Image& img) {
   for (const auto& n : img.channel_names()) {
@@ -80,8 +89,8 @@ int main(int argc, char** argv) {
     fd.push_back(temporal::test::make_frame(k2, t));
   }
 
-  std::vector<std::vector<float>> results(6);
-  for (int m = 0; m < 6; ++m) {
+  std::vector<std::vector<float>> results(kVariants);
+  for (int m = 0; m < kVariants; ++m) {
     {
       up::Upsampler u(options(m));
       for (int i = 0; i < 40; ++i) {
@@ -91,9 +100,7 @@ int main(int argc, char** argv) {
       }
     }
     {
-      up::Options o = options(m);
-      o.debug_layers = true;
-      up::Upsampler u(o);
+      up::Upsampler u(options(m, {"--debug-layers"}));
       for (int i = 0; i < 24; ++i) {
         auto r = u.process(fb[i].gbuffer, fb[i].low, kRGB, false);
         if (!r) return 2;
@@ -101,13 +108,9 @@ int main(int argc, char** argv) {
       }
     }
     for (int scene = 0; scene < 2; ++scene) {
-      up::Options o = options(m);
-      o.debug_layers = true;
-      if (scene == 1) {
-        o.gradient_scale = 4;
-        o.gradient_mip_level = 3.0f;
-      }
-      up::Upsampler u(o);
+      std::vector<std::string> extra = {"--debug-layers"};
+      if (scene == 1) extra.insert(extra.end(), {"--gradient-scale", "4", "--gradient-mip-level", "3"});
+      up::Upsampler u(options(m, extra));
       const auto& frames = scene == 0 ? fc : fd;
       for (const auto& fr : frames) {
         auto r = u.process(fr.gbuffer, fr.low, kRGB, false);
@@ -127,7 +130,7 @@ int main(int argc, char** argv) {
   }
   std::ifstream f(argv[2], std::ios::binary);
   int bad = 0;
-  for (int m = 0; m < 6; ++m) {
+  for (int m = 0; m < kVariants; ++m) {
     std::uint64_t n = 0;
     f.read(reinterpret_cast<char*>(&n), sizeof n);
     std::vector<float> ref(n);

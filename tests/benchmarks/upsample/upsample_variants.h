@@ -1,26 +1,34 @@
-// The upsampling variants the benchmark and the golden-check tool run, by index (Google Benchmark's range
-// argument): each method once, plus drobot --mode refresh and herzog --lagged-wf.
+// The upsampling variants the benchmark and the golden-check tool run, from the stage's method table
+// (temporal/upsample/methods.h): every method with its defaults and each named variant (herzog-lagged,
+// drobot-refresh, ...).
 #pragma once
 
+#include "temporal/upsample/methods.h"
 #include "temporal/upsample/upsample.h"
+
+#include <cstdio>
+#include <cstdlib>
+#include <string>
+#include <vector>
 
 namespace temporal::test {
 
-inline constexpr int kUpsampleVariants = 6;
-inline constexpr const char* kUpsampleVariantNames[kUpsampleVariants] = {
-    "spatial", "temporal", "herzog", "drobot", "drobot-refresh", "herzog-lagged-wf"};
-
-inline upsample::Options upsample_variant(int index) {
-  upsample::Options o;
-  switch (index) {
-    case 0: o.method = upsample::Method::Spatial; break;
-    case 1: o.method = upsample::Method::Temporal; break;
-    case 2: o.method = upsample::Method::Herzog; break;
-    case 3: o.method = upsample::Method::Drobot; break;
-    case 4: o.method = upsample::Method::Drobot; o.drobot_mode = upsample::DrobotMode::Refresh; break;
-    default: o.method = upsample::Method::Herzog; o.lagged_wf = true; break;
+// Options of a variant with extra command-line style arguments; aborts on a name or argument the table does not
+// know (a broken benchmark definition, not a runtime condition).
+inline upsample::Options upsample_variant(const std::string& name, std::vector<std::string> extra = {}) {
+  const upsample::MethodVariant* v = upsample::find_variant(name);
+  if (!v) {
+    std::fprintf(stderr, "no upsampling variant '%s'\n", name.c_str());
+    std::abort();
   }
-  return o;
+  std::vector<std::string> args = v->args;
+  args.insert(args.end(), extra.begin(), extra.end());
+  auto o = upsample::make_options(v->method, args);
+  if (!o) {
+    std::fprintf(stderr, "variant '%s': %s\n", name.c_str(), o.error().message.c_str());
+    std::abort();
+  }
+  return *o;
 }
 
 }  // namespace temporal::test

@@ -51,6 +51,10 @@ struct Param {
   static Param choice(std::string flag, std::string help, std::string* v, std::vector<std::string> options) {
     return {std::move(flag), std::move(help), v, 0, 0, std::move(options)};
   }
+  static Param text(std::string flag, std::string help, std::string* v) {
+    return {std::move(flag), std::move(help), v, -std::numeric_limits<double>::infinity(),
+            std::numeric_limits<double>::infinity(), {}};
+  }
 };
 using ParamList = std::vector<Param>;
 
@@ -63,5 +67,11 @@ std::string param_range_text(const Param& param);
 Status check_param(const Param& param);
 // check_param for every entry (the first failure).
 Status check_params(const ParamList& params);
+
+// Sets parameters from command-line style arguments, e.g. {"--mode", "refresh", "--lagged-wf"}: a flag (bool)
+// takes no value, every other parameter the next argument; each value is range-checked. For the named variants
+// of a method (benchmarks, pipelines, tests) written the way a user writes them. Usage error for an unknown flag,
+// a missing or malformed value, or a value out of range.
+Status apply_args(const ParamList& params, const std::vector<std::string>& args);
 
 }  // namespace temporal

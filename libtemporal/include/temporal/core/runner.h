@@ -46,6 +46,7 @@ struct SequenceOptions {
 struct LayerNeed {
   std::string layer;  // "motion", "depth", "N", "id", "albedo"
   bool required = true;
+  std::string alternative = {};  // appended to the message when it is missing, e.g. "or pass --no-ids"
 };
 
 // What a stage reads and how its inputs relate.

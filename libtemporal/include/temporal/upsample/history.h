@@ -22,19 +22,31 @@ inline constexpr float kMaxGradient = 1.0f;
 // Largest fall-off of the image-space kernel: gamma * w_f at most 4 (section 3.5).
 inline constexpr float kMaxKernelGamma = 4.0f;
 
-// Eq. 7: h = (h~ w~ + w_f h_w h_r) / (w~ + w_f h_w). With no weight at all (w~ = 0 and no history) the
-// spatial estimate h~ is returned.
-inline float history_blend(float h_tilde, float w_tilde, float w_f, float h_w, float h_r) {
-  const float den = w_tilde + w_f * h_w;
-  return den > 0.0f ? (h_tilde * w_tilde + w_f * h_w * h_r) / den : h_tilde;
+// Sensitivity a of eq. 8 for the paper's elephant scene (section 5: "we used a = 0.7"), `--favor-spatial`.
+inline constexpr float kFavorSpatialA = 0.7f;
+
+// Eq. 7 with the history's weight w_hist = w_f h_w already multiplied out (the per-pixel form herzog runs: the
+// product also feeds the weight update): h = (h~ w~ + w_hist h_r) / (w~ + w_hist). With no weight at all
+// (w~ = 0 and no history) the spatial estimate h~ is returned.
+inline float history_blend_weighted(float h_tilde, float w_tilde, float w_hist, float h_r) {
+  const float den = w_tilde + w_hist;
+  return den > 0.0f ? (h_tilde * w_tilde + w_hist * h_r) / den : h_tilde;
 }
 
-// History weight update after eq. 7: h_w := w~ + w_f h_w, bounded by `max_weight`. Without the bound h_w
-// grows without limit in static regions (w_f = 1), so a new sample would eventually weigh nothing and
+// Eq. 7: h = (h~ w~ + w_f h_w h_r) / (w~ + w_f h_w).
+inline float history_blend(float h_tilde, float w_tilde, float w_f, float h_w, float h_r) {
+  return history_blend_weighted(h_tilde, w_tilde, w_f * h_w, h_r);
+}
+
+// History weight update after eq. 7, h_w := w~ + w_hist (w_hist = w_f h_w), bounded by `max_weight`. Without the
+// bound h_w grows without limit in static regions (w_f = 1), so a new sample would eventually weigh nothing and
 // float precision would be lost; bounded, eq. 7 becomes an exponential moving average whose newest
 // frame has at least the weight w~ / (w~ + max_weight).
+inline float bounded_history_weight(float w_tilde, float w_hist, float max_weight) {
+  return std::min(w_tilde + w_hist, max_weight);
+}
 inline float history_weight_update(float w_tilde, float w_f, float h_w, float max_weight) {
-  return std::min(w_tilde + w_f * h_w, max_weight);
+  return bounded_history_weight(w_tilde, w_f * h_w, max_weight);
 }
 
 // Relative temporal gradient of section 3.5.1: (cur - prev) / max(|cur|, |prev|); 0 when both are 0.

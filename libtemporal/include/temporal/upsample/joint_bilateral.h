@@ -46,6 +46,18 @@ inline float normal_weight(float dot, float sigma_n = kSigmaNormal) {
 // (linear view depth).
 inline float depth_weight(float z_i, float z_j, float sigma_d) { return tri_weight(z_i - z_j, sigma_d); }
 
+// Eq. 2's geometric factor n * d of one sample in the per-pixel form every joint-bilateral kernel of the stage
+// runs (spatial, temporal's hole filling, herzog's eq. 6): both tri-weights of eq. 3 with 1 / sigma^2
+// precomputed, multiplied out in one expression. `dot` = n_i . n_j, `dz` = z_i - z_j (world units),
+// inv_sn2 = 1 / sigma_n^2, inv_sd2 = 1 / sigma_d^2. Equals normal_weight(dot, sigma_n) * depth_weight(z_i, z_j,
+// sigma_d) up to float rounding (tests/upsample/equations_test.cpp); NaN geometry gives NaN (callers drop it).
+inline float geometric_weight(float dot, float dz, float inv_sn2, float inv_sd2) {
+  const float xn = std::max(0.0f, 1.0f - dot);
+  const float tn = std::max(kKernelEpsilon, 1.0f - xn * xn * inv_sn2);
+  const float td = std::max(kKernelEpsilon, 1.0f - dz * dz * inv_sd2);
+  return tn * tn * tn * td * td * td;
+}
+
 // Image-space kernel of the spatio-temporal method (section 3.3): k(i, j) = g(|x(i) - x(j)|, r, gamma) with
 // r the low-resolution pixel diagonal in full-resolution pixels (r = k * sqrt(2)).
 inline float image_kernel(float distance_px, float r, float gamma) { return kernel_g(distance_px, r, gamma); }

@@ -1,15 +1,16 @@
 // Upsampling of a jittered low-resolution shading payload to full resolution with a full-resolution
 // G-buffer: the methods of seed 000 (Herzog et al. 2010) and seed 002 (Drobot 2011), used by `upsample-st`.
 //
+// The methods are units listed in one table (temporal/upsample/methods.h; libtemporal/src/upsample/registry.cpp):
 //   spatial   joint-bilateral upsampling, seed 000 eq. 1-3 (hat image kernel)            [joint_bilateral.h]
 //   temporal  temporally-amortised upsampling, seed 000 eq. 4: pixels shaded this frame are kept, the
-//             others are fetched from the previous output at p + motion; disocclusions (depth + id,
-//             Figure 3) have no history and are filled spatially and counted ("hole pixels")  [temporal/core/reproject.h]
+//             others are fetched from the previous output at p + motion; disocclusions have no history and
+//             are filled spatially and counted ("hole pixels")                           [temporal/core/reproject.h]
 //   herzog    spatio-temporal upsampling, seed 000 sections 3.3-3.5: exponential history (eq. 6-7),
 //             image kernel with fall-off gamma * w_f, w_f from the filtered relative gradient (eq. 8)  [history.h]
 //   drobot    seed 002: reprojection cache at low resolution + exponential history with convergence,
 //             convergence-steered separable bilateral filter, Listing 7.1 bilateral upsampling; or its
-//             refresh-buffer reconstruction (Figure 7.12, `DrobotMode::Refresh`)              [drobot.h]
+//             refresh-buffer reconstruction (Figure 7.12, `--mode refresh`)                 [drobot.h]
 //
 // Inputs per frame (docs/conventions.md): the G-buffer at full resolution (`depth.Z`, `N.X/Y/Z`,
 // `motion.X/Y`, `id`; metadata clipNear/clipFar) and the payload at 1/k resolution per axis with
@@ -17,61 +18,70 @@
 // (seed 000 section 4, `aa_factor` m > 1) the G-buffer is m x m the output resolution and the result is
 // box-downsampled by m.
 //
-// State: an Upsampler keeps its histories in buffers allocated once and reused for every frame; process()
-// allocates nothing per pixel. Non-finite payload values are counted and never enter a history.
+// State: each method keeps its histories in its own state object, allocated when the frame size is first
+// seen and reused for every frame; process() allocates nothing per pixel. Non-finite payload values are counted
+// and never enter a history. save_state() / load_state() carry everything the next frame needs (--state-out /
+// --state-in), so that a resumed run is bit-identical to an uninterrupted one.
 #pragma once
 
 #include "temporal/core/error.h"
 #include "temporal/core/image.h"
+#include "temporal/core/params.h"
+#include "temporal/core/reproject.h"
+#include "temporal/upsample/joint_bilateral.h"
 
 #include <cstddef>
 #include <memory>
-#include <optional>
 #include <span>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace temporal::upsample {
 
-enum class Method { Spatial, Temporal, Herzog, Drobot };
-enum class DrobotMode { Cache, Refresh };
+// A method's own parameters: an options struct defined in the method's source file (its fields hold the
+// defaults) that lists them as Params pointing at those fields. Options holds one per registered method, so that
+// the command line binds every method's flags before the method is chosen.
+class MethodOptions {
+ public:
+  virtual ~MethodOptions() = default;
+  virtual std::unique_ptr<MethodOptions> clone() const = 0;
+  virtual ParamList params() = 0;
+  // Checks that a range cannot express (e.g. a power of two); the ranges themselves are checked by the Params.
+  virtual Status check() const { return Status::ok(); }
+};
 
-// Parses "spatial|temporal|herzog|drobot" and "cache|refresh".
-Expected<Method> parse_method(const std::string& name);
-Expected<DrobotMode> parse_drobot_mode(const std::string& name);
-const char* method_name(Method m);
+// The per-method options of Options: one entry per registered method, copied deeply.
+class MethodOptionSet {
+ public:
+  MethodOptionSet();  // every registered method's options, with their defaults
+  MethodOptionSet(const MethodOptionSet& other);
+  MethodOptionSet& operator=(const MethodOptionSet& other);
+  MethodOptionSet(MethodOptionSet&&) noexcept = default;
+  MethodOptionSet& operator=(MethodOptionSet&&) noexcept = default;
+  ~MethodOptionSet();
+  // The options of method `name` (nullptr for a method without parameters or an unknown name).
+  MethodOptions* find(const std::string& name);
+  const MethodOptions* find(const std::string& name) const;
 
+ private:
+  std::vector<std::pair<std::string, std::unique_ptr<MethodOptions>>> entries_;
+};
+
+// Options of the upsampling stage. The defaults are here (shared parameters) and in each method's options struct
+// (MethodOptions); the command line binds to them through params().
 struct Options {
-  Method method = Method::Herzog;
+  std::string method = "herzog";  // a name of methods() (temporal/upsample/methods.h)
+  std::string layer = "rgb";      // payload layers: `rgb` (bare R,G,B) or layer names, comma-separated
 
-  // --- seed 000, section 3.1 (spatial weights) ---
-  float sigma_normal = 0.2f;           // sigma_n of eq. 2
-  float sigma_depth_fraction = 0.03f;  // sigma_d = fraction * (clipFar - clipNear)
-  float sigma_depth = 0.0f;            // > 0: absolute sigma_d (world units), overrides the fraction
+  // --- seed 000, section 3.1 (spatial weights, every method) ---
+  float sigma_normal = kSigmaNormal;                 // sigma_n of eq. 2
+  float sigma_depth_fraction = kSigmaDepthFraction;  // sigma_d = fraction * (clipFar - clipNear)
+  float sigma_depth = 0.0f;                          // > 0: absolute sigma_d (world units), overrides the fraction
 
-  // --- seed 000, sections 3.2-3.5 ---
-  float depth_tolerance = 0.05f;  // relative depth difference above which a history tap is disoccluded
-  bool use_ids = true;            // also compare material ids (Figure 3)
-  float kernel_gamma = 4.0f;      // gamma of the image kernel k; the fall-off used is min(gamma * w_f, cap)
-  float max_kernel_gamma = 4.0f;  // the cap of gamma * w_f (seed 000: 4)
-  float min_kernel_gamma = 0.0f;  // floor of the fall-off (seed 000: 0, a flat kernel where w_f = 0)
-  float a = 1.0f;                 // eq. 8 sensitivity (the paper's elephant scene used 0.7)
-  int gradient_scale = 2;         // intermediate resolution of the gradient: full / scale (power of 2)
-  float gradient_mip_level = 2.5f;  // spatial low-pass: trilinear mip level, in full-resolution levels
-  float max_history_weight = 0.0f;  // bound of h_w; 0 = 2 * k * k (see docs/upsample-st.md)
-  bool lagged_wf = false;           // eq. 7 with the previous frame's w_f (motion-compensated): one pass over
-                                    // the image instead of three, w_f reacts one frame later
-
-  // --- seed 002 ---
-  DrobotMode drobot_mode = DrobotMode::Cache;
-  float normal_power = 32.0f;       // contrastCoef of Listing 7.1
-  bool drobot_normals = true;       // false: depth-only weights (the chapter's SSAO variant)
-  float miss_threshold = 0.02f;     // IN_MissThreshold of Listing 7.2 (relative depth)
-  float convergence_time = 50.0f;   // IN_ConvergenceTime of Listing 7.2
-  float max_frames = 0.0f;          // frames in the exponential history; 0 = k * k (pattern length)
-  float filter_amp = 200.0f;        // IN_BilateralFilterAmp of Listing 7.3 (per relative depth)
-  bool cache_bilinear = true;       // cache values read with bilinear (true) or point (false) filtering; the
-                                    // depth test always uses bilinear depth (Listing 7.2)
+  // --- the history fetch (temporal/core/reproject.h: the disocclusion test every history method uses) ---
+  float depth_tolerance = reproject::kDepthTolerance;  // relative depth difference of a disoccluded tap
+  bool no_ids = false;                                 // depth only: do not compare material ids (Figure 3)
 
   // --- seed 000 section 4 ---
   int aa_factor = 1;  // m: G-buffer is m x m the output; the result is box-downsampled
@@ -83,7 +93,31 @@ struct Options {
   bool demodulate = false;
 
   bool debug_layers = false;  // add debug.* layers to the result
+
+  MethodOptionSet per_method;  // each method's own parameters
+
+  // The disocclusion test of the history fetch.
+  reproject::SurfaceTest surface_test() const { return {depth_tolerance, !no_ids}; }
 };
+
+// Every parameter of the stage, pointing at the fields of `options`: the shared ones, then each method's (help
+// prefixed with the method's name). Valid while `options` lives and is not moved.
+ParamList params(Options& options);
+
+// Options for `method` with parameters set by command-line style arguments (apply_args), e.g.
+// make_options("drobot", {"--mode", "refresh"}). Usage error for an unknown method or parameter.
+Expected<Options> make_options(const std::string& method, const std::vector<std::string>& args = {});
+
+// The selected method's own parameters as the arguments that set them, every one with its value (defaults
+// included; flags only when on), e.g. "--kernel-gamma 4 --max-kernel-gamma 4 ... --a 0.7 --gradient-scale 2":
+// the `temporal:methodParameters` header of every output, so a result says which a, cap, mode, ... made it.
+// make_options(method, split(text)) gives the same options (values to 6 significant digits). Empty for a method
+// without parameters.
+std::string method_parameters(const Options& options);
+
+// Usage error unless every value is valid: the method exists, every parameter is inside its range, and each
+// method's own checks pass.
+Status check(const Options& options);
 
 // What happened in one frame.
 struct FrameStats {
@@ -100,11 +134,8 @@ struct FrameNames {
   std::string input;
 };
 
-// Layers of the G-buffer each method reads (for read_exr's selection).
+// Layers of the G-buffer the method reads (for read_exr's selection): its own, plus `albedo` with demodulation.
 std::vector<std::string> gbuffer_layers(const Options& options);
-
-// Counts non-finite values in the G-buffer layers the method reads.
-std::size_t count_non_finite_gbuffer(const Image& gbuffer);
 
 // Payload channels for a `--layer` value: "rgb" = R,G,B; "NAME" = NAME.* of `low`; a comma-separated list
 // takes several. An Input error when a layer is missing.
@@ -113,34 +144,44 @@ Expected<std::vector<std::string>> select_channels(const Image& low, const std::
 
 class Upsampler {
  public:
+  // `options` must pass check(); an unknown method makes every process() fail with a usage error.
   explicit Upsampler(Options options);
   ~Upsampler();
   Upsampler(const Upsampler&) = delete;
   Upsampler& operator=(const Upsampler&) = delete;
 
-  const Options& options() const { return options_; }
+  const Options& options() const;
 
   // Upsamples one frame. `channels` names the payload channels of `low` to rebuild. `cut` discards the
   // history first (also done on the first frame, a size change, or `temporal:cameraCut` in either header).
   // The result holds the same channel names at output resolution (+ debug.* layers when enabled); it is
   // owned by the Upsampler and valid until the next call. Errors: Input (missing layers, sizes that do
-  // not match full = k * low, missing jitter metadata, jitter off the regular pattern).
+  // not match full = k * low, missing jitter metadata, jitter off the regular pattern, a loaded state of another
+  // size), Usage (bad options).
   Expected<Image*> process(const Image& gbuffer, const Image& low, std::span<const std::string> channels, bool cut,
                            FrameStats* stats = nullptr, const FrameNames& names = {});
 
   // Discards every history.
   void reset();
 
+  // Whether the method keeps anything between frames (spatial does not).
+  bool has_state() const;
+  // Everything the next frame needs (histories, weights, gradients, previous depth and ids), as planes of an
+  // image at the G-buffer's size (smaller planes in its top-left corner), with the method, sizes and channels in
+  // its header (docs/upsample-st.md, "State files"). Usage error before the first frame or without state.
+  Expected<Image> save_state() const;
+  // Resumes from a save_state() image: the next process() continues as if the frames before had just been
+  // processed. Checked now: the method and its options that shape the state; at the next process(): the frame
+  // size, k and channels (an Input error there names --state-in).
+  Status load_state(const Image& state);
+
   // Bytes per frame a method must read and write at this size (streaming bound of the benchmark).
   static std::size_t streamed_bytes(const Options& options, int full_width, int full_height, int k, int channels);
 
-  struct State;
+  struct Impl;
 
  private:
-  Options options_;
-  std::unique_ptr<State> state_;
-  struct Demodulation;
-  std::unique_ptr<Demodulation> demod_;
+  std::unique_ptr<Impl> impl_;
 };
 
 }  // namespace temporal::upsample

@@ -1,0 +1,182 @@
+// The methods of the upsampling stage, as one table, and what is derived from it: the options of every method,
+// the parameter list the command line binds, the G-buffer layers, the variants of the benchmark and pipelines.
+#include "method.h"
+
+#include <algorithm>
+#include <limits>
+
+namespace temporal::upsample {
+namespace {
+constexpr double kUnbounded = std::numeric_limits<double>::infinity();
+}  // namespace
+
+// Every method, in the order of --help, --list-methods and the docs. Adding a method: its source file defines
+// `const MethodEntry& NAME_method()` (options, state, run, streamed bytes), and one line here lists it.
+const MethodEntry& spatial_method();   // spatial.cpp
+const MethodEntry& temporal_method();  // temporal.cpp
+const MethodEntry& herzog_method();    // herzog.cpp
+const MethodEntry& drobot_method();    // drobot.cpp
+
+const std::vector<const MethodEntry*>& registry() {
+  static const std::vector<const MethodEntry*> table = {&spatial_method(), &temporal_method(), &herzog_method(),
+                                                        &drobot_method()};
+  return table;
+}
+
+const MethodEntry* find_entry(const std::string& name) {
+  for (const MethodEntry* e : registry())
+    if (e->info.name == name) return e;
+  return nullptr;
+}
+
+const std::vector<MethodInfo>& methods() {
+  static const std::vector<MethodInfo> list = [] {
+    std::vector<MethodInfo> v;
+    for (const MethodEntry* e : registry()) v.push_back(e->info);
+    return v;
+  }();
+  return list;
+}
+
+const MethodInfo* find_method(const std::string& name) {
+  for (const MethodInfo& m : methods())
+    if (m.name == name) return &m;
+  return nullptr;
+}
+
+const std::vector<MethodVariant>& method_variants() {
+  static const std::vector<MethodVariant> list = [] {
+    std::vector<MethodVariant> v;
+    for (const MethodInfo& m : methods()) {
+      v.push_back({m.name, m.name, {}, m.summary});
+      v.insert(v.end(), m.variants.begin(), m.variants.end());
+    }
+    return v;
+  }();
+  return list;
+}
+
+const MethodVariant* find_variant(const std::string& name) {
+  for (const MethodVariant& v : method_variants())
+    if (v.name == name) return &v;
+  return nullptr;
+}
+
+const std::vector<VariantSuffix>& variant_suffixes() {
+  static const std::vector<VariantSuffix> list = {
+      {"-demod", {"--demodulate"}, "any method on the demodulated lighting (seed 000 section 4, shader splitting)"}};
+  return list;
+}
+
+// --- Options --------------------------------------------------------------------------------------------------
+
+MethodOptionSet::MethodOptionSet() {
+  for (const MethodEntry* e : registry())
+    if (e->make_options) entries_.emplace_back(e->info.name, e->make_options());
+}
+MethodOptionSet::MethodOptionSet(const MethodOptionSet& other) { *this = other; }
+MethodOptionSet& MethodOptionSet::operator=(const MethodOptionSet& other) {
+  if (this == &other) return *this;
+  entries_.clear();
+  for (const auto& [name, options] : other.entries_) entries_.emplace_back(name, options->clone());
+  return *this;
+}
+MethodOptionSet::~MethodOptionSet() = default;
+
+MethodOptions* MethodOptionSet::find(const std::string& name) {
+  for (auto& [n, options] : entries_)
+    if (n == name) return options.get();
+  return nullptr;
+}
+const MethodOptions* MethodOptionSet::find(const std::string& name) const {
+  return const_cast<MethodOptionSet*>(this)->find(name);
+}
+
+ParamList params(Options& o) {
+  std::vector<std::string> names;
+  for (const MethodInfo& m : methods()) names.push_back(m.name);
+  ParamList list = {
+      Param::choice("--method", "Upsampling method (upsample-st --list-methods describes each)", &o.method, names),
+      Param::text("--layer", "Payload layers to upsample: rgb (bare R,G,B) or layer names, comma-separated", &o.layer),
+      Param::flag_on("--debug-layers",
+                     "Add debug.* layers: confidence, disocclusion, gradient, wf, historyWeight, convergence",
+                     &o.debug_layers),
+      Param::real("--sigma-normal", "sigma_n of the normal weight (seed 000 eq. 2)", &o.sigma_normal, 1e-3, 1e3),
+      Param::real("--sigma-depth-fraction", "sigma_d as a fraction of clipFar - clipNear (seed 000 section 3.1: 3%)",
+                  &o.sigma_depth_fraction, 1e-6, 1.0),
+      Param::real("--sigma-depth", "Absolute sigma_d in world units; 0 uses --sigma-depth-fraction", &o.sigma_depth,
+                  0.0, kUnbounded),
+      Param::real("--depth-tolerance",
+                  "Relative depth difference above which a history tap is disoccluded (temporal/core/reproject.h)",
+                  &o.depth_tolerance, 0.0, 10.0),
+      Param::flag_on("--no-ids", "Disocclusion test on depth only (no material-id comparison, seed 000 Figure 3)",
+                     &o.no_ids),
+  };
+  for (const MethodEntry* e : registry())
+    if (MethodOptions* m = o.per_method.find(e->info.name))
+      for (Param p : m->params()) {
+        p.help = e->info.name + ": " + p.help;
+        list.push_back(std::move(p));
+      }
+  list.push_back(Param::flag_on("--demodulate",
+                                "Upsample lighting only: divide R,G,B by the G-buffer albedo, multiply the result "
+                                "back (seed 000 section 4); needs `albedo` in the G-buffer",
+                                &o.demodulate));
+  list.push_back(Param::integer("--aa-factor",
+                                "Antialiasing variant (seed 000 section 4): the G-buffer is m x m the output "
+                                "resolution; the result is box-downsampled by m",
+                                &o.aa_factor, 1, 8));
+  return list;
+}
+
+Status check(const Options& options) {
+  if (!find_entry(options.method)) {
+    std::string names;
+    for (const MethodInfo& m : methods()) names += (names.empty() ? "" : ", ") + m.name;
+    return Error::usage("unknown method '" + options.method + "': use one of " + names);
+  }
+  Options copy = options;  // params() points at the fields it is given
+  if (Status s = check_params(params(copy)); !s) return s;
+  for (const MethodEntry* e : registry())
+    if (const MethodOptions* m = options.per_method.find(e->info.name))
+      if (Status s = m->check(); !s) return s;
+  return Status::ok();
+}
+
+Expected<Options> make_options(const std::string& method, const std::vector<std::string>& args) {
+  Options o;
+  o.method = method;
+  if (Status s = apply_args(params(o), args); !s) return s.error();
+  if (Status s = check(o); !s) return s.error();
+  return o;
+}
+
+std::string method_parameters(const Options& o) {
+  Options copy = o;  // params() points at the fields it is given
+  MethodOptions* m = copy.per_method.find(o.method);
+  if (!m) return {};
+  std::string text;
+  for (const Param& p : m->params()) {
+    const std::string value = param_value_text(p);
+    const bool flag = std::holds_alternative<bool*>(p.value);
+    if (flag && value != "on") continue;
+    text += (text.empty() ? "" : " ") + p.flag;
+    if (!flag) text += " " + value;
+  }
+  return text;
+}
+
+std::vector<std::string> gbuffer_layers(const Options& o) {
+  std::vector<std::string> layers;
+  if (const MethodEntry* e = find_entry(o.method))
+    for (const LayerNeed& n : e->layers(o)) layers.push_back(n.layer);
+  if (o.demodulate) layers.push_back("albedo");
+  return layers;
+}
+
+std::size_t Upsampler::streamed_bytes(const Options& o, int W, int H, int k, int C) {
+  const MethodEntry* e = find_entry(o.method);
+  return e ? e->streamed_bytes(o, W, H, k, C) : 0;
+}
+
+}  // namespace temporal::upsample
