@@ -85,7 +85,8 @@ TEST_F(MorphStageRun, BlendSeesTheNextSelectedFrameAndTheLastOneRepeats) {
   EXPECT_DOUBLE_EQ(*md.fps, 120.0);
   EXPECT_NEAR(*md.time, 4.0 / 120.0, 1e-7);
   EXPECT_EQ(md.extra.at("method"), "blend");
-  EXPECT_EQ(md.extra.at("latencyFrames"), "1");
+  // One rendered frame of latency is factor = 3 output frames: slot k of frame n is shown 3 output frames late.
+  EXPECT_EQ(md.extra.at("latencyFrames"), "3");
   EXPECT_EQ(md.extra.at("sourceFrame"), "1");
   EXPECT_EQ(md.extra.at("slot"), "1");
   EXPECT_FALSE(md.world_to_camera.has_value()) << "an extrapolated slot has no camera of its own";

@@ -108,7 +108,10 @@ class UpsampleStage final : public FrameStage {
       o.compute_ms = total_ms_ / n;  // the rendered frame's work produces all its slots: each gets an equal share
       o.timings_ms = {{"flow", timings_.flow_ms}, {"morph", timings_.morph_ms}, {"blur", timings_.blur_ms}};
       o.extra = {{"method", info_.name},
-                 {"latencyFrames", std::to_string(info_.latency_frames)},
+                 // In frames of the output sequence: slot k of rendered frame n can be shown only once the
+                 // method's lookahead has been rendered, latency_frames rendered frames = latency_frames * n
+                 // display frames later (docs/conventions.md, "Latency").
+                 {"latencyFrames", std::to_string(info_.latency_frames * n)},
                  {"sourceFrame", std::to_string(f.frame)},
                  {"slot", std::to_string(k)}};
       o.keep_input_metadata = false;

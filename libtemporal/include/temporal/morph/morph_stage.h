@@ -4,7 +4,8 @@
 //  - input frame n becomes output frames n*factor + k, k = 0..factor-1, with temporal:fps = fps*factor and
 //    temporal:time = (n*factor + k) / (fps*factor); fps is --fps or the input header's temporal:fps;
 //  - slots k >= 1 drop the rendered frame's camera matrices, jitter and camera cut (they do not describe an
-//    extrapolated frame); every slot records method, latencyFrames, sourceFrame, slot and the flow / morph /
+//    extrapolated frame); every slot records method, latencyFrames (output frames: the method's rendered
+//    frames of latency times factor), sourceFrame, slot and the flow / morph /
 //    blur timings (seed 004 Table 1);
 //  - methods with lookahead (blend) see frame n+1 of the selected frames (the last one repeats);
 //  - NaN and Inf input values (counted and reported by the runner) are replaced by 0 before a method sees them;
