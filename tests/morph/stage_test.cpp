@@ -133,6 +133,61 @@ TEST_F(MorphStageRun, PerceiveReadsItsWindowPastTheSelectedFramesWhileTheyExist)
   EXPECT_NEAR(value(2), 0.6f, 1e-6f);
 }
 
+// --perceive --lag-reference: the native stream's bump moves right 1 px per 120 Hz frame; a stream that shows
+// every frame 2 frames late (and declares temporal:latencyFrames = 3, so it is aligned against native frame
+// t + 3) lags by 2 + 3 = 5 frames = 41.667 ms at 120 Hz.
+TEST_F(MorphStageRun, PerceiveWithALagReferenceReportsTheLagApartFromTheBlur) {
+  const int w = 64, h = 4;
+  auto bump_frame = [&](const std::string& file, float centre, const char* latency) {
+    Image c = test::make_color(w, h, [=](float x, float, int) {
+      const float d = (x - centre) / 3.0f;
+      return 0.5f * std::exp(-0.5f * d * d);
+    });
+    c.metadata().fps = 120.0;
+    if (latency) c.metadata().extra["latencyFrames"] = latency;
+    ASSERT_TRUE(write_exr(path(file), c));
+  };
+  for (int t = 0; t <= 12; ++t) {
+    const std::string n = std::to_string(1000 + t).substr(1);
+    bump_frame("native." + n + ".exr", 20.5f + float(t), nullptr);
+    bump_frame("late." + n + ".exr", 20.5f + float(t) - 2.0f, "3");
+    Image g = test::make_gbuffer(w, h, [](int, int, float& mx, float& my, float& d) {
+      mx = -1.0f;
+      my = 0.0f;
+      d = 2.0f;
+    });
+    ASSERT_TRUE(write_exr(path("mg." + n + ".exr"), g));
+  }
+  MorphStageOptions o;
+  o.perceive = true;
+  auto stage = make_morph_stage(o);
+  ASSERT_TRUE(stage);
+  SequenceOptions seq;
+  seq.input = path("native.###.exr");
+  seq.gbuffer = path("mg.###.exr");
+  seq.out = path("pn/p.####.exr");
+  seq.frames = "0-10";
+  ASSERT_TRUE(run_sequence(seq, **stage, {"morph-120hz test", "test"}, {}));
+  o.lag_reference = path("pn/p.####.exr");
+  ASSERT_TRUE(run(o, "late", "2-4", "mg"));
+  auto img = read_exr(path("out/o.0003.exr"));
+  ASSERT_TRUE(img);
+  const auto& md = img->metadata();
+  EXPECT_EQ(md.extra.at("lagFrames"), "5.00000");
+  EXPECT_EQ(md.extra.at("lagMs"), "41.6667");  // 5 * 1000 / 120
+  EXPECT_EQ(md.extra.at("lagReferenceFrame"), "6");
+  // The aligned layer is the native perceived frame 6 (interior pixels; the border repeats its edge tap).
+  auto native6 = read_exr(path("pn/p.0006.exr"));
+  ASSERT_TRUE(native6);
+  for (int x = 8; x < w - 8; ++x) EXPECT_NEAR(img->plane("aligned.G")[x], native6->plane("G")[x], 1e-5f) << x;
+  // The last frames are shown past the native perceived frames that exist: a clear input error.
+  auto r = run(o, "late", "8-9", "mg");
+  ASSERT_FALSE(r);
+  EXPECT_EQ(r.error().kind, ErrorKind::Input);
+  EXPECT_NE(r.error().message.find("run --perceive on the native sequence through frame 11"), std::string::npos)
+      << r.error().message;
+}
+
 TEST_F(MorphStageRun, ClearErrors) {
   write_color("nofps", 0, 0.5f, false);
   MorphStageOptions o;

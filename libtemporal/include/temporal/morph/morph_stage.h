@@ -11,7 +11,8 @@
 //  - NaN and Inf input values (counted and reported by the runner) are replaced by 0 before a method sees them;
 //  - the eye-tracking limit's pixels per degree comes from the viewing geometry and the image width;
 //  - `perceive`: instead of upsampling, the hold-type blur simulation of temporal/morph/hold_blur.h, whose window
-//    of displayed frames reads past the selected frames while files exist (the eye keeps integrating).
+//    of displayed frames reads past the selected frames while files exist (the eye keeps integrating); with a
+//    lag reference, the lag apart from the blur (align_lag).
 #pragma once
 
 #include "temporal/core/error.h"
@@ -48,6 +49,12 @@ struct MorphStageOptions {
   ViewingOptions viewing;
   bool perceive = false;  // simulate hold-type blur instead of upsampling
   HoldBlurOptions hold;   // perceive: the eye's window
+  // perceive: the perceived images of the reference (native) stream, PATTERN.####.exr. When set, each frame t is
+  // also aligned to the reference's perceived frame t + L (L = the input's temporal:latencyFrames: the instant
+  // it is shown) by the best shift along the motion (align_lag, hold_blur.h): layer `aligned.R,G,B`, headers
+  // temporal:lagFrames and temporal:lagMs.
+  std::string lag_reference;
+  LagSearchOptions lag;
 };
 
 // Every parameter of the tool: the method (its choices and help from the registry), factor, fps, debug layers,
