@@ -133,9 +133,9 @@ TEST_F(MorphStageRun, PerceiveReadsItsWindowPastTheSelectedFramesWhileTheyExist)
   EXPECT_NEAR(value(2), 0.6f, 1e-6f);
 }
 
-// --perceive --lag-reference: the native stream's bump moves right 1 px per 120 Hz frame; a stream that shows
-// every frame 2 frames late (and declares temporal:latencyFrames = 3, so it is aligned against native frame
-// t + 3) lags by 2 + 3 = 5 frames = 41.667 ms at 120 Hz.
+// --perceive --lag-reference: the native stream's bump moves right 1 px per 120 Hz frame; a stream whose content
+// is 2 frames late (found by the search against native frame t) and that declares temporal:latencyFrames = 3
+// (added) lags by 2 + 3 = 5 frames = 41.667 ms at 120 Hz.
 TEST_F(MorphStageRun, PerceiveWithALagReferenceReportsTheLagApartFromTheBlur) {
   const int w = 64, h = 4;
   auto bump_frame = [&](const std::string& file, float centre, const char* latency) {
@@ -173,15 +173,16 @@ TEST_F(MorphStageRun, PerceiveWithALagReferenceReportsTheLagApartFromTheBlur) {
   auto img = read_exr(path("out/o.0003.exr"));
   ASSERT_TRUE(img);
   const auto& md = img->metadata();
+  EXPECT_EQ(md.extra.at("lagContentFrames"), "2.00000");
   EXPECT_EQ(md.extra.at("lagFrames"), "5.00000");
   EXPECT_EQ(md.extra.at("lagMs"), "41.6667");  // 5 * 1000 / 120
-  EXPECT_EQ(md.extra.at("lagReferenceFrame"), "6");
-  // The aligned layer is the native perceived frame 6 (interior pixels; the border repeats its edge tap).
-  auto native6 = read_exr(path("pn/p.0006.exr"));
-  ASSERT_TRUE(native6);
-  for (int x = 8; x < w - 8; ++x) EXPECT_NEAR(img->plane("aligned.G")[x], native6->plane("G")[x], 1e-5f) << x;
-  // The last frames are shown past the native perceived frames that exist: a clear input error.
-  auto r = run(o, "late", "8-9", "mg");
+  EXPECT_EQ(md.extra.at("lagReferenceFrame"), "3");
+  // The aligned layer is the native perceived frame 3 (interior pixels; the border repeats its edge tap).
+  auto native3 = read_exr(path("pn/p.0003.exr"));
+  ASSERT_TRUE(native3);
+  for (int x = 8; x < w - 8; ++x) EXPECT_NEAR(img->plane("aligned.G")[x], native3->plane("G")[x], 1e-5f) << x;
+  // A frame past the native perceived frames that exist: a clear input error.
+  auto r = run(o, "late", "11-11", "mg");
   ASSERT_FALSE(r);
   EXPECT_EQ(r.error().kind, ErrorKind::Input);
   EXPECT_NE(r.error().message.find("run --perceive on the native sequence through frame 11"), std::string::npos)

@@ -182,7 +182,11 @@ class PerceiveStage final : public FrameStage {
   }
 
  private:
-  // The lag apart from the blur: align with the reference's perceived frame at the instant this one is shown.
+  // The lag apart from the blur. The declared latency L (temporal:latencyFrames) is known exactly and is added,
+  // not searched; the search finds the lag of the content itself (repeat's held frames, an extrapolation that
+  // falls short) against the native perceived frame of the same instant, t. Aligning against frame t + L
+  // instead would ask one shift to explain L frames of native motion, which it cannot where the motion is not a
+  // translation (rotation, disocclusions over L frames), and that residual would be charged as blur.
   Status align(const StageFrame& f, const Image& gbuffer, StageOutput& o) {
     int latency = 0;
     const auto& extra = f.input->metadata().extra;
@@ -193,13 +197,11 @@ class PerceiveStage final : public FrameStage {
         return Error::input(f.input_path, "temporal:latencyFrames is '" + it->second + "', not a whole number >= 0");
       latency = int(v);
     }
-    const int shown = f.frame + latency;
-    const std::string path = lag_reference_->path(shown);
+    const std::string path = lag_reference_->path(f.frame);
     auto ref = read_exr(path, ExrSelection{{"rgb"}});
     if (!ref)
-      return Error::input(path, "no perceived reference image for frame " + std::to_string(f.frame) + " shown at " +
-                                    std::to_string(shown) + " (temporal:latencyFrames = " + std::to_string(latency) +
-                                    "): run --perceive on the native sequence through frame " + std::to_string(shown) +
+      return Error::input(path, "no perceived reference image for frame " + std::to_string(f.frame) +
+                                    ": run --perceive on the native sequence through frame " + std::to_string(f.frame) +
                                     " (" + ref.error().message + ")");
     const auto t0 = std::chrono::steady_clock::now();
     auto a = align_lag(result_, *ref, kColor, gbuffer.plane("motion.X"), gbuffer.plane("motion.Y"), lag_);
@@ -213,12 +215,15 @@ class PerceiveStage final : public FrameStage {
       float* dst = result_.add_channel("aligned." + c);
       std::copy(src, src + result_.pixel_count(), dst);
     }
+    const double lag = a->lag_frames + double(latency);
     char text[64];
     std::snprintf(text, sizeof text, "%.5f", a->lag_frames);
+    o.extra["lagContentFrames"] = text;
+    std::snprintf(text, sizeof text, "%.5f", lag);
     o.extra["lagFrames"] = text;
-    o.extra["lagReferenceFrame"] = std::to_string(shown);
+    o.extra["lagReferenceFrame"] = std::to_string(f.frame);
     if (const auto fps = f.input->metadata().fps; fps && *fps > 0.0) {
-      std::snprintf(text, sizeof text, "%.4f", a->lag_frames * 1000.0 / *fps);
+      std::snprintf(text, sizeof text, "%.4f", lag * 1000.0 / *fps);
       o.extra["lagMs"] = text;
     }
     o.timings_ms["lag"] = ms_since(t0);
@@ -258,7 +263,8 @@ ParamList morph_stage_params(MorphStageOptions& o) {
       Param::integer("--window", "--perceive: displayed frames integrated by the eye", &o.hold.window, 1, 64),
       {.flag = "--lag-reference",
        .help = "--perceive: perceived images of the native stream (P.####.exr); adds layer aligned.R,G,B (the best "
-               "shift along the motion against frame t + temporal:latencyFrames) and temporal:lagFrames, lagMs",
+               "shift along the motion against the native frame t) and temporal:lagFrames, lagMs (plus the declared "
+               "temporal:latencyFrames)",
        .value = &o.lag_reference},
       Param::real("--max-lag", "--perceive --lag-reference: largest lag searched, display frames", &o.lag.max_lag_frames,
                   0, 64),

@@ -50,9 +50,9 @@ struct MorphStageOptions {
   bool perceive = false;  // simulate hold-type blur instead of upsampling
   HoldBlurOptions hold;   // perceive: the eye's window
   // perceive: the perceived images of the reference (native) stream, PATTERN.####.exr. When set, each frame t is
-  // also aligned to the reference's perceived frame t + L (L = the input's temporal:latencyFrames: the instant
-  // it is shown) by the best shift along the motion (align_lag, hold_blur.h): layer `aligned.R,G,B`, headers
-  // temporal:lagFrames and temporal:lagMs.
+  // also aligned to the reference's perceived frame t by the best shift tau along the motion (align_lag,
+  // hold_blur.h): layer `aligned.R,G,B`; headers temporal:lagContentFrames (tau), temporal:lagFrames (tau + L,
+  // L = the input's temporal:latencyFrames, known exactly and so added, not searched) and temporal:lagMs.
   std::string lag_reference;
   LagSearchOptions lag;
 };
