@@ -312,7 +312,9 @@ TEST(Upsample, NonFiniteInputNeverEntersHistory) {
       // Long after the bad frames, the output is as good as without them.
       const SeqRun clean = run_seq(scene, o, 3 * scene.k * scene.k);
       const Err e = error(r.output, clean.output);
-      EXPECT_LE(e.max, v.method == "herzog" || v.method == "drobot" ? 0.02 : 1e-6) << m;
+      // Exponential histories (herzog, drobot, taau's accumulation) keep a decaying trace of the repaired frames.
+      const bool exponential = v.method == "herzog" || v.method == "drobot" || v.method == "taau";
+      EXPECT_LE(e.max, exponential ? 0.02 : 1e-6) << m;
     }
   }
 }
