@@ -571,6 +571,7 @@ void PlainUpsampler::taau(const Frame& f, Image& out) {
   const bool locks = param(options_, "--no-locks") != 0;  // the field behind the inverted flag: true = locks on
   const float box_scale = float(param(options_, "--box-scale"));
   const float luma_change = float(param(options_, "--lock-luma-change"));
+  const float motion_acc = float(param(options_, "--motion-accumulation"));
   const int W = f.W, H = f.H, k = f.k, C = f.C;
   const std::size_t N = std::size_t(W) * H;
   if (!have_history_) {
@@ -670,7 +671,7 @@ void PlainUpsampler::taau(const Frame& f, Image& out) {
           for (int c = 0; c < C; ++c) res[c] = rec[c];
           acc = w_new;
         } else {
-          const float max_acc = 1.0f + (0.25f - 1.0f) * std::min(1.0f, vel * 10.0f);
+          const float max_acc = 1.0f + (motion_acc - 1.0f) * std::min(1.0f, vel * 10.0f);
           acc = std::min(acc, max_acc);
           const float s = box_scale > 0 ? box_scale : influence + (1 - influence) * std::min(1.0f, vel / 20.0f);
           const float lock_keep = locks ? std::clamp(4.0f * (lock - 1.0f), 0.0f, 1.0f) : 0.0f;

@@ -42,7 +42,6 @@ namespace {
 // FSR 2 constants (ffx_fsr2_common.h, 2.2).
 constexpr float kLanczosWeightScale = 1.0f / 12.0f;  // fUpsampleLanczosWeightScale
 constexpr float kMaxAccumulation = 1.0f;             // fMaxAccumulationLanczosWeight
-constexpr float kMaxAccumulationOnMotion = 3.0f * kLanczosWeightScale;  // fAccumulationMaxOnMotion
 constexpr float kAverageLanczosWeight = 0.74f * kLanczosWeightScale;    // fAverageLanczosWeightPerFrame
 constexpr float kEpsilon = 1e-3f;                                       // FSR2_EPSILON
 constexpr float kRectifiedAccumulation = 0.1f;  // RectifyHistory: accumulation of a clamped history, at most
@@ -61,6 +60,7 @@ struct TaauOptions {
   bool locks = true;  // step 5
   float box_scale = 0.0f;  // s of step 3; 0 = FSR 2.2's lerp(min(20, k^6), 1, saturate(velocity / 20))
   float lock_luma_change = 0.1f;  // a lock dies when 1 - min/max of its luminance and this frame's exceeds this
+  float motion_accumulation = 3.0f * kLanczosWeightScale;  // FSR 2.0 accumulationMaxOnMotion
 
   ParamList params() {
     return {
@@ -71,6 +71,10 @@ struct TaauOptions {
                     &box_scale, 0.0, 100.0),
         Param::real("--lock-luma-change", "a lock dies when its luminance changes by more than this (relative)",
                     &lock_luma_change, 0.0, 1.0),
+        Param::real("--motion-accumulation",
+                    "cap of the accumulation weight of a moving pixel (FSR 2.0 accumulationMaxOnMotion: 3/12; the "
+                    "still cap is 1)",
+                    &motion_accumulation, 0.0, 1.0),
     };
   }
 };
@@ -311,7 +315,7 @@ Image& TaauState::run(const FrameContext& f, bool history, FrameStats& stats) {
             alpha = 1.0f;
           } else {
             // FSR 2.0 ComputeMaxAccumulationWeight: 1, 3/12 once the pixel moves by 0.1 px.
-            const float max_acc = kMaxAccumulation + (kMaxAccumulationOnMotion - kMaxAccumulation) *
+            const float max_acc = kMaxAccumulation + (to.motion_accumulation - kMaxAccumulation) *
                                                          std::min(1.0f, velocity * 10.0f);
             acc = std::min(acc, max_acc);
             // Step 3: rectification (FSR 2.2 RectifyHistory).
