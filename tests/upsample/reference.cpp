@@ -572,6 +572,7 @@ void PlainUpsampler::taau(const Frame& f, Image& out) {
   const float box_scale = float(param(options_, "--box-scale"));
   const float luma_change = float(param(options_, "--lock-luma-change"));
   const float motion_acc = float(param(options_, "--motion-accumulation"));
+  const bool catmull_rom = text_param(options_, "--history") == "catmull-rom";
   const int W = f.W, H = f.H, k = f.k, C = f.C;
   const std::size_t N = std::size_t(W) * H;
   if (!have_history_) {
@@ -630,6 +631,16 @@ void PlainUpsampler::taau(const Frame& f, Image& out) {
       const float vel = std::isfinite(f.mx[i]) && std::isfinite(f.my[i]) ? std::hypot(f.mx[i], f.my[i]) : 0.0f;
       float hv[16], sum[16] = {}, bs[16] = {}, lo[16] = {}, hi[16] = {}, res[16] = {}, rec[16] = {};
       for (int c = 0; c < C; ++c) hv[c] = h(prev_out_.plane(out.channel_name(std::size_t(c))));
+      if (h.hit && catmull_rom) {  // Catmull-Rom where the fetch kept all four taps at their bilinear weights
+        const float u = float(X) + f.mx[i], v = float(Y) + f.my[i];
+        const rp::Bilinear b = rp::bilinear(u, v, W, H);
+        const float raw[4] = {b.w00, b.w10, b.w01, b.w11};
+        bool full = true;
+        for (int j = 0; j < 4; ++j) full = full && std::abs(h.w[j] - raw[j]) <= 1e-5f;
+        if (full)
+          for (int c = 0; c < C; ++c)
+            hv[c] = rp::catmull_rom(u, v, W, H)(prev_out_.plane(out.channel_name(std::size_t(c))));
+      }
       to_ycgco(hv);
       float acc = h(acc_.data()), lock = h(lock_.data()), lluma = h(lock_luma_.data());
       // The nearest sample (ties to the right/below) and its 3x3 neighbourhood.

@@ -162,7 +162,7 @@ TEST(UpsampleReference, NoIdsAndOtherParameters) {
       {"herzog", "--fallback", "flat", "--min-kernel-gamma", "0.5"},
       {"drobot", "--cache-point", "--miss-threshold", "0.05", "--max-frames", "8"},
       {"drobot", "--mode", "refresh", "--no-ids", "--depth-only"},
-      {"taau", "--no-locks", "--box-scale", "2", "--motion-accumulation", "0.6"},
+      {"taau", "--no-locks", "--box-scale", "2", "--motion-accumulation", "0.6", "--history", "bilinear"},
       {"taau", "--no-ids", "--lock-luma-change", "0.3", "--depth-tolerance", "0.2"},
   };
   for (const auto& run : runs) {

@@ -9,7 +9,8 @@
 // docs/conventions.md, "Jitter"):
 //  1. History (FSR 2 "ReprojectHistoryColor"): the previous output, its accumulation weight and its lock at
 //     p + motion through the shared reprojection module (temporal/core/reproject.h): off-screen rule, bilinear taps,
-//     per-tap depth (and id) disocclusion test, FSR 2's depth clip. A miss makes p a "new sample".
+//     per-tap depth (and id) disocclusion test, FSR 2's depth clip. A miss makes p a "new sample". The colour is
+//     re-read with the module's Catmull-Rom fetch (UE4) where all four bilinear taps were kept.
 //  2. Reconstruction of this frame's samples (FSR 2 ComputeUpsampledColorAndWeight): the 3x3 low-resolution
 //     samples around the nearest one, each weighted by Lanczos-2 (FSR 2's polynomial approximation
 //     Lanczos2ApproxSq) of its offset from p in low-resolution pixels times the kernel bias (min(1.99, k) with
@@ -61,6 +62,7 @@ struct TaauOptions {
   float box_scale = 0.0f;  // s of step 3; 0 = FSR 2.2's lerp(min(20, k^6), 1, saturate(velocity / 20))
   float lock_luma_change = 0.1f;  // a lock dies when 1 - min/max of its luminance and this frame's exceeds this
   float motion_accumulation = 3.0f * kLanczosWeightScale;  // FSR 2.0 accumulationMaxOnMotion
+  std::string history = "catmull-rom";                     // the history's colour filter (step 1)
 
   ParamList params() {
     return {
@@ -75,6 +77,10 @@ struct TaauOptions {
                     "cap of the accumulation weight of a moving pixel (FSR 2.0 accumulationMaxOnMotion: 3/12; the "
                     "still cap is 1)",
                     &motion_accumulation, 0.0, 1.0),
+        Param::choice("--history",
+                      "filter of the history's colour: catmull-rom (UE4 TAAU, Karis 2014) where the reprojection "
+                      "module kept all four bilinear taps, else its bilinear fetch; bilinear everywhere",
+                      &history, {"catmull-rom", "bilinear"}),
     };
   }
 };
@@ -214,6 +220,7 @@ Image& TaauState::run(const FrameContext& f, bool history, FrameStats& stats) {
   // Lock lifetime spent per unit of accumulated weight (FSR 2 FinalizeLockStatus): a jitter cycle of average weight.
   const float lifetime_per_weight = 1.0f / (float(k * k) * kAverageLanczosWeight);
   const float inv_k = 1.0f / float(k);
+  const bool catmull_rom = to.history == "catmull-rom";
 
   std::atomic<std::size_t> hits{0};
   parallel_rows(H, [&](int y0, int y1) {
@@ -293,6 +300,20 @@ Image& TaauState::run(const FrameContext& f, bool history, FrameStats& stats) {
           }
         float hv[16], recon[16];
         for (int c = 0; c < C; ++c) hv[c] = hit ? fetched[std::size_t(c) * W + X] : 0.0f;
+        if (hit && catmull_rom) {
+          // UE4 TAAU's bicubic (Catmull-Rom) history (Karis 2014: the bilinear fetch blurs a little more every
+          // frame); only where the module's fetch kept the four bilinear taps at their plain weights (no tap of
+          // another surface, none outside), so the disocclusion test still decides. The module's 4x4 fetch.
+          const float u = float(X) + mxv, v = float(Y) + myv;
+          const float ax = u - std::floor(u), ay = v - std::floor(v);
+          const float raw[4] = {(1 - ax) * (1 - ay), ax * (1 - ay), (1 - ax) * ay, ax * ay};
+          bool full = true;
+          for (int j = 0; j < 4; ++j) full = full && std::abs(hist.w[j][X] - raw[j]) <= 1e-5f;
+          if (full) {
+            const reproject::CatmullRom cr = reproject::catmull_rom(u, v, W, H);
+            for (int c = 0; c < C; ++c) hv[c] = cr(prev_planes[c]);
+          }
+        }
         cs.to(hv);
         float acc = hit ? fetched[std::size_t(C) * W + X] : 0.0f;
         float lock = hit ? fetched[std::size_t(C + 1) * W + X] : 0.0f;
