@@ -17,6 +17,7 @@ PACKAGES=(
   libgtest-dev libgmock-dev libbenchmark-dev
   snakemake slurm-wlm munge python3
   clang-14 libclang-rt-14-dev
+  ffmpeg fonts-dejavu-core chromium
 )
 
 say() { printf 'setup.sh: %s\n' "$*" >&2; }

@@ -25,7 +25,8 @@ find_package(TinyGLTF CONFIG REQUIRED)
 
 find_package(MPI REQUIRED COMPONENTS C)
 set(TEMPORAL_VTK_COMPONENTS CommonCore CommonDataModel ChartsCore ViewsContext2D RenderingContext2D
-  RenderingContextOpenGL2 RenderingCore RenderingOpenGL2 RenderingFreeType IOImage InteractionStyle)
+  RenderingContextOpenGL2 RenderingCore RenderingOpenGL2 RenderingFreeType IOImage InteractionStyle
+  IOExportPDF IOExportGL2PS RenderingGL2PSOpenGL2)
 find_package(VTK 9.1 REQUIRED COMPONENTS ${TEMPORAL_VTK_COMPONENTS})
 list(JOIN TEMPORAL_VTK_COMPONENTS " " TEMPORAL_VTK_COMPONENTS)  # for temporalConfig.cmake
 

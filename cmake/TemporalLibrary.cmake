@@ -16,7 +16,9 @@ set(TEMPORAL_STAGE_DEPS_morph "core")
 set(TEMPORAL_STAGE_DEPS_scene "core")
 set(TEMPORAL_STAGE_DEPS_render "core;scene")
 set(TEMPORAL_STAGE_DEPS_plot "core;metrics")
-set(TEMPORAL_STAGES core metrics upsample phlm morph scene render plot)
+set(TEMPORAL_STAGE_DEPS_pictures "core;metrics")
+set(TEMPORAL_STAGE_DEPS_report "core;metrics;pictures;plot")
+set(TEMPORAL_STAGES core metrics upsample phlm morph scene render plot pictures report)
 # Package component of each stage.
 set(TEMPORAL_COMPONENT_core core)
 set(TEMPORAL_COMPONENT_metrics core)
@@ -26,6 +28,8 @@ set(TEMPORAL_COMPONENT_morph methods)
 set(TEMPORAL_COMPONENT_scene scene)
 set(TEMPORAL_COMPONENT_render render)
 set(TEMPORAL_COMPONENT_plot plot)
+set(TEMPORAL_COMPONENT_pictures core)
+set(TEMPORAL_COMPONENT_report plot)
 
 # temporal_add_stage(STAGE SOURCES ... [PUBLIC libs...] [PRIVATE libs...]): the static library of a stage.
 # It links the stages named in TEMPORAL_STAGE_DEPS_<STAGE> publicly (nothing else from the project).

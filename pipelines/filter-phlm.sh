@@ -2,18 +2,26 @@
 # Reproduces seed 003's Table 2 and Figures 3-4 (Iglesias-Guitian et al. 2016, "Pixel History Linear Models")
 # on the built-in scenes: each scene is rendered by render-gbuffer with 1 sample per pixel and random sub-pixel
 # jitter (the flickering "Non-AA" input) and with a 16-spp reference, every method of filter-phlm filters the
-# input, and compare reports PSNR per frame (the paper's Figures 3-4, as PNG charts), average PSNR (Table 2) and
-# the motion-compensated flicker measure, against the same reference, for the unfiltered input too.
+# input, and compare reports PSNR per frame (the paper's Figures 3-4, as PNG charts), average PSNR (Table 2) with
+# its 95% interval and steady-state mean, the motion-compensated flicker measure, and paired differences between
+# the methods, against the same reference, for the unfiltered input too.
 #
 # Usage: pipelines/filter-phlm.sh [BUILD_DIR] [OUT_DIR] [SCENE.glb ...]
 #   BUILD_DIR  where the tools were built (default build/release)
 #   OUT_DIR    report folder (default report/filter-phlm)
 #   SCENE      scenes to run (default: the built-in fence, tower, fan and walkers scenes of assets/scenes)
 # Environment: SIZE (default 512x288), FRAMES (default 0-47), FPS (default 40), METHODS (default
-#   "phlm taa ema fxaa"), RENDER_ARGS (extra render-gbuffer options; default "--payload direct,shadow,ssao":
-#   the gi payload's 2000 VPLs make the 16-spp reference ~10x slower on llvmpipe), FILTER_ARGS (extra
-#   filter-phlm options), REUSE_RENDER=1 (keep an existing OUT_DIR/SCENE/render folder instead of rendering
-#   again, e.g. after changing only the filters).
+#   "phlm taa ema fxaa"), VARIANTS (more runs, one per line "NAME METHOD filter-phlm options", e.g. the previous TAA
+#   "taa-0.1 taa --taa-alpha 0.1" (the engine-typical blend) and "taa-2014 taa --taa-velocity centre --taa-clip
+#   minmax --taa-alpha 0.04" by default; "" for none),
+#   RENDER_ARGS (extra render-gbuffer options; default "--payload direct,shadow,ssao": the gi payload's 2000 VPLs
+#   make the 16-spp reference ~10x slower on llvmpipe), FILTER_ARGS (extra filter-phlm options for every run),
+#   REFERENCE_SPP (samples per pixel of the reference, default 16),
+#   RENDERS (folder holding SCENE/render, default OUT_DIR: the ablation script reuses the Table 2 renders),
+#   REUSE_RENDER=1 (keep an existing render folder instead of rendering again, e.g. after changing only the
+#   filters), REUSE_OUTPUTS=1 (keep existing filtered sequences: measure again only), WARMUP (frames compare
+#   reports apart as warm-up, default 10 = 1 / TAA's alpha; only when compare has --warmup), PAIRS (paired differences printed, "A:B,..."; default: phlm and taa against each other, the input
+#   and the previous TAA).
 #
 # The comparison target: render-gbuffer's `color` is the shading payload's R,G,B at one sample per pixel with
 # the chosen jitter, and its `reference` is the same payload's R,G,B averaged over --reference-spp samples at
@@ -30,8 +38,15 @@ FRAMES="${FRAMES:-0-47}"
 FPS="${FPS:-40}"
 METHODS="${METHODS:-phlm taa ema fxaa}"
 RENDER_ARGS="${RENDER_ARGS:---payload direct,shadow,ssao}"
+REFERENCE_SPP="${REFERENCE_SPP:-16}"
 REUSE_RENDER="${REUSE_RENDER:-0}"
+REUSE_OUTPUTS="${REUSE_OUTPUTS:-0}"
 FILTER_ARGS="${FILTER_ARGS:-}"
+VARIANTS="${VARIANTS-taa-0.1 taa --taa-alpha 0.1
+taa-2014 taa --taa-velocity centre --taa-clip minmax --taa-alpha 0.04}"
+RENDERS="${RENDERS:-$OUT}"
+WARMUP="${WARMUP:-10}"
+PAIRS="${PAIRS:-phlm:taa,phlm:taa-0.1,phlm:input,taa:input,taa:taa-0.1,phlm:fxaa,phlm:ema,taa-0.1:taa-2014}"
 
 # A relative BUILD_DIR is taken from the current folder, else from the repository root.
 case "$BUILD" in
@@ -61,6 +76,13 @@ fi
 
 mkdir -p "$OUT"
 summary="$OUT/summary.md"
+# Every run: "NAME METHOD options" (the methods under their own names first, then the variants).
+runs=()
+for m in $METHODS; do runs+=("$m $m"); done
+while read -r line; do [[ -n "$line" ]] && runs+=("$line"); done <<< "$VARIANTS"
+compare_args=()
+compare_help="$("$compare" --help 2>/dev/null || true)"
+if [[ "$compare_help" == *--warmup* ]]; then compare_args+=(--warmup "$WARMUP"); fi
 {
   echo "# filter-phlm: seed 003 Table 2 on the built-in scenes"
   echo
@@ -69,34 +91,44 @@ summary="$OUT/summary.md"
   echo
 } > "$summary"
 
+seq_names="input"
+for run in "${runs[@]}"; do read -r n _ <<< "$run"; seq_names+=",$n"; done
+scene_names=""
 for scene in "${scenes[@]}"; do
   name="$(basename "${scene%.*}")"
+  scene_names+="${scene_names:+,}$name"
   dir="$OUT/$name"
+  render_dir="$RENDERS/$name/render"
   mkdir -p "$dir"
-  if [[ "$REUSE_RENDER" == 1 && -d "$dir/render" ]]; then
-    echo "== $name: reusing $dir/render" >&2
+  if [[ "$REUSE_RENDER" == 1 && -d "$render_dir" ]]; then
+    echo "== $name: reusing $render_dir" >&2
   else
     echo "== $name: rendering ($SIZE, frames $FRAMES)" >&2
     # shellcheck disable=SC2086
-    "$render" "$scene" --out "$dir/render" --size "$SIZE" --fps "$FPS" --frames "$FRAMES" \
-      --outputs gbuffer,color,reference --jitter random --reference-spp 16 $RENDER_ARGS
+    "$render" "$scene" --out "$render_dir" --size "$SIZE" --fps "$FPS" --frames "$FRAMES" \
+      --outputs gbuffer,color,reference --jitter random --reference-spp "$REFERENCE_SPP" $RENDER_ARGS
   fi
 
-  tests=("$dir/render/color.####.exr")
-  names="input"
-  for m in $METHODS; do
-    echo "== $name: filter-phlm --method $m" >&2
+  tests=("$render_dir/color.####.exr")
+  last_frame="$(ls "$render_dir"/color.*.exr | tail -1)"
+  last_frame="${last_frame##*/color.}"
+  for run in "${runs[@]}"; do
+    read -r n m args <<< "$run"
+    tests+=("$dir/$n/$n.####.exr")
+    if [[ "$REUSE_OUTPUTS" == 1 && -f "$dir/$n/$n.$last_frame" ]]; then
+      echo "== $name: reusing $dir/$n" >&2
+      continue
+    fi
+    echo "== $name: $n = filter-phlm --method $m $args" >&2
     # shellcheck disable=SC2086
-    "$filter" --input "$dir/render/color.####.exr" --gbuffer "$dir/render/gbuffer.####.exr" \
-      --out "$dir/$m/$m.####.exr" --method "$m" $FILTER_ARGS
-    tests+=("$dir/$m/$m.####.exr")
-    names+=",$m"
+    "$filter" --input "$render_dir/color.####.exr" --gbuffer "$render_dir/gbuffer.####.exr" \
+      --out "$dir/$n/$n.####.exr" --method "$m" $args $FILTER_ARGS
   done
 
   echo "== $name: compare" >&2
-  "$compare" --reference "$dir/render/reference.####.exr" "${tests[@]}" --names "$names" \
-    --gbuffer "$dir/render/gbuffer.####.exr" --csv "$dir/metrics.csv" --json "$dir/metrics.json" \
-    --plot "$dir/psnr.png" | tee "$dir/table.txt"
+  "$compare" --reference "$render_dir/reference.####.exr" "${tests[@]}" --names "$seq_names" \
+    --gbuffer "$render_dir/gbuffer.####.exr" --csv "$dir/metrics.csv" --json "$dir/metrics.json" \
+    --plot "$dir/psnr.png" "${compare_args[@]}" | tee "$dir/table.txt"
 
   {
     echo "## $name"
@@ -108,20 +140,11 @@ for scene in "${scenes[@]}"; do
   } >> "$summary"
 done
 
-# Mean over the scenes of each sequence's mean PSNR (RGB) and flicker (the columns of compare's table).
 {
-  echo "## Mean over the scenes"
+  echo "## Table 2: mean PSNR (RGB, dB) [95% interval] (steady state) / mean flicker"
   echo
-  echo '```'
-  for s in "${scenes[@]}"; do
-    cat "$OUT/$(basename "${s%.*}")/table.txt"
-  done | awk '$1 != "sequence" && NF >= 6 {
-      n[$1]++; p[$1] += $3; f[$1] += $6; if (!($1 in seen)) { seen[$1] = 1; order[++k] = $1 } }
-    END {
-      printf "%-12s %7s %10s %11s\n", "sequence", "scenes", "psnr_rgb", "flicker"
-      for (i = 1; i <= k; i++) { s = order[i]; printf "%-12s %7d %10.3f %11.5f\n", s, n[s], p[s] / n[s], f[s] / n[s] }
-    }'
-  echo '```'
+  python3 "$here/pipelines/phlm_tables.py" scenes "$OUT" "$scene_names" "$seq_names" "$PAIRS"
+  echo
 } >> "$summary"
 
 echo

@@ -7,6 +7,7 @@
 
 #include <unistd.h>
 
+#include <cmath>
 #include <csignal>
 #include <cstdio>
 #include <iostream>
@@ -96,8 +97,9 @@ void Tool::add_sequence_options(SequenceOptions& o, const SequenceFlags& f) {
 
 RunHooks Tool::hooks() {
   RunHooks h;
+  hooks_start_ = std::chrono::steady_clock::now();  // the run starts now: the first frame's rate counts its time
   h.frame_done = [this](int frame, int done, int total) {
-    if (!progress_) progress_ = std::make_shared<Progress>(name_, total);
+    if (!progress_) progress_ = std::make_shared<Progress>(name_, total, hooks_start_);
     progress_->step(frame);
     if (done == total) progress_.reset();  // erase the line before any summary
   };
@@ -149,6 +151,7 @@ int Tool::run(int argc, char** argv, const std::function<Status()>& body) {
 }
 
 void Tool::print_error(const Error& error) const {
+  Progress::clear_active();
   if (error.file.empty())
     std::cerr << name_ << ": " << error.message << "\n";
   else
@@ -156,27 +159,86 @@ void Tool::print_error(const Error& error) const {
 }
 
 void Tool::print_warning(const std::string& file, const std::string& message) const {
+  Progress::clear_active();
   std::cerr << name_ << ": " << (file.empty() ? "" : file + ": ") << "warning: " << message << "\n";
 }
 
 void Tool::log(const std::string& message) const {
-  if (verbose_) std::cerr << name_ << ": " << message << "\n";
+  if (!verbose_) return;
+  Progress::clear_active();
+  std::cerr << name_ << ": " << message << "\n";
 }
 
-Progress::Progress(std::string tool, int total)
-    : tool_(std::move(tool)), total_(total), enabled_(isatty(STDERR_FILENO) != 0), start_(std::chrono::steady_clock::now()) {}
+namespace {
+Progress* g_active = nullptr;  // the progress line on the terminal (tools are single-threaded here)
+
+// Three significant digits without an exponent: 0.0123, 0.123, 1.23, 12.3, 123, 1234.
+std::string three_digits(double v) {
+  char text[64];
+  const double a = std::fabs(v);
+  const int decimals = a >= 100.0 ? 0 : a >= 10.0 ? 1 : a >= 1.0 ? 2 : a >= 0.1 ? 3 : 4;
+  std::snprintf(text, sizeof text, "%.*f", decimals, v);
+  return text;
+}
+}  // namespace
+
+std::string duration_text(double seconds) {
+  char text[64];
+  if (!(seconds >= 0.0) || !std::isfinite(seconds)) return "?";
+  if (seconds < 10.0) std::snprintf(text, sizeof text, "%.1f s", seconds);
+  else if (seconds < 60.0) std::snprintf(text, sizeof text, "%.0f s", std::round(seconds));
+  else if (seconds < 3600.0) {
+    const long s = std::lround(seconds);
+    std::snprintf(text, sizeof text, "%ld min %02ld s", s / 60, s % 60);
+  } else {
+    const long m = std::lround(seconds / 60.0);
+    std::snprintf(text, sizeof text, "%ld h %02ld min", m / 60, m % 60);
+  }
+  return text;
+}
+
+std::string progress_text(const std::string& tool, int frame, int done, int total, double elapsed_s) {
+  std::string text = tool + ": frame " + std::to_string(frame) + " (" + std::to_string(done) + "/" + std::to_string(total);
+  if (done > 0 && elapsed_s >= kProgressRateAfterSeconds) {
+    const double rate = double(done) / elapsed_s;
+    text += ", " + three_digits(rate) + " frames/s";
+    if (done < total) text += ", ETA " + duration_text(double(total - done) / rate);
+  }
+  return text + ")";
+}
+
+Progress::Progress(std::string tool, int total, std::chrono::steady_clock::time_point start)
+    : tool_(std::move(tool)), total_(total), enabled_(isatty(STDERR_FILENO) != 0), start_(start) {
+  if (enabled_) g_active = this;
+}
 
 Progress::~Progress() {
-  if (enabled_ && done_ > 0) std::fprintf(stderr, "\r\033[K");
+  finish();
+  if (g_active == this) g_active = nullptr;
+}
+
+void Progress::finish() {
+  if (drawn_) std::fprintf(stderr, "\r\033[K");
+  if (drawn_) std::fflush(stderr);
+  drawn_ = false;
+  enabled_ = false;
+}
+
+void Progress::clear_active() {
+  if (!g_active || !g_active->drawn_) return;
+  std::fprintf(stderr, "\r\033[K");
+  std::fflush(stderr);
+  g_active->drawn_ = false;
 }
 
 void Progress::step(int frame) {
   ++done_;
   if (!enabled_) return;
+  g_active = this;
   const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
-  std::fprintf(stderr, "\r\033[K%s: frame %d (%d/%d, %.1f frames/s)", tool_.c_str(), frame, done_, total_,
-               s > 0 ? done_ / s : 0.0);
+  std::fprintf(stderr, "\r\033[K%s", progress_text(tool_, frame, done_, total_, s).c_str());
   std::fflush(stderr);
+  drawn_ = true;
 }
 
 }  // namespace temporal::tool

@@ -1,12 +1,11 @@
 // compare: per-frame PSNR, SSIM, flicker and (with --flip) FLIP of test sequences against a reference, as CSV,
-// JSON, error-map EXRs and VTK plots, with pass/fail thresholds for pipelines. The metrics and their registry
-// live in libtemporal (temporal/metrics/comparison.h); docs/compare.md defines them. This file binds options.
+// JSON, error-map EXRs, charts, pictures and an HTML report, with pass/fail thresholds for pipelines. The run
+// lives in libtemporal (temporal/report/compare_run.h; the metrics in temporal/metrics/comparison.h);
+// docs/compare.md defines them. This file binds options.
 #include "tool.h"
 
-#include "temporal/metrics/comparison.h"
-#include "temporal/plot/plot.h"
+#include "temporal/report/compare_run.h"
 
-#include <cmath>
 #include <cstdio>
 #include <iostream>
 #include <map>
@@ -21,28 +20,47 @@ int main(int argc, char** argv) {
                   "luminance), SSIM (Wang et al. 2004, on luminance), temporal instability (flicker: RMS "
                   "difference between the test's and the reference's frame-to-frame change, motion-compensated "
                   "with --gbuffer) and, with --flip, FLIP (Andersson et al. 2020, 2021). Writes a per-frame CSV, a "
-                  "JSON summary, error-map EXRs and PNG charts.\n"
+                  "JSON summary, error-map EXRs, charts, pictures and an HTML report.\n"
                   "Typical use: compare --reference REF.####.exr TEST.####.exr [TEST2.####.exr ...] [--names a,b] "
-                  "--csv F.csv --json F.json --plot F.png");
+                  "--flip ldr --report DIR");
   auto& app = tool.app();
 
   ComparisonSetup setup;
-  std::string csv, json, plot, frames, peak = "1";
-  std::string fail_on = "mean";
-  std::vector<std::string> merge;
+  CompareOutputs out;
+  PictureOptions& pic = out.pictures;
+  std::string frames, peak = "1", fail_on = "mean", profile = "row";
+  std::vector<std::string> crops;
+  std::optional<int> sheet_frame;
   app.add_option("--reference", setup.reference, "Reference sequence, e.g. ref.####.exr (not with --merge)");
   app.add_option("tests", setup.tests, "Test sequences (one or more), e.g. taa.####.exr phlm.####.exr");
-  app.add_option("--merge", merge,
+  app.add_option("--merge", out.merge,
                  "Instead of comparing: merge per-shard CSVs of one comparison (disjoint --frames ranges) into "
                  "--csv/--json/--plot; the means and intervals equal a single run's exactly")
       ->excludes("--reference");
   app.add_option("--names", setup.names, "Comma-separated names of the test sequences (default: file names)")
       ->delimiter(',')->default_str("");
-  app.add_option("--csv", csv, "Per-frame metrics CSV to write");
-  app.add_option("--json", json, "JSON summary to write (mean/min/max per sequence, thresholds)");
-  app.add_option("--plot", plot,
-                 "PNG charts: F.png (PSNR per frame), F-psnr-y.png, F-ssim.png, F-flicker.png, F-flip.png (with "
-                 "--flip), F-speed.png (PSNR against the compute time found in the test headers)");
+  app.add_option("--csv", out.csv, "Per-frame metrics CSV to write");
+  app.add_option("--json", out.json, "JSON summary to write (mean with 95% interval per sequence, paired differences)");
+  app.add_option("--plot", out.plot,
+                 "Charts F.EXT, EXT = png, svg or pdf: F (PSNR per frame), F-psnr-y, F-ssim, F-flicker, F-flip (with "
+                 "--flip), F-speed (PSNR against the methods' own compute time)");
+  app.add_option("--title", out.title, "Title of the charts, the contact sheet and the report (e.g. the scene)");
+  app.add_option("--report", pic.report_dir,
+                 "Folder for an offline HTML report (index.html): tables, charts, contact sheet, FLIP and error "
+                 "maps, temporal profiles, side-by-side video (ffmpeg)");
+  app.add_option("--png", pic.png_dir,
+                 "Folder for pictures of every frame: reference and tests display-encoded, FLIP and error heat "
+                 "maps, G-buffer; and the contact sheet and profiles");
+  app.add_option("--png-format", pic.png_format, "Format of the --png pictures: png or jpg");
+  app.add_option("--sheet-frame", sheet_frame, "Frame of the contact sheet (default: the last compared frame)");
+  app.add_option("--crop", crops, "Region x,y,w,h (pixels) zoomed on the contact sheet; repeat for more (default: "
+                                  "the two regions of largest FLIP, else error)");
+  app.add_option("--profile", profile, "Line of the temporal profiles: row:Y (x-t image), column:X (y-t), row or "
+                                       "column (the middle)");
+  app.add_option("--exposure", pic.display.exposure, "Exposure of the pictures in stops (values x 2^E before encoding)");
+  app.add_option("--display", pic.display.display, "Display colour space of the pictures (OCIO config: srgb_display, "
+                                                   "gamma22_display, ...)");
+  app.add_option("--ocio", pic.display.ocio, "OpenColorIO config for --display (default: $OCIO, else the built-in one)");
   app.add_option("--gbuffer", setup.gbuffer,
                  "G-buffer sequence with `motion` (at the reference's size): motion-compensated flicker");
   app.add_option("--mask", setup.mask,
@@ -86,9 +104,9 @@ int main(int argc, char** argv) {
   app.add_option("--fail-on", fail_on, "What the thresholds judge: each sequence's mean over frames, or its worst frame")
       ->check(CLI::IsMember({"mean", "worst"}));
   app.footer("Exit codes: 0 success (thresholds passed), 1 usage error, 2 input error (missing, corrupt or mismatched "
-             "files, missing layers), 3 a threshold (" + fail_list + ") failed, 4 output error (including plots that "
-             "cannot be drawn: CSV and JSON are still written), 5 internal error.\n"
-             "Without DISPLAY, compare starts its own Xvfb for the plots (--verbose says so). Definitions: "
+             "files, missing layers), 3 a threshold (" + fail_list + ") failed, 4 output error (including charts, "
+             "pictures or a video that cannot be made: CSV and JSON are still written), 5 internal error.\n"
+             "Without DISPLAY, compare starts its own Xvfb for the charts (--verbose says so). Definitions: "
              "docs/compare.md; conventions: docs/conventions.md");
 
   bool threshold_failed = false;
@@ -98,14 +116,17 @@ int main(int argc, char** argv) {
       if (!range) return range.error();
       setup.frames = *range;
     }
-    if (peak == "max") {
-      setup.peak_from_data = true;
-    } else {
-      char* end = nullptr;
-      setup.peak = std::strtod(peak.c_str(), &end);
-      if (end == peak.c_str() || *end != '\0' || !(setup.peak > 0.0) || !std::isfinite(setup.peak))
-        return Error::usage("--peak '" + peak + "' is not a positive number or `max`");
+    if (auto st = set_peak(peak, setup); !st) return st;
+    for (const auto& c : crops) {
+      auto rect = parse_crop(c);
+      if (!rect) return rect.error();
+      pic.crops.push_back(*rect);
     }
+    auto line = parse_profile_line(profile);
+    if (!line) return line.error();
+    pic.profile = *line;
+    pic.sheet_frame = sheet_frame;
+    pic.title = out.title;
     setup.tool = tool.signature();
     setup.parameters = tool.command_line();
     Thresholds thresholds;
@@ -113,52 +134,16 @@ int main(int argc, char** argv) {
     thresholds.nonfinite = fail_nonfinite;
     for (const auto& [metric, limit] : fail)
       if (limit) thresholds.limits[metric] = *limit;
-    if (auto st = check_threshold_setup(setup, thresholds); !st) return st;
 
-    if (merge.empty() && (setup.reference.empty() || setup.tests.empty()))
-      return Error::usage("give --reference REF.####.exr and at least one test sequence (or --merge A.csv B.csv ...)");
-    // No output may replace a file this run reads (error maps are checked by the engine).
-    ProtectedInputs inputs;
-    if (merge.empty()) {
-      auto found = comparison_inputs(setup);
-      if (!found) return found.error();
-      inputs = std::move(*found);
-    }
-    for (const auto& m : merge) inputs.add(m);
-    for (const auto& [path, option] : {std::pair{csv, "--csv"}, std::pair{json, "--json"}, std::pair{plot, "--plot"}})
-      if (!path.empty())
-        if (auto st = inputs.check(path, option); !st) return st;
-    auto report = merge.empty() ? compare_sequences(setup, tool.hooks()) : merge_comparison_csvs(merge, setup);
-    if (!report) return report.error();
-    const auto failures = check_thresholds(*report, thresholds);
-
-    std::optional<Error> output_error;
-    auto keep = [&](const Status& st) {
-      if (!st && !output_error) output_error = st.error();
-      if (!st) tool.print_error(st.error());
-    };
-    if (!csv.empty()) keep(write_comparison_csv(*report, csv));
-    if (!json.empty())
-      keep(write_comparison_json(*report, thresholds, failures, tool.signature(), tool.command_line(), json));
-    std::fputs(summary_table(*report).c_str(), stdout);
+    auto run = run_compare(setup, thresholds, out, tool.hooks());
+    if (!run) return run.error();
+    std::fputs(run->table.c_str(), stdout);
     std::fflush(stdout);
-
-    if (!plot.empty()) {
-      auto display = VirtualDisplay::ensure();
-      if (!display) {
-        keep(Status(Error::output(plot, display.error().message)));
-      } else {
-        if (display->started()) tool.log("DISPLAY is not usable: started Xvfb on " + display->display() + " for the plots");
-        for (const auto& [path, chart] : comparison_charts(*report, plot)) {
-          if (auto st = inputs.check(path, "--plot"); !st) return st;
-          keep(write_chart_png(chart, path));
-          tool.log("wrote " + path);
-        }
-      }
-    }
-    for (const auto& f : failures) std::cerr << "compare: threshold failed: " << f.message() << "\n";
-    threshold_failed = !failures.empty();
-    if (output_error) return Status(Error{output_error->kind, {}, "some outputs were not written (see above)"});
+    for (const auto& e : run->output_errors) tool.print_error(e);
+    for (const auto& f : run->failures) std::cerr << "compare: threshold failed: " << f.message() << "\n";
+    threshold_failed = !run->failures.empty();
+    if (!run->output_errors.empty())
+      return Status(Error{run->output_errors.front().kind, {}, "some outputs were not written (see above)"});
     return Status::ok();
   });
   if (code == tool::kExitOk && threshold_failed) return tool::kExitThreshold;

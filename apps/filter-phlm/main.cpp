@@ -13,8 +13,11 @@ namespace {
 using namespace temporal;
 
 std::string description() {
-  return "Temporal filtering of a 1-spp sequence: pixel history linear models (seed 003, --method phlm) and the "
-         "baselines taa (Karis 2014), ema (seed 003 eq. 1) and fxaa (Lottes 2011).\n"
+  std::string methods;
+  for (const auto& m : filter_methods()) methods += std::string("  ") + m.name + ": " + m.summary + "\n";
+  return "Temporal filtering of a 1-spp sequence: pixel history linear models (seed 003, --method phlm), the "
+         "engine-strength baseline taa, and the papers' weak references ema and fxaa.\n" +
+         methods +
          "State per pixel (persistent, kept across frames; --state-out writes it):\n"
          "  phlm, 3 channels: " +
          std::to_string(phlm_state_floats(3) * 4) + " bytes (beta 3x4 = 12, P 4x4 as UD factors = 10, feature 3, "
@@ -35,11 +38,13 @@ int main(int argc, char** argv) {
   auto& app = tool.app();
   tool.add_sequence_options(
       seq, {"Input sequence, e.g. color.####.exr (1 spp, scene-linear)",
-            "G-buffer sequence with `motion` (and `depth`, `id` for ema); without it the scene is static",
+            "G-buffer sequence with `motion` (and `depth` for taa's nearest-depth velocity, `depth`, `id` for ema); "
+            "without it the scene is static",
             "Output sequence, e.g. phlm.####.exr", false, true, true});
   app.add_option("--method", options.method, filter_method_names());
   app.add_option("--layer", options.layer, "Layer to filter: rgb (R,G,B) or a layer name (ssao, shadow, direct, ...)");
-  app.add_flag("--debug-layers", options.debug_layers, "Add debug.* layers (phlm: feature, alpha, reset, traceP)");
+  app.add_flag("--debug-layers", options.debug_layers, "Add debug.* layers (phlm: feature, alpha, reset, traceP; taa: clip, noHistory, velocity; ema: reject; "
+                 "fxaa: edge)");
   for (const auto& method : filter_methods()) tool.add_params(method.params(options));
   return tool.run(argc, argv, [&]() -> Status {
     auto stage = make_filter_stage(options);

@@ -9,6 +9,8 @@
 # daemon cannot be started; it never skips.
 #
 # Usage: tests/cluster/check_cluster.sh SOURCE_DIR BUILD_DIR WORK_DIR
+# Environment: TEMPORAL_CLUSTER_CONFIG=FILE runs another workflow config the same way (e.g. config/sweep.yaml with
+# BUILD_DIR build/release, for the measurements of docs/pipelines.md).
 set -euo pipefail
 src="$1"; build="$2"; work="$3"
 fail() { echo "cluster test: $*" >&2; exit 1; }
@@ -99,7 +101,7 @@ say "one-node cluster up on $host ($(nproc) CPUs)"
 
 # --- the workflow, locally and through Slurm ---------------------------------------------------------------------
 flow="$src/pipelines/workflow/Snakefile"
-cfg="$src/pipelines/workflow/config/ci.yaml"
+cfg="${TEMPORAL_CLUSTER_CONFIG:-$src/pipelines/workflow/config/ci.yaml}"  # another config: docs/pipelines.md
 t0=$(date +%s)
 snakemake -s "$flow" --configfile "$cfg" --config "build=$build" "out=$work/local" --directory "$work/local-wd" \
   --cores 2 -q > "$work/log/local.log" 2>&1 || fail "local run failed: $(tail -20 "$work/log/local.log")"

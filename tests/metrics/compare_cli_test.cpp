@@ -241,7 +241,9 @@ TEST_F(CompareCli, BadRunsLoseNothingAndOverflowIsReported) {
                                  "--error-maps . --names a", "--error-maps ./ --names x,b"}) {
     const std::string tests = args.find("x,b") != std::string::npos ? " a.####.exr b.####.exr" : " a.####.exr";
     EXPECT_EQ(run("--reference ref.####.exr" + tests + " --gbuffer g.####.exr " + args, &out), 1) << args << out;
-    EXPECT_NE(out.find("one of this run's inputs"), std::string::npos) << out;
+    // A chart is never an .exr: --plot refuses the extension before it could name an input.
+    const char* why = args.rfind("--plot", 0) == 0 ? ".png, .svg or .pdf" : "one of this run's inputs";
+    EXPECT_NE(out.find(why), std::string::npos) << out;
   }
   EXPECT_EQ(run("--reference ref.####.exr a.####.exr --fail-psnr nan", &out), 1) << out;
   EXPECT_EQ(checksum(), before);
@@ -300,6 +302,15 @@ TEST_F(CompareCli, ShardsMergeIntoTheSingleRunExactly) {
   // Overlapping shards are refused.
   EXPECT_EQ(run("--merge s1.csv whole.csv --json x.json", &out), 2) << out;
   EXPECT_NE(out.find("two shards"), std::string::npos) << out;
+  // Pictures and the report need the frames: refused with --merge before anything is written.
+  for (const std::string extra : {"--report rep", "--png pngs", "--error-maps maps"}) {
+    EXPECT_EQ(run("--merge s2.csv s1.csv --json never.json " + extra, &out), 1) << extra << "\n" << out;
+    EXPECT_NE(out.find("need the frames"), std::string::npos) << out;
+    EXPECT_FALSE(fs::exists(dir_ / "never.json")) << extra;
+  }
+  // Without --merge a reference and a test are needed.
+  EXPECT_EQ(run("--json never.json", &out), 1) << out;
+  EXPECT_NE(out.find("--reference"), std::string::npos) << out;
 }
 
 }  // namespace

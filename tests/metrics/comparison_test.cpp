@@ -643,3 +643,28 @@ TEST_F(BadInput, NamesCountMismatchIsUsage) {
 
 }  // namespace
 }  // namespace temporal
+
+namespace temporal {
+namespace {
+
+// --peak's text: a positive finite number, or `max` (idiff's per-frame rule); anything else is a usage error.
+TEST(SetPeak, NumbersMaxAndRefusals) {
+  ComparisonSetup s;
+  ASSERT_TRUE(set_peak("2.5", s));
+  EXPECT_DOUBLE_EQ(s.peak, 2.5);
+  EXPECT_FALSE(s.peak_from_data);
+  ASSERT_TRUE(set_peak("max", s));
+  EXPECT_TRUE(s.peak_from_data);
+  ASSERT_TRUE(set_peak("1e3", s));
+  EXPECT_DOUBLE_EQ(s.peak, 1000.0);
+  EXPECT_FALSE(s.peak_from_data);
+  for (const char* bad : {"0", "-1", "nan", "inf", "1x", "", "MAX"}) {
+    const Status st = set_peak(bad, s);
+    ASSERT_FALSE(st) << bad;
+    EXPECT_EQ(st.error().kind, ErrorKind::Usage) << bad;
+    EXPECT_NE(st.error().message.find("--peak"), std::string::npos) << bad;
+  }
+}
+
+}  // namespace
+}  // namespace temporal

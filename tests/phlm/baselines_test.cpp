@@ -100,6 +100,114 @@ TEST(Taa, ReducesTemporalNoiseAndClipsStaleHistory) {
   EXPECT_NEAR(out.plane("G")[27], 0.0f, 1e-5f);
 }
 
+// Issue 16: TAA's velocity dilation takes the motion of the closest surface of the 3x3 neighbourhood (UE4).
+// A foreground block (x >= 5, depth 2) moves with motion (-1, 0); the background is static at depth 10 except a
+// far plane strip (x <= 1, depth 50) with a larger motion (-2, 0), so the dilation must pick by depth, not by
+// the size of the motion.
+TEST(Taa, VelocityDilationPicksTheClosestSurface) {
+  const int w = 10, h = 5;
+  Image g(w, h);
+  float* mx = g.add_channel("motion.X", 0.0f);
+  float* my = g.add_channel("motion.Y", 0.0f);
+  float* depth = g.add_channel("depth.Z", 10.0f);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      const std::size_t i = std::size_t(y * w + x);
+      if (x >= 5) {
+        depth[i] = 2.0f;
+        mx[i] = -1.0f;
+      } else if (x <= 1) {
+        depth[i] = 50.0f;
+        mx[i] = -2.0f;
+      }
+    }
+  // The image is a grey ramp 0.1 x, the same in both frames, so every history value is known: the first frame's
+  // output at interior pixels is the ramp itself (symmetric reconstruction weights of a linear function).
+  const Image ramp = make_frame(w, h, [](int x, int, int) { return 0.1f * float(x); });
+  for (const char* velocity : {"nearest", "centre"}) {
+    TaaParams p;
+    p.alpha = 0.0f;  // the output is the (clipped) history alone
+    p.clip = "minmax";
+    p.velocity = velocity;
+    TaaFilter taa(p);
+    Image out;
+    FilterInput in = input_for(ramp);
+    in.motion_x = mx;
+    in.motion_y = my;
+    in.depth = depth;
+    in.debug = true;
+    ASSERT_TRUE(taa.process(in, out));
+    ASSERT_TRUE(taa.process(in, out));
+    const float* vx = out.plane("debug.velocity.X");
+    const float* r = out.plane("R");
+    const bool nearest = std::string(velocity) == "nearest";
+    const int y = 2;
+    auto at = [&](int x) { return std::size_t(y * w + x); };
+    // Pixel 4: background (depth 10, motion 0) beside the foreground block: the closest surface of its 3x3
+    // neighbourhood is the block (depth 2), so it takes the block's motion -1 and fetches the history at x = 3,
+    // 0.3 (inside its box [0.3, 0.5]).
+    EXPECT_EQ(vx[at(4)], nearest ? -1.0f : 0.0f) << velocity;
+    EXPECT_NEAR(r[at(4)], nearest ? 0.3f : 0.4f, 1e-6f) << velocity;
+    // Pixel 3: neighbours 2..4 all at depth 10; ties go to the centre: its own motion 0.
+    EXPECT_EQ(vx[at(3)], 0.0f) << velocity;
+    EXPECT_NEAR(r[at(3)], 0.3f, 1e-6f) << velocity;
+    // Pixel 2: beside the far strip (pixel 1, depth 50, the larger motion -2): the closest surface is its own
+    // (depth 10, motion 0); the dilation picks by depth, not by the size of the motion.
+    EXPECT_EQ(vx[at(2)], 0.0f) << velocity;
+    // Pixel 1 (far strip, motion -2): beside the depth-10 background at pixel 2, it takes motion 0 when dilated.
+    EXPECT_EQ(vx[at(1)], nearest ? 0.0f : -2.0f) << velocity;
+    // Pixel 6 is inside the block: its own motion.
+    EXPECT_EQ(vx[at(6)], -1.0f) << velocity;
+  }
+}
+
+TEST(Taa, NearestVelocityNeedsDepthWhenThereIsMotion) {
+  const Image frame = make_frame(4, 4, [](int, int, int) { return 0.5f; });
+  Image g(4, 4);
+  FilterInput in = input_for(frame);
+  in.motion_x = g.add_channel("motion.X", 0.0f);
+  in.motion_y = g.add_channel("motion.Y", 0.0f);
+  TaaFilter taa;  // velocity = nearest
+  Image out;
+  const Status s = taa.process(in, out);
+  ASSERT_FALSE(s);
+  EXPECT_EQ(s.error().kind, ErrorKind::Usage);
+  EXPECT_NE(s.error().message.find("--taa-velocity centre"), std::string::npos) << s.error().message;
+  TaaParams centre;
+  centre.velocity = "centre";
+  TaaFilter taa_centre(centre);
+  EXPECT_TRUE(taa_centre.process(in, out));
+  TaaParams bad;
+  bad.clip = "aabb";
+  TaaFilter taa_bad(bad);
+  EXPECT_FALSE(taa_bad.process(input_for(frame), out));
+}
+
+// Salvi 2016's variance clipping: the box is mu +- gamma sigma of the 3x3 samples in YCoCg and the history is
+// clipped towards mu. Grey 3x3 frame: eight samples 0.2 and a centre 0.5 -> mu = 2.1 / 9, E[v^2] = 0.57 / 9,
+// sigma = sqrt(0.57 / 9 - (2.1 / 9)^2) = 0.0942809; a history of 1.0 is clipped to mu + sigma.
+TEST(Taa, VarianceClippingUsesTheMeanAndStandardDeviation) {
+  const Image one = make_frame(3, 3, [](int, int, int) { return 1.0f; });
+  const Image spot = make_frame(3, 3, [](int x, int y, int) { return (x == 1 && y == 1) ? 0.5f : 0.2f; });
+  TaaParams p;
+  p.alpha = 0.0f;
+  p.clip = "variance";
+  TaaFilter taa(p);
+  Image out;
+  ASSERT_TRUE(taa.process(input_for(one), out));
+  FilterStats stats;
+  ASSERT_TRUE(taa.process(input_for(spot), out, &stats));
+  const double mu = 2.1 / 9.0, sigma = std::sqrt(0.57 / 9.0 - mu * mu);
+  EXPECT_NEAR(out.plane("R")[4], mu + sigma, 1e-6);
+  EXPECT_EQ(stats.clamped, 9u);
+  // gamma = 2 widens the box: mu + 2 sigma.
+  p.gamma = 2.0f;
+  TaaFilter wide(p);
+  ASSERT_TRUE(wide.process(input_for(one), out));
+  ASSERT_TRUE(wide.process(input_for(spot), out));
+  EXPECT_NEAR(out.plane("R")[4], mu + 2.0 * sigma, 1e-6);
+}
+
 TEST(Taa, NonFiniteInputIsIgnored) {
   TaaFilter taa;
   Image out;
@@ -114,7 +222,9 @@ TEST(Taa, NonFiniteInputIsIgnored) {
 }
 
 TEST(Ema, FollowsEquationOne) {
-  EmaFilter ema;  // alpha = 0.9
+  EmaParams params;
+  params.alpha = 0.9f;  // eq. 1 by hand with a ten-frame memory (the default is the tuned 0.5)
+  EmaFilter ema(params);
   Image out;
   ASSERT_TRUE(ema.process(input_for(make_frame(3, 3, [](int, int, int) { return 1.0f; })), out));
   ASSERT_TRUE(ema.process(input_for(make_frame(3, 3, [](int, int, int) { return 0.0f; })), out));
@@ -124,7 +234,9 @@ TEST(Ema, FollowsEquationOne) {
 }
 
 TEST(Ema, RejectsHistoryOnIdOrDepthChange) {
-  EmaFilter ema;
+  EmaParams params;
+  params.alpha = 0.9f;
+  EmaFilter ema(params);
   Image out;
   Image g(3, 1);
   float* depth = g.add_channel("depth.Z", 5.0f);

@@ -80,6 +80,72 @@ TEST(Phlm, FeatureWeightFollowsSection51) {
     const double alpha = (0.125 * 0.04 + 0.25 * v * 0.008) / 0.8;
     EXPECT_NEAR(out.plane("debug.alpha")[12], alpha, 1e-6) << "v = " << v;
     EXPECT_NEAR(out.plane("debug.featureG")[12], 0.5 + alpha * (0.5125 - 0.5), 1e-6);
+    // The literal eq. 1 reading (ablation --feature-alpha eq1): alpha weighs the history.
+    PhlmParams eq1;
+    eq1.alpha_reading = "eq1";
+    PhlmFilter literal(eq1);
+    in.color = &f0;
+    in.reset = true;
+    ASSERT_TRUE(literal.process(in, out));
+    in.color = &f1;
+    in.reset = false;
+    ASSERT_TRUE(literal.process(in, out));
+    EXPECT_NEAR(out.plane("debug.featureG")[12], alpha * 0.5 + (1.0 - alpha) * 0.5125, 1e-6);
+  }
+}
+
+// Issue 16: with the feature off (--no-feature, x = [1]) PHLM is an intercept-only RLS, i.e. per pixel the
+// lambda-weighted running mean of its samples with the prior of the reset. From eq. 6-7 with x = 1: the
+// information I = 1 / P and S = I beta follow I <- lambda I + 1, S <- lambda S + y, starting at the reset (frame 0)
+// from I = 1 / p_init, S = y0 / p_init; the output after frame n is S_n / I_n:
+//   f_n = (lambda^(n+1) y0 / p_init + sum_k lambda^(n-k) y_k) / (lambda^(n+1) / p_init + sum_k lambda^(n-k)).
+// The sequence is static (no motion) and built so the box test never fires: grey values, and in every 3x3
+// neighbourhood anchor pixels at 0 and 1 (columns x = 0 mod 3, 0 on even rows, 1 on odd rows), so every box is
+// [0, 1] in Y and [0, 0] in Cg, Co; the other pixels take a new random grey in [0.05, 0.95] every frame.
+TEST(Phlm, InterceptOnlyIsAPerPixelRunningMean) {
+  const int w = 8, h = 5, frames = 60;
+  for (const float lambda : {1.0f, 0.998f, 0.9f}) {
+    std::mt19937 rng(41);
+    std::uniform_real_distribution<float> u(0.05f, 0.95f);
+    PhlmParams p;
+    p.lambda = lambda;
+    p.no_feature = true;
+    PhlmFilter filter(p);
+    PhlmParams with_feature = p;
+    with_feature.no_feature = false;
+    PhlmFilter full(with_feature);
+    std::vector<double> S(std::size_t(w * h)), I(std::size_t(w * h));
+    Image out, out_full;
+    double largest_feature_effect = 0.0;
+    for (int t = 0; t < frames; ++t) {
+      Image frame(w, h);
+      float* r = frame.add_channel("R");
+      for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x) r[y * w + x] = x % 3 == 0 ? float(y % 2) : u(rng);
+      std::copy(r, r + w * h, frame.add_channel("G"));
+      std::copy(r, r + w * h, frame.add_channel("B"));
+      FilterInput in = input_for(frame, t == 0);
+      in.debug = true;
+      FilterStats stats;
+      ASSERT_TRUE(filter.process(in, out, &stats));
+      EXPECT_EQ(stats.clamped, 0u) << "frame " << t;  // the box test never fired
+      EXPECT_EQ(stats.history_resets, t == 0 ? std::size_t(w * h) : 0u);
+      ASSERT_TRUE(full.process(in, out_full));
+      for (std::size_t i = 0; i < std::size_t(w * h); ++i) {
+        if (t == 0) {
+          I[i] = 1.0 / 1000.0;  // p_init
+          S[i] = double(r[i]) / 1000.0;
+        }
+        I[i] = lambda * I[i] + 1.0;
+        S[i] = lambda * S[i] + double(r[i]);
+        for (const auto& c : kRgb) ASSERT_NEAR(out.plane(c)[i], S[i] / I[i], 2e-6) << "frame " << t << " pixel " << i;
+        largest_feature_effect = std::max(largest_feature_effect, std::fabs(double(out_full.plane("G")[i]) - S[i] / I[i]));
+      }
+    }
+    // The slopes never moved, and the feature does change the full method's output on this sequence (so the
+    // comparison above is not vacuous).
+    for (std::size_t i = 0; i < std::size_t(w * h); ++i) EXPECT_EQ(filter.state().plane("beta.G1")[i], 0.0f);
+    EXPECT_GT(largest_feature_effect, 1e-3) << "lambda " << lambda;
   }
 }
 
@@ -270,7 +336,10 @@ TEST(Phlm, ModelsFollowTheMotionAndResetOffScreen) {
   Image motion(w, h);
   float* mx = motion.add_channel("motion.X", -1.0f);
   float* my = motion.add_channel("motion.Y", 0.0f);
-  PhlmFilter filter;
+  for (const char* fetch : {"bilinear", "nearest", "catmull-rom"}) {  // integer motion: every fetch is exact
+  PhlmParams params;
+  params.model_fetch = fetch;
+  PhlmFilter filter(params);
   Image out;
   for (int t = 0; t < 30; ++t) {
     Image frame = make_frame(w, h, [&](int x, int, int) { return tex(x - t + 100); });
@@ -283,7 +352,9 @@ TEST(Phlm, ModelsFollowTheMotionAndResetOffScreen) {
       EXPECT_EQ(stats.history_resets, std::size_t(h));  // the left column came from off-screen
     }
     for (const auto& c : kRgb)
-      for (std::size_t i = 0; i < out.pixel_count(); ++i) ASSERT_NEAR(out.plane(c)[i], frame.plane(c)[i], 1e-4f);
+      for (std::size_t i = 0; i < out.pixel_count(); ++i)
+        ASSERT_NEAR(out.plane(c)[i], frame.plane(c)[i], 1e-4f) << fetch;
+  }
   }
 }
 

@@ -192,6 +192,46 @@ std::string foreign_format(const unsigned char* b, std::size_t n) {
 constexpr std::int64_t kMaxPixels = std::int64_t(16384) * 16384;
 constexpr int kMaxSide = 65536;
 
+// Walks the attribute list of every header (name, type, 4-byte size, value) without reading the values, and
+// refuses an attribute whose declared size is negative or runs past the end of the file. OpenEXR's C++ reader
+// (which OpenImageIO uses) allocates a string attribute's declared size before it reads it: a 12 kB file that
+// declares a 1.8 GB `temporal:tool` made it allocate 1.8 GB (found by tests/fuzz/exr_fuzz). Reads only the headers.
+Status check_exr_attributes(const std::string& path, std::FILE* f, std::uint64_t size, bool multipart) {
+  auto corrupt = [&](const std::string& what) {
+    return Error::input(path, "has a corrupt header (" + what + "): the file is damaged; write it again");
+  };
+  auto read_name = [&](std::string& out) -> bool {  // a NUL-terminated name of at most 255 characters
+    out.clear();
+    for (int c; (c = std::fgetc(f)) != EOF;) {
+      if (c == 0) return true;
+      if (out.size() >= 255) return false;
+      out.push_back(char(c));
+    }
+    return false;
+  };
+  if (std::fseek(f, 8, SEEK_SET) != 0) return corrupt("no header");
+  std::string name, type;
+  for (int part = 0;; ++part) {
+    int attributes = 0;
+    for (;; ++attributes) {
+      if (!read_name(name)) return corrupt("an attribute name is not terminated");
+      if (name.empty()) break;  // end of this header
+      if (!read_name(type)) return corrupt("the type of attribute '" + name + "' is not terminated");
+      unsigned char b[4];
+      if (std::fread(b, 1, 4, f) != 4) return corrupt("attribute '" + name + "' has no size");
+      const std::int32_t declared = std::int32_t(std::uint32_t(b[0]) | std::uint32_t(b[1]) << 8 |
+                                                 std::uint32_t(b[2]) << 16 | std::uint32_t(b[3]) << 24);
+      const long at = std::ftell(f);
+      if (declared < 0 || at < 0 || std::uint64_t(at) + std::uint64_t(declared) > size)
+        return corrupt("attribute '" + name + "' declares " + std::to_string(declared) + " bytes, more than the file holds");
+      if (std::fseek(f, declared, SEEK_CUR) != 0) return corrupt("attribute '" + name + "'");
+    }
+    if (!multipart) return Status::ok();
+    if (attributes == 0) return Status::ok();  // the empty header that ends a multi-part file's headers
+    if (part > 100000) return corrupt("too many parts");
+  }
+}
+
 // Checks, before any pixel is allocated, that `path` is an OpenEXR file whose parts are complete: the magic number,
 // sane part sizes, and for every part the last chunk (scanline block or tile) lies inside the file. A multi-part
 // file truncated in a part that the caller does not read is caught here (reading only the needed parts would
@@ -216,6 +256,12 @@ Status check_exr_structure(const std::string& path) {
                                 "with `oiiotool IN --colorconvert sRGB linear -o OUT.exr` if it is sRGB-encoded");
     return Error::input(path, std::string("is not an OpenEXR file") + (what.empty() ? "" : " (it looks like " + what + ")") +
                                   (got < 4 ? ": it is empty or truncated" : ""));
+  }
+  if (std::FILE* f = std::fopen(path.c_str(), "rb")) {
+    const bool multipart = (magic[5] & 0x10) != 0;  // version field bit 12: multi-part
+    const Status st = check_exr_attributes(path, f, size, multipart);
+    std::fclose(f);
+    if (!st) return st;
   }
   exr_context_t ctx = nullptr;
   exr_context_initializer_t init = EXR_DEFAULT_CONTEXT_INITIALIZER;

@@ -18,6 +18,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <limits>
 
@@ -70,6 +71,8 @@ struct TestState {
   std::vector<float> y, prev_y, delta;
   bool has_prev = false;
   SequenceReport report;
+  std::optional<Image> image, maps;  // this frame's test image and error maps, kept for ComparisonHooks::frame
+  std::vector<std::string> channels;
 };
 
 // One comparison run: setup checks and inputs (open), then per frame the reference (reference_frame) and each
@@ -96,6 +99,8 @@ class Run {
       }
       if (ref_invalid_ && !priming_)
         warn(ref_path_, std::to_string(ref_invalid_) + " pixels hold NaN or Inf; they are excluded from every metric");
+      if (hooks_.frame && !priming_)  // the observer sees the compared frames only, indexed among them
+        if (auto st = observe(fi - (prime ? 1 : 0), frame); !st) return st.error();
       for (std::size_t i = 0; i < n_; ++i)
         if (!ref_valid_[i]) ref_y_[i] = std::numeric_limits<float>::quiet_NaN();
       std::swap(ref_y_, ref_prev_y_);
@@ -125,6 +130,8 @@ class Run {
                      std::span<const std::string> names, const float* mask, double peak, bool change, Image* maps);
   Status write_maps(Image& maps, const Image& test, const TestState& t, const std::string& path, int frame,
                     const FrameMetrics& m);
+  Status observe(std::size_t fi, int frame);
+  void add_invalid_channel(Image& maps) const;
 
   const ComparisonSetup& setup_;
   const ComparisonHooks& hooks_;
@@ -149,7 +156,7 @@ class Run {
   ExrSelection ref_sel_, gbuf_sel_;
   // The current frame: reference and G-buffer, and the shared work planes (allocated at the first frame).
   std::optional<Image> ref_, gbuf_;
-  std::string ref_path_;
+  std::string ref_path_, gbuf_path_;
   std::vector<std::string> ref_names_;
   std::vector<const float*> ref_planes_;
   std::vector<float> ref_y_, ref_prev_y_, ref_delta_, warped_;
@@ -225,6 +232,14 @@ Status Run::open() {
     report_.disocclusion_tested = gbuf_geometry_;
   }
   if (gbuf_mask_) gbuf_sel_.layers.push_back(setup_.mask);
+  if (gbuf_pattern_ && hooks_.frame && !hooks_.gbuffer_layers.empty()) {  // what the pictures show, when present
+    auto info = read_exr_info(gbuf_pattern_->path(report_.frames.front()));
+    if (!info) return info.error();
+    for (const auto& layer : hooks_.gbuffer_layers)
+      if (has_layer(info->channels, layer) &&
+          std::find(gbuf_sel_.layers.begin(), gbuf_sel_.layers.end(), layer) == gbuf_sel_.layers.end())
+        gbuf_sel_.layers.push_back(layer);
+  }
   return {};
 }
 
@@ -234,7 +249,7 @@ Status Run::open_tests(const FrameRange& range) {
     if (!p) return p.error();
     // Every frame must exist before any work is done: a missing file is reported at once.
     if (auto f = resolve_frames(*p, range); !f) return f.error();
-    TestState t{*p, {}, {}, {}, {}, false, {}};
+    TestState t{*p, {}, {}, {}, {}, false, {}, {}, {}, {}};
     t.report.name = setup_.names.empty() ? sequence_name(setup_.tests[i]) : setup_.names[i];
     t.report.pattern = setup_.tests[i];
     tests_.push_back(std::move(t));
@@ -318,11 +333,13 @@ Status Run::reference_frame(std::size_t fi, int frame) {
     return Error::input(ref_path_, "has other channels for layer '" + report_.reference_layer + "' than frame " +
                                        std::to_string(report_.frames.front()));
   }
+  if (fi == 0) report_.fps = ref->metadata().fps;
   ref_ = std::move(*ref);
 
   gbuf_.reset();
   if (gbuf_pattern_) {
     const std::string gpath = gbuf_pattern_->path(frame);
+    gbuf_path_ = gpath;
     auto g = read_exr(gpath, gbuf_sel_);
     if (!g) return g.error();
     if (g->width() != width_ || g->height() != height_)
@@ -393,7 +410,11 @@ Status Run::test_frame(TestState& t, std::size_t fi, int frame) {
     return Error::input(path, "layer '" + report_.layer + "' has " + std::to_string(names.size()) +
                                   " channels but the reference's '" + report_.reference_layer + "' has " +
                                   std::to_string(ref_names_.size()) + "; pick matching layers (--layer, --reference-layer)");
-  if (fi == 0) report_.channels = names;
+  if (fi == 0) {
+    report_.channels = names;
+    t.report.tool = img->metadata().tool;
+    t.report.compute_kind = compute_kind_of(img->metadata());
+  }
   const float* mask = nullptr;
   if (t.mask_source == "test") mask = mask_plane(*img, setup_.mask);
   else if (t.mask_source == "gbuffer") mask = mask_plane(*gbuf_, setup_.mask);
@@ -428,7 +449,7 @@ Status Run::test_frame(TestState& t, std::size_t fi, int frame) {
   if (change) temporal_delta(t.y.data(), t.delta.data(), n_, t.delta.data());  // t.delta held the warped history
 
   std::optional<Image> maps;
-  if (!setup_.error_maps.empty() && !priming_) maps.emplace(width_, height_);
+  if (!priming_ && (!setup_.error_maps.empty() || (hooks_.frame && hooks_.keep_maps))) maps.emplace(width_, height_);
   const FrameInputs in = inputs(t, frame, planes, names, mask, m.peak, change, maps ? &*maps : nullptr);
   for (std::size_t k = 0; k < measures_.size(); ++k) {
     MetricSample sample;
@@ -449,8 +470,14 @@ Status Run::test_frame(TestState& t, std::size_t fi, int frame) {
     if (!sample.values.empty() && std::isinf(sample.values.front()) && sample.values.front() < 0)
       warn(path, sample.metric + " is -inf: the test holds values so far from the reference that the squared error "
                                  "overflows (a broken output); --fail-nonfinite makes this a failure");
-  if (maps)
+  if (maps && !setup_.error_maps.empty())
     if (auto st = write_maps(*maps, *img, t, path, frame, m); !st) return st;
+  if (hooks_.frame && !priming_) {  // kept until every test of the frame is measured (observe)
+    if (maps && setup_.error_maps.empty()) add_invalid_channel(*maps);
+    t.channels = names;
+    t.image = std::move(*img);
+    t.maps = std::move(maps);
+  }
 
   // Keep this frame's luminance as history; pixels that were not finite must not be compared next frame.
   for (std::size_t i = 0; i < n_; ++i)
@@ -481,11 +508,36 @@ FrameInputs Run::inputs(TestState& t, int frame, std::span<const float* const> p
   return in;
 }
 
+void Run::add_invalid_channel(Image& maps) const {
+  float* inv = maps.add_channel("error.invalid");
+  for (std::size_t i = 0; i < n_; ++i) inv[i] = valid_[i] ? 0.0f : 1.0f;
+}
+
+Status Run::observe(std::size_t fi, int frame) {
+  ComparedFrame cf;
+  cf.frame = frame;
+  cf.index = fi;
+  cf.count = report_.frames.size();
+  cf.reference = &*ref_;
+  cf.reference_channels = ref_names_;
+  cf.reference_path = ref_path_;
+  cf.gbuffer = gbuf_ ? &*gbuf_ : nullptr;
+  cf.gbuffer_path = gbuf_ ? gbuf_path_ : std::string();
+  for (auto& t : tests_)
+    cf.tests.push_back({t.report.name, t.image ? &*t.image : nullptr, t.channels, t.maps ? &*t.maps : nullptr,
+                        t.report.frames.empty() ? nullptr : &t.report.frames.back(), t.pattern.path(frame)});
+  Status st = hooks_.frame(cf);
+  for (auto& t : tests_) {
+    t.image.reset();
+    t.maps.reset();
+  }
+  return st;
+}
+
 // The metrics' channels are in `maps` already; error.invalid and the header complete it.
 Status Run::write_maps(Image& maps, const Image& test, const TestState& t, const std::string& path, int frame,
                        const FrameMetrics& m) {
-  float* inv = maps.add_channel("error.invalid");
-  for (std::size_t i = 0; i < n_; ++i) inv[i] = valid_[i] ? 0.0f : 1.0f;
+  add_invalid_channel(maps);
   auto& md = maps.metadata();
   md.frame = frame;
   md.fps = test.metadata().fps;
@@ -614,6 +666,23 @@ std::optional<double> mean_compute_ms(const SequenceReport& sequence) {
   return std::nullopt;
 }
 
+const char* compute_kind_name(ComputeKind kind) {
+  switch (kind) {
+    case ComputeKind::Render: return "render";
+    case ComputeKind::Simulation: return "simulation";
+    case ComputeKind::Method: break;
+  }
+  return "method";
+}
+
+ComputeKind compute_kind_of(const FrameMetadata& header) {
+  if (header.tool.rfind("render-gbuffer", 0) == 0) return ComputeKind::Render;
+  const auto method = header.extra.find("method");
+  if (header.extra.count("perceivedWindow") || (method != header.extra.end() && method->second == "perceive"))
+    return ComputeKind::Simulation;
+  return ComputeKind::Method;
+}
+
 std::string ThresholdFailure::message() const {
   if (!text.empty()) return sequence + ": " + text;
   const MetricDefinition* d = find_metric(metric);
@@ -623,6 +692,20 @@ std::string ThresholdFailure::message() const {
   std::snprintf(text, sizeof text, "%s: %s %.6g%s %s limit %.6g%s", sequence.c_str(), metric.c_str(), value, unit,
                 higher ? "<" : ">", limit, unit);
   return text;
+}
+
+Status set_peak(const std::string& text, ComparisonSetup& setup) {
+  if (text == "max") {
+    setup.peak_from_data = true;
+    return {};
+  }
+  char* end = nullptr;
+  const double peak = std::strtod(text.c_str(), &end);
+  if (end == text.c_str() || *end != '\0' || !(peak > 0.0) || !std::isfinite(peak))
+    return Error::usage("--peak '" + text + "' is not a positive number or `max`");
+  setup.peak = peak;
+  setup.peak_from_data = false;
+  return {};
 }
 
 Status check_threshold_setup(const ComparisonSetup& setup, const Thresholds& thresholds) {

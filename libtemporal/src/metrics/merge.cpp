@@ -145,7 +145,9 @@ Expected<ComparisonReport> read_comparison_csv(const std::string& path) {
     auto it = index.find(name);
     if (it == index.end()) {
       it = index.emplace(name, report.sequences.size()).first;
-      report.sequences.push_back({name, {}, {}, {}});
+      SequenceReport sequence;
+      sequence.name = name;
+      report.sequences.push_back(std::move(sequence));
     }
     report.sequences[it->second].frames.push_back(std::move(f));
   }

@@ -37,9 +37,10 @@ MetricDefinition flicker_metric() {
   d.historical_csv = true;
   d.threshold_option = "flicker";
   d.threshold_help = "Exit 3 when a sequence's flicker is above this";
-  d.chart = {"-flicker", "Temporal instability per frame{motion}", "flicker (RMS of luminance change difference)", true};
+  d.chart = {"-flicker", "Temporal instability per frame{motion}",
+             "flicker (RMS luminance-change difference, scene-linear units)", true, 0.0, {}};
   d.table_width = 11;
-  d.table_format = "%.5g";
+  d.table_format = "%.5f";  // fixed decimals: a column of flicker values lines up
   d.make = [](const ComparisonSetup&) -> std::unique_ptr<FrameMeasure> { return std::make_unique<Flicker>(); };
   return d;
 }

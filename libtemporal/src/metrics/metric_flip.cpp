@@ -82,7 +82,7 @@ MetricDefinition flip_metric() {
   d.mask_columns = {"flip_in", "flip_out"};
   d.threshold_option = "flip";
   d.threshold_help = "Exit 3 when a sequence's mean FLIP is above this (needs --flip ldr|hdr)";
-  d.chart = {"-flip", "Mean FLIP per frame", "FLIP (mean over pixels)", false};
+  d.chart = {"-flip", "Mean FLIP per frame", "mean FLIP (unitless, 0 = identical, 1 = largest)", false, 0.0, 1.0};
   d.table_width = 9;
   d.table_format = "%.5f";
   d.enabled = [](const ComparisonSetup& setup) { return setup.flip != FlipMode::Off; };

@@ -66,7 +66,7 @@ MetricDefinition psnr_rgb_metric() {
   d.historical_csv = true;
   d.threshold_option = "psnr";
   d.threshold_help = "Exit 3 when a sequence's PSNR (dB) is below this";
-  d.chart = {"", "PSNR ({layer}) per frame", "PSNR (dB)", false};
+  d.chart = {"", "PSNR ({layer}) per frame", "PSNR (dB)", false, {}, {}};
   d.table_width = 10;
   d.table_format = "%.3f";
   d.make = [](const ComparisonSetup&) -> std::unique_ptr<FrameMeasure> { return std::make_unique<PsnrRgb>(); };
@@ -80,7 +80,7 @@ MetricDefinition psnr_y_metric() {
   d.columns = {{"psnr_y_db", ""}};
   d.mask_columns = {"psnr_y_in_db", "psnr_y_out_db"};
   d.historical_csv = true;
-  d.chart = {"-psnr-y", "PSNR of luminance per frame", "PSNR (dB)", false};
+  d.chart = {"-psnr-y", "PSNR of luminance per frame", "PSNR of luminance (dB)", false, {}, {}};
   d.table_width = 10;
   d.table_format = "%.3f";
   d.make = [](const ComparisonSetup&) -> std::unique_ptr<FrameMeasure> { return std::make_unique<PsnrY>(); };

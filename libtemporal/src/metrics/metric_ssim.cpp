@@ -36,7 +36,7 @@ MetricDefinition ssim_metric() {
   d.historical_csv = true;
   d.threshold_option = "ssim";
   d.threshold_help = "Exit 3 when a sequence's SSIM is below this";
-  d.chart = {"-ssim", "SSIM of luminance per frame", "SSIM", false};
+  d.chart = {"-ssim", "SSIM of luminance per frame", "SSIM (unitless, 1 = identical)", false, {}, 1.0};
   d.table_width = 9;
   d.table_format = "%.5f";
   d.make = [](const ComparisonSetup&) -> std::unique_ptr<FrameMeasure> { return std::make_unique<Ssim>(); };

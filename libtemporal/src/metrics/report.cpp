@@ -204,6 +204,8 @@ nlohmann::ordered_json sequence_json(const ComparisonReport& report, const Seque
   }
   js["nonfinite_pixels"] = {{"test", nf_test}, {"reference", nf_ref}};
   js["compute_ms"] = jnum(mean_compute_ms(s));
+  js["compute_kind"] = compute_kind_name(s.compute_kind);
+  js["tool"] = s.tool.empty() ? nlohmann::ordered_json(nullptr) : nlohmann::ordered_json(s.tool);
   json timings = json::object();
   std::map<std::string, std::pair<double, std::size_t>> sums;
   for (const auto& f : s.frames)

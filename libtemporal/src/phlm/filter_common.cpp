@@ -21,6 +21,13 @@ Status validate_filter_input(const FilterInput& in) {
   return Status::ok();
 }
 
+Expected<HistoryFetch> parse_history_fetch(const std::string& name, const char* flag) {
+  if (name == "bilinear") return HistoryFetch::Bilinear;
+  if (name == "catmull-rom") return HistoryFetch::CatmullRom;
+  if (name == "nearest") return HistoryFetch::Nearest;
+  return Error::usage(std::string(flag) + " '" + name + "' is not one of: bilinear, catmull-rom, nearest");
+}
+
 namespace detail {
 
 std::size_t prepare_frame(const FilterInput& in, bool want_ycgco, std::vector<float> ycgco[3],

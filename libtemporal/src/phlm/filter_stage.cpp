@@ -27,6 +27,12 @@ class FilterStage final : public FrameStage {
       : options_(options), method_(method), filter_(method.create(options)) {
     inputs_.input_layers = {options.layer};
     inputs_.gbuffer_layers = method.gbuffer_layers;
+    // Every parameter of the method with its value (ablation switches included), for the output headers.
+    FilterOptions copy = options;
+    for (const Param& p : method.params(copy)) {
+      if (!parameters_.empty()) parameters_ += ' ';
+      parameters_ += p.flag + "=" + param_value_text(p);
+    }
   }
   const StageInputs& inputs() const override { return inputs_; }
   bool has_state() const override { return filter_->has_state(); }
@@ -78,7 +84,7 @@ class FilterStage final : public FrameStage {
     o.image = &output_;
     o.compute_ms = ms_;
     o.timings_ms = {{"filter", ms_}};
-    o.extra = {{"method", method_.name}};
+    o.extra = {{"method", method_.name}, {"methodParameters", parameters_}};
     out.push_back(std::move(o));
     return Status::ok();
   }
@@ -94,6 +100,7 @@ class FilterStage final : public FrameStage {
   std::unique_ptr<FrameFilter> filter_;
   StageInputs inputs_;
   std::optional<Image> pending_state_;
+  std::string parameters_;  // "--lambda=0.998 --p-init=1000 ..." (temporal:methodParameters)
   Image output_;
   FilterStats stats_;
   double ms_ = 0.0;

@@ -79,6 +79,26 @@ struct Layout {
   static_assert(kSize == phlm_state_floats(C));
 };
 
+// The resolved ablation switches of PhlmParams.
+struct Variant {
+  bool feature = true, box_test = true, alpha_eq1 = false;
+  HistoryFetch fetch = HistoryFetch::Bilinear;
+};
+
+Expected<Variant> resolve_variant(const PhlmParams& p) {
+  Variant v;
+  v.feature = !p.no_feature;
+  v.box_test = !p.no_box_test;
+  if (p.alpha_reading == "eq1")
+    v.alpha_eq1 = true;
+  else if (p.alpha_reading != "ue4")
+    return Error::usage("--feature-alpha '" + p.alpha_reading + "' is not one of: ue4, eq1");
+  auto fetch = parse_history_fetch(p.model_fetch, "--model-fetch");
+  if (!fetch) return fetch.error();
+  v.fetch = *fetch;
+  return v;
+}
+
 struct FrameScratch {
   const float* y[3];       // input planes
   const float* box[3];     // input in box space (YCgCo or the value)
@@ -86,7 +106,8 @@ struct FrameScratch {
 };
 
 template <int C>
-void run_phlm(const FilterInput& in, const PhlmParams& params, bool have_prev, const float* prev, float* next,
+void run_phlm(const FilterInput& in, const PhlmParams& params, const Variant& variant, bool have_prev,
+              const float* prev, float* next,
               const FrameScratch& fs, float* const out[C], float* const dbg[3 + C],
               std::atomic<std::size_t>& resets, std::atomic<std::size_t>& clamps, float& max_trace) {
   constexpr int N = kN<C>;
@@ -201,13 +222,15 @@ void run_phlm(const FilterInput& in, const PhlmParams& params, bool have_prev, c
         const float mvy = in.motion_y ? in.motion_y[i] : 0.0f;
         const float fx = float(xx) + mvx, fy = float(yy) + mvy;
         const bool reset = in.reset || !have_prev || !reproject::on_screen(fx, fy, w, h);  // lines 7-9
-        reproject::Bilinear bl{};
-        if (!reset) bl = reproject::bilinear(fx, fy, w, h);
-        // The previous model record at q, bilinearly (line 11). Integer motion (a static scene, a static
-        // camera's still objects) reads the one record directly instead of four with weights (1, 0, 0, 0).
+        // The previous model record at q (line 11): bilinearly by default. Integer motion (a static scene, a
+        // static camera's still objects) reads the one record directly instead of four with weights (1, 0, 0, 0).
         using L = Layout<C>;
         float rec[L::kSize];
-        if (!reset) {
+        if (!reset && variant.fetch == HistoryFetch::Nearest) {
+          const float* q = prev + reproject::nearest(fx, fy, w, h) * L::kSize;
+          for (int k = 0; k < L::kSize; ++k) rec[k] = q[k];
+        } else if (!reset) {
+          const reproject::Bilinear bl = reproject::bilinear(fx, fy, w, h);
           const float* q00 = prev + bl.i00 * L::kSize;
           if (bl.w00 == 1.0f) {
             for (int k = 0; k < L::kSize; ++k) rec[k] = q00[k];
@@ -217,6 +240,21 @@ void run_phlm(const FilterInput& in, const PhlmParams& params, bool have_prev, c
             const float* q11 = prev + bl.i11 * L::kSize;
             for (int k = 0; k < L::kSize; ++k)
               rec[k] = bl.w00 * q00[k] + bl.w10 * q10[k] + bl.w01 * q01[k] + bl.w11 * q11[k];
+          }
+          if (variant.fetch == HistoryFetch::CatmullRom) {
+            // beta and the feature with the 4x4 Catmull-Rom taps; P's factors and the scale keep the bilinear
+            // (convex) combination, which keeps D > 0.
+            const reproject::CatmullRom cr = reproject::catmull_rom(fx, fy, w, h);
+            float acc[C * N + C] = {};
+            for (int j = 0; j < 4; ++j)
+              for (int k = 0; k < 4; ++k) {
+                const float wt = cr.wy[j] * cr.wx[k];
+                const float* q = prev + (cr.row[j] + std::size_t(cr.col[k])) * L::kSize;
+                for (int e = 0; e < C * N; ++e) acc[e] += wt * q[L::kBeta + e];
+                for (int c = 0; c < C; ++c) acc[C * N + c] += wt * q[L::kFeature + c];
+              }
+            for (int e = 0; e < C * N; ++e) rec[L::kBeta + e] = acc[e];
+            for (int c = 0; c < C; ++c) rec[L::kFeature + c] = acc[C * N + c];
           }
         }
 
@@ -252,8 +290,12 @@ void run_phlm(const FilterInput& in, const PhlmParams& params, bool have_prev, c
             for (int c = 0; c < C; ++c) zb[c] = std::clamp(zb[c], bmin[c], bmax[c]);
             from_box_space<C>(zb, zh);
             // alpha weighs the new low-frequency sample (the reading of Karis / UE4, whose code the constants
-            // a, b come from; see docs): z = (1 - alpha) z_prev + alpha low.
-            for (int c = 0; c < C; ++c) z[c] = zh[c] + alpha * (low[c] - zh[c]);
+            // a, b come from; see docs): z = (1 - alpha) z_prev + alpha low. The eq1 ablation reads it as eq. 1's
+            // history weight: z = alpha z_prev + (1 - alpha) low.
+            if (variant.alpha_eq1)
+              for (int c = 0; c < C; ++c) z[c] = low[c] + alpha * (zh[c] - low[c]);
+            else
+              for (int c = 0; c < C; ++c) z[c] = zh[c] + alpha * (low[c] - zh[c]);
           }
         }
 
@@ -276,9 +318,11 @@ void run_phlm(const FilterInput& in, const PhlmParams& params, bool have_prev, c
           for (int k = 0; k < N; ++k) m.d[k] = rec[L::kD + k];
           s = rec[L::kScale];
         }
+        // eq. 3, x = [1, z]; without the feature x = [1, 0, ..]: an intercept-only RLS (Bierman's update then
+        // leaves the slopes at 0 and U = I, so it is exactly the scalar recursion of a weighted running mean).
         float x[N];
         x[0] = 1.0f;
-        for (int c = 0; c < C; ++c) x[c + 1] = z[c] / s;  // eq. 3, x = [1, z]
+        for (int c = 0; c < C; ++c) x[c + 1] = variant.feature ? z[c] / s : 0.0f;
 
         float trace_p = 0.0f;
         if (centre_valid) {
@@ -289,6 +333,7 @@ void run_phlm(const FilterInput& in, const PhlmParams& params, bool have_prev, c
           to_box_space<C>(yc, yb);
           bool inside = true;
           for (int c = 0; c < C; ++c) inside = inside && fb[c] >= bmin[c] && fb[c] <= bmax[c];
+          inside = inside || !variant.box_test;
           if (!inside) {
             bool finite = true;
             for (int c = 0; c < C; ++c) finite = finite && std::isfinite(fb[c]);
@@ -311,7 +356,7 @@ void run_phlm(const FilterInput& in, const PhlmParams& params, bool have_prev, c
             float v0[C];
             for (int c = 0; c < C; ++c) v0[c] = f[c] / s;
             rls::reset(m, v0, p0);
-            for (int c = 0; c < C; ++c) x[c + 1] = z[c] / s;
+            for (int c = 0; c < C; ++c) x[c + 1] = variant.feature ? z[c] / s : 0.0f;
             flag = 2.0f;
             ++local_clamps;
           }
@@ -388,6 +433,8 @@ std::vector<std::string> PhlmFilter::state_channel_names(int channels) {
 
 Status PhlmFilter::process(const FilterInput& in, Image& output, FilterStats* stats) {
   if (Status s = validate_filter_input(in); !s) return s;
+  const auto variant = resolve_variant(params_);
+  if (!variant) return variant.error();
   const int channels = int(in.channels.size());
   const int w = in.color->width(), h = in.color->height();
   const bool same_shape = have_state_ && channels == channels_ && width_ == w && height_ == h;
@@ -424,9 +471,9 @@ Status PhlmFilter::process(const FilterInput& in, Image& output, FilterStats* st
   std::atomic<std::size_t> resets{0}, clamps{0};
   float max_trace = 0.0f;
   if (channels == 3) {
-    run_phlm<3>(in, params_, have_prev, state_.data(), next_.data(), fs, out, dbg, resets, clamps, max_trace);
+    run_phlm<3>(in, params_, *variant, have_prev, state_.data(), next_.data(), fs, out, dbg, resets, clamps, max_trace);
   } else {
-    run_phlm<1>(in, params_, have_prev, state_.data(), next_.data(), fs, out, dbg, resets, clamps, max_trace);
+    run_phlm<1>(in, params_, *variant, have_prev, state_.data(), next_.data(), fs, out, dbg, resets, clamps, max_trace);
   }
   std::swap(state_, next_);
   have_state_ = true;

@@ -1,5 +1,5 @@
-// TAA after Karis 2014 (the UE4-TAA baseline of seed 003 Table 2). Choices beyond the talk are listed in
-// docs/filter-phlm.md ("TAA").
+// TAA after Karis 2014 with Salvi 2016's variance clipping (the engine-strength baseline of seed 003 Table 2).
+// The source of every choice is listed in docs/filter-phlm.md ("TAA").
 #include "temporal/phlm/taa.h"
 
 #include "filter_common.h"
@@ -35,10 +35,36 @@ inline void from_box(const float* b, float* v) {
     v[0] = b[0];
 }
 
+// The resolved choices of TaaParams.
+struct TaaConfig {
+  float alpha = 0.0f, gamma = 1.0f;
+  TaaVelocity velocity = TaaVelocity::Nearest;
+  TaaClip clip = TaaClip::MinMax;
+  HistoryFetch history = HistoryFetch::CatmullRom;
+};
+
+// Index of the 3x3 neighbour of pixel (xx, yy) with the smallest depth (the closest surface); the centre wins
+// ties, then raster order. Non-finite depths never win.
+inline std::size_t closest_neighbour(const float* depth, int xx, int yy, int w, int h) {
+  const std::size_t centre = std::size_t(yy) * std::size_t(w) + std::size_t(xx);
+  std::size_t best = centre;
+  float bz = std::isfinite(depth[centre]) ? depth[centre] : INFINITY;
+  for (int j = std::max(yy - 1, 0); j <= std::min(yy + 1, h - 1); ++j)
+    for (int k = std::max(xx - 1, 0); k <= std::min(xx + 1, w - 1); ++k) {
+      const std::size_t n = std::size_t(j) * std::size_t(w) + std::size_t(k);
+      if (depth[n] < bz) {  // false for NaN
+        bz = depth[n];
+        best = n;
+      }
+    }
+  return best;
+}
+
 template <int C>
-void run_taa(const FilterInput& in, const TaaParams& params, bool have_history, const float* const hist[C],
-             float* const next[C], const float* const box[C], const std::uint8_t* valid, float* const out[C],
-             float* dbg_clip, float* dbg_nohist, std::atomic<std::size_t>& resets, std::atomic<std::size_t>& clips) {
+void run_taa(const FilterInput& in, const TaaParams& params, const TaaConfig& cfg, bool have_history,
+             const float* const hist[C], float* const next[C], const float* const box[C], const std::uint8_t* valid,
+             float* const out[C], float* const dbg[4], std::atomic<std::size_t>& resets,
+             std::atomic<std::size_t>& clips) {
   const int w = in.color->width(), h = in.color->height();
   const float* y[C];
   for (int c = 0; c < C; ++c) y[c] = in.color->plane(in.channels[std::size_t(c)]);
@@ -50,7 +76,9 @@ void run_taa(const FilterInput& in, const TaaParams& params, bool have_history, 
       const float dx = float(k - 1) + in.jitter.x, dy = float(j - 1) + in.jitter.y;
       weight[j * 3 + k] = std::exp(-params.filter_sharpness * (dx * dx + dy * dy));
     }
-  const float alpha = params.alpha;
+  const float alpha = cfg.alpha;
+  const bool variance = cfg.clip == TaaClip::Variance;
+  const bool dilate = cfg.velocity == TaaVelocity::Nearest && in.motion_x && in.depth;
   parallel_rows(h, [&](int y0, int y1) {
     std::size_t local_resets = 0, local_clips = 0;
     for (int yy = y0; yy < y1; ++yy) {
@@ -58,13 +86,15 @@ void run_taa(const FilterInput& in, const TaaParams& params, bool have_history, 
       for (int xx = 0; xx < w; ++xx) {
         const std::size_t i = std::size_t(yy) * std::size_t(w) + std::size_t(xx);
         const int cols[3] = {std::max(xx - 1, 0), xx, std::min(xx + 1, w - 1)};
-        float bmin[C], bmax[C], cur[C];
+        float bmin[C], bmax[C], cur[C], m1[C], samples[9][C];
         for (int c = 0; c < C; ++c) {
           bmin[c] = INFINITY;
           bmax[c] = -INFINITY;
           cur[c] = 0.0f;
+          m1[c] = 0.0f;
         }
         float wsum = 0.0f;
+        int count = 0;
         for (int j = 0; j < 3; ++j)
           for (int k = 0; k < 3; ++k) {
             const std::size_t n = std::size_t(rows[j]) * std::size_t(w) + std::size_t(cols[k]);
@@ -72,16 +102,22 @@ void run_taa(const FilterInput& in, const TaaParams& params, bool have_history, 
             const float wt = weight[j * 3 + k];
             wsum += wt;
             for (int c = 0; c < C; ++c) {
-              bmin[c] = min_(bmin[c], box[c][n]);
-              bmax[c] = max_(bmax[c], box[c][n]);
+              const float b = box[c][n];
+              bmin[c] = min_(bmin[c], b);
+              bmax[c] = max_(bmax[c], b);
+              m1[c] += b;
+              samples[count][c] = b;
               cur[c] += wt * y[c][n];
             }
+            ++count;
           }
         const bool any_valid = wsum > 0.0f;
         for (int c = 0; c < C; ++c) cur[c] = any_valid ? cur[c] / wsum : 0.0f;
 
-        const float mvx = in.motion_x ? in.motion_x[i] : 0.0f;
-        const float mvy = in.motion_y ? in.motion_y[i] : 0.0f;
+        // Velocity: the pixel's own motion, or that of the closest surface of the 3x3 neighbourhood.
+        const std::size_t vi = dilate ? closest_neighbour(in.depth, xx, yy, w, h) : i;
+        const float mvx = in.motion_x ? in.motion_x[vi] : 0.0f;
+        const float mvy = in.motion_y ? in.motion_y[vi] : 0.0f;
         const float fx = float(xx) + mvx, fy = float(yy) + mvy;
         const bool no_history = in.reset || !have_history || !reproject::on_screen(fx, fy, w, h);
         float result[C];
@@ -90,25 +126,50 @@ void run_taa(const FilterInput& in, const TaaParams& params, bool have_history, 
           for (int c = 0; c < C; ++c) result[c] = cur[c];
           ++local_resets;
         } else {
-          const reproject::CatmullRom cr = reproject::catmull_rom(fx, fy, w, h);
           float hv[C];
-          for (int c = 0; c < C; ++c) hv[c] = cr(hist[c]);
+          if (cfg.history == HistoryFetch::CatmullRom) {
+            const reproject::CatmullRom cr = reproject::catmull_rom(fx, fy, w, h);
+            for (int c = 0; c < C; ++c) hv[c] = cr(hist[c]);
+          } else if (cfg.history == HistoryFetch::Bilinear) {
+            const reproject::Bilinear bl = reproject::bilinear(fx, fy, w, h);
+            for (int c = 0; c < C; ++c) hv[c] = bl(hist[c]);
+          } else {
+            const std::size_t q = reproject::nearest(fx, fy, w, h);
+            for (int c = 0; c < C; ++c) hv[c] = hist[c][q];
+          }
           if (!any_valid) {
             for (int c = 0; c < C; ++c) result[c] = hv[c];  // nothing valid to blend in: keep the history
           } else {
-            // Clip the history towards the filtered current colour (inside the box: it is a convex
-            // combination of the box's samples) in YCgCo.
-            float hb[C], cb[C];
+            // Clip the history in YCgCo along the segment towards an origin inside the box: the filtered current
+            // colour for the min/max box (a convex combination of its samples, UE4's HistoryClip), the mean mu
+            // for the variance box mu +- gamma sigma (Salvi 2016).
+            float hb[C], cb[C], origin[C];
             to_box<C>(hv, hb);
             to_box<C>(cur, cb);
+            if (variance) {
+              // Two passes over the samples (mean, then squared deviations): identical samples give sigma = 0
+              // exactly, where E[v^2] - mu^2 would leave a rounding residue.
+              const float inv_n = 1.0f / float(count);
+              for (int c = 0; c < C; ++c) {
+                const float mu = m1[c] * inv_n;
+                float m2 = 0.0f;
+                for (int k = 0; k < count; ++k) m2 += (samples[k][c] - mu) * (samples[k][c] - mu);
+                const float sigma = std::sqrt(m2 * inv_n);
+                bmin[c] = mu - cfg.gamma * sigma;
+                bmax[c] = mu + cfg.gamma * sigma;
+                origin[c] = mu;
+              }
+            } else {
+              for (int c = 0; c < C; ++c) origin[c] = cb[c];
+            }
             float t = 1.0f;
             for (int c = 0; c < C; ++c) {
-              const float d = hb[c] - cb[c];
-              if (d > 0.0f && cb[c] + d > bmax[c]) t = min_(t, max_(bmax[c] - cb[c], 0.0f) / d);
-              if (d < 0.0f && cb[c] + d < bmin[c]) t = min_(t, min_(bmin[c] - cb[c], 0.0f) / d);
+              const float d = hb[c] - origin[c];
+              if (d > 0.0f && origin[c] + d > bmax[c]) t = min_(t, max_(bmax[c] - origin[c], 0.0f) / d);
+              if (d < 0.0f && origin[c] + d < bmin[c]) t = min_(t, min_(bmin[c] - origin[c], 0.0f) / d);
             }
             if (t < 1.0f) {
-              for (int c = 0; c < C; ++c) hb[c] = cb[c] + t * (hb[c] - cb[c]);
+              for (int c = 0; c < C; ++c) hb[c] = origin[c] + t * (hb[c] - origin[c]);
               from_box<C>(hb, hv);
               clipped = 1.0f;
               ++local_clips;
@@ -124,15 +185,41 @@ void run_taa(const FilterInput& in, const TaaParams& params, bool have_history, 
           out[c][i] = result[c];
           next[c][i] = result[c];
         }
-        if (dbg_clip) {
-          dbg_clip[i] = clipped;
-          dbg_nohist[i] = no_history ? 1.0f : 0.0f;
+        if (dbg[0]) {
+          dbg[0][i] = clipped;
+          dbg[1][i] = no_history ? 1.0f : 0.0f;
+          dbg[2][i] = mvx;
+          dbg[3][i] = mvy;
         }
       }
     }
     resets += local_resets;
     clips += local_clips;
   });
+}
+
+Expected<TaaConfig> resolve(const TaaParams& p) {
+  TaaConfig cfg;
+  cfg.alpha = p.alpha;
+  cfg.gamma = p.gamma;
+  if (!(p.alpha >= 0.0f && p.alpha <= 1.0f)) return Error::usage("--taa-alpha must be in [0, 1]");
+  if (!(p.gamma > 0.0f && std::isfinite(p.gamma))) return Error::usage("--taa-gamma must be a finite number > 0");
+  if (p.velocity == "nearest")
+    cfg.velocity = TaaVelocity::Nearest;
+  else if (p.velocity == "centre")
+    cfg.velocity = TaaVelocity::Centre;
+  else
+    return Error::usage("--taa-velocity '" + p.velocity + "' is not one of: nearest, centre");
+  if (p.clip == "variance")
+    cfg.clip = TaaClip::Variance;
+  else if (p.clip == "minmax")
+    cfg.clip = TaaClip::MinMax;
+  else
+    return Error::usage("--taa-clip '" + p.clip + "' is not one of: variance, minmax");
+  auto fetch = parse_history_fetch(p.history, "--taa-history");
+  if (!fetch) return fetch.error();
+  cfg.history = *fetch;
+  return cfg;
 }
 
 }  // namespace
@@ -147,6 +234,11 @@ Status TaaFilter::process(const FilterInput& in, Image& output, FilterStats* sta
   if (Status s = validate_filter_input(in); !s) return s;
   const int channels = int(in.channels.size());
   const int w = in.color->width(), h = in.color->height();
+  auto cfg = resolve(params_);
+  if (!cfg) return cfg.error();
+  if (cfg->velocity == TaaVelocity::Nearest && in.motion_x && !in.depth)
+    return Error::usage("taa: --taa-velocity nearest takes the motion of the closest surface and needs the "
+                        "G-buffer's depth; render it (render-gbuffer --outputs gbuffer) or use --taa-velocity centre");
   const bool same = have_state_ && channels == channels_ && history_.width() == w && history_.height() == h;
   if (!same) {
     channels_ = channels;
@@ -155,8 +247,13 @@ Status TaaFilter::process(const FilterInput& in, Image& output, FilterStats* sta
   const std::size_t non_finite = detail::prepare_frame(in, channels == 3, ycgco_, valid_);
   float* out[3] = {};
   detail::prepare_output(in, output, out);
-  float* dbg_clip = in.debug ? output.add_channel("debug.clip") : nullptr;
-  float* dbg_nohist = in.debug ? output.add_channel("debug.noHistory") : nullptr;
+  float* dbg[4] = {};
+  if (in.debug) {
+    dbg[0] = output.add_channel("debug.clip");
+    dbg[1] = output.add_channel("debug.noHistory");
+    dbg[2] = output.add_channel("debug.velocity.X");
+    dbg[3] = output.add_channel("debug.velocity.Y");
+  }
   const auto names = state_channel_names(channels);
   const float* hist[3] = {};
   float* next[3] = {};
@@ -168,9 +265,9 @@ Status TaaFilter::process(const FilterInput& in, Image& output, FilterStats* sta
   }
   std::atomic<std::size_t> resets{0}, clips{0};
   if (channels == 3)
-    run_taa<3>(in, params_, same, hist, next, box, valid_.data(), out, dbg_clip, dbg_nohist, resets, clips);
+    run_taa<3>(in, params_, *cfg, same, hist, next, box, valid_.data(), out, dbg, resets, clips);
   else
-    run_taa<1>(in, params_, same, hist, next, box, valid_.data(), out, dbg_clip, dbg_nohist, resets, clips);
+    run_taa<1>(in, params_, *cfg, same, hist, next, box, valid_.data(), out, dbg, resets, clips);
   std::swap(history_, next_);
   have_state_ = true;
   if (stats) {

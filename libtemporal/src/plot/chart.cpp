@@ -1,6 +1,9 @@
-// VTK charts written to PNG (temporal/plot/plot.h): vtkChartXY in an off-screen vtkContextView, read back with
-// vtkWindowToImageFilter and written with vtkPNGWriter.
+// VTK charts written to PNG, SVG or PDF (temporal/plot/plot.h): vtkChartXY in an off-screen vtkContextView; PNG
+// read back with vtkWindowToImageFilter and written with vtkPNGWriter, SVG through GL2PS (vtkGL2PSExporter), PDF
+// through libharu (vtkPDFExporter).
 #include "temporal/plot/plot.h"
+
+#include "temporal/core/atomic_file.h"
 
 #include <vtkAxis.h>
 #include <vtkBrush.h>
@@ -9,7 +12,9 @@
 #include <vtkContextScene.h>
 #include <vtkContextView.h>
 #include <vtkDoubleArray.h>
+#include <vtkGL2PSExporter.h>
 #include <vtkNew.h>
+#include <vtkPDFExporter.h>
 #include <vtkPNGWriter.h>
 #include <vtkPen.h>
 #include <vtkPlot.h>
@@ -20,6 +25,8 @@
 #include <vtkTextProperty.h>
 #include <vtkWindowToImageFilter.h>
 
+#include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -35,7 +42,42 @@ constexpr unsigned char kPalette[][3] = {{31, 119, 180}, {255, 127, 14}, {44, 16
 
 }  // namespace
 
-Status write_chart_png(const Chart& chart, const std::string& path) {
+Expected<ChartFormat> chart_format(const std::string& path) {
+  std::string ext = std::filesystem::path(path).extension().string();
+  for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
+  if (ext == ".png") return ChartFormat::Png;
+  if (ext == ".svg") return ChartFormat::Svg;
+  if (ext == ".pdf") return ChartFormat::Pdf;
+  return Error::usage("--plot '" + path + "': charts are written as .png, .svg or .pdf; " +
+                      (ext.empty() ? std::string("add one of these extensions") : "'" + ext + "' is none of them"));
+}
+
+AxisRange chart_y_range(const Chart& chart) {
+  double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+  for (const auto& series : chart.series)
+    for (std::size_t i = 0; i < std::min(series.x.size(), series.y.size()); ++i)
+      if (std::isfinite(series.y[i])) {
+        lo = std::min(lo, series.y[i]);
+        hi = std::max(hi, series.y[i]);
+      }
+  if (!(lo <= hi)) {  // nothing finite to show
+    lo = chart.y_lowest.value_or(0.0);
+    hi = chart.y_highest.value_or(lo + 1.0);
+  }
+  if (chart.y_min) lo = *chart.y_min;
+  if (chart.y_max) hi = *chart.y_max;
+  const double span = hi > lo ? hi - lo : std::max(1e-3, 0.1 * std::fabs(hi));
+  if (!chart.y_min) lo -= 0.05 * span;
+  if (!chart.y_max) hi += 0.05 * span;
+  if (chart.y_lowest && !chart.y_min) lo = std::max(lo, *chart.y_lowest);
+  if (chart.y_highest && !chart.y_max) hi = std::min(hi, *chart.y_highest);
+  if (!(hi > lo)) hi = lo + span;  // a flat series at a bound (SSIM exactly 1 everywhere)
+  return {lo, hi};
+}
+
+Status write_chart(const Chart& chart, const std::string& path) {
+  auto format = chart_format(path);
+  if (!format) return format.error();
   if (chart.series.empty()) return Error::usage("chart '" + chart.title + "' has no series to draw");
   if (chart.width < 64 || chart.height < 64) return Error::usage("chart size must be at least 64x64 pixels");
 
@@ -51,6 +93,9 @@ Status write_chart_png(const Chart& chart, const std::string& path) {
   xy->GetTitleProperties()->SetFontSize(18);
   xy->SetShowLegend(true);
   xy->GetLegend()->GetLabelProperties()->SetFontSize(14);
+  xy->GetLegend()->SetInline(false);  // to the right of the plot area: it never hides a curve
+  xy->GetLegend()->SetHorizontalAlignment(vtkChartLegend::RIGHT);
+  xy->GetLegend()->SetVerticalAlignment(vtkChartLegend::TOP);
   xy->GetAxis(vtkAxis::BOTTOM)->SetTitle(chart.x_label);
   xy->GetAxis(vtkAxis::LEFT)->SetTitle(chart.y_label);
   for (int a : {vtkAxis::BOTTOM, vtkAxis::LEFT}) {
@@ -58,8 +103,7 @@ Status write_chart_png(const Chart& chart, const std::string& path) {
     xy->GetAxis(a)->GetLabelProperties()->SetFontSize(12);
   }
 
-  double ymin = std::numeric_limits<double>::infinity(), ymax = -ymin;
-  double xmin = ymin, xmax = -ymin;
+  double xmin = std::numeric_limits<double>::infinity(), xmax = -xmin;
   bool any = false;
   for (std::size_t s = 0; s < chart.series.size(); ++s) {
     const auto& series = chart.series[s];
@@ -77,18 +121,24 @@ Status write_chart_png(const Chart& chart, const std::string& path) {
       ys->SetValue(vtkIdType(i), y);
       if (std::isfinite(y)) {
         any = true;
-        ymin = std::min(ymin, y);
-        ymax = std::max(ymax, y);
         xmin = std::min(xmin, series.x[i]);
         xmax = std::max(xmax, series.x[i]);
       }
     }
     table->AddColumn(xs);
     table->AddColumn(ys);
-    vtkPlot* plot = xy->AddPlot(chart.style == ChartStyle::Lines ? vtkChart::LINE : vtkChart::POINTS);
+    const bool as_line = chart.style == ChartStyle::Lines || series.line;
+    vtkPlot* plot = xy->AddPlot(as_line ? vtkChart::LINE : vtkChart::POINTS);
     plot->SetInputData(table, 0, 1);
     plot->SetLabel(ys->GetName());
-    const auto* c = kPalette[s % (sizeof kPalette / sizeof kPalette[0])];
+    const std::size_t entry = series.color >= 0 ? std::size_t(series.color) : s;
+    const auto* c = kPalette[entry % (sizeof kPalette / sizeof kPalette[0])];
+    if (series.line && chart.style == ChartStyle::Points) {
+      plot->SetColor(110, 110, 110, 255);  // the front: grey, thin, behind the markers' colours
+      plot->SetWidth(1.5f);
+      if (auto* points = vtkPlotPoints::SafeDownCast(plot)) points->SetMarkerStyle(vtkPlotPoints::NONE);
+      continue;
+    }
     plot->SetColor(c[0], c[1], c[2], 255);
     plot->SetWidth(chart.style == ChartStyle::Lines ? 2.0f : 1.0f);
     if (auto* points = vtkPlotPoints::SafeDownCast(plot)) {
@@ -103,14 +153,9 @@ Status write_chart_png(const Chart& chart, const std::string& path) {
   auto* left = xy->GetAxis(vtkAxis::LEFT);
   auto* bottom = xy->GetAxis(vtkAxis::BOTTOM);
   if (any) {
-    double lo = chart.y_min.value_or(ymin), hi = chart.y_max.value_or(ymax);
-    const double span = hi > lo ? hi - lo : std::max(1e-3, 0.1 * std::fabs(hi));
-    // Headroom at the top for the legend (top right, inside the plot), so it does not hide the highest points.
-    const double legend = 0.06 * double(chart.series.size()) + 0.04;
-    if (!chart.y_min) lo -= 0.05 * span;
-    if (!chart.y_max) hi += (0.05 + legend) * span;
+    const AxisRange y = chart_y_range(chart);
     left->SetBehavior(vtkAxis::FIXED);
-    left->SetRange(lo, hi);
+    left->SetRange(y.low, y.high);
     const double xfrac = chart.style == ChartStyle::Points ? 0.1 : 0.02;  // markers need room at the edges
     const double xpad = xmax > xmin ? xfrac * (xmax - xmin) : std::max(0.5, 0.1 * std::fabs(xmax));
     bottom->SetBehavior(vtkAxis::FIXED);
@@ -134,31 +179,41 @@ Status write_chart_png(const Chart& chart, const std::string& path) {
   }
 
   view->GetRenderWindow()->Render();
-  vtkNew<vtkWindowToImageFilter> grab;
-  grab->SetInput(view->GetRenderWindow());
-  grab->SetInputBufferTypeToRGB();
-  grab->ReadFrontBufferOff();
-  grab->Update();
-
-  namespace fs = std::filesystem;
+  TemporaryFile tmp(path);  // removed on failure and on SIGINT; the extension is kept
+  if (*format == ChartFormat::Png) {
+    vtkNew<vtkWindowToImageFilter> grab;
+    grab->SetInput(view->GetRenderWindow());
+    grab->SetInputBufferTypeToRGB();
+    grab->ReadFrontBufferOff();
+    grab->Update();
+    vtkNew<vtkPNGWriter> writer;
+    writer->SetFileName(tmp.path().c_str());
+    writer->SetInputConnection(grab->GetOutputPort());
+    writer->Write();
+    if (writer->GetErrorCode() != 0) return Error::output(path, "cannot write the PNG: check that the folder is writable");
+  } else if (*format == ChartFormat::Svg) {
+    // GL2PS appends the extension to its prefix: give it the temporary name without `.svg`.
+    const std::string prefix = tmp.path().substr(0, tmp.path().size() - 4);
+    vtkNew<vtkGL2PSExporter> exporter;
+    exporter->SetRenderWindow(view->GetRenderWindow());
+    exporter->SetFileFormatToSVG();
+    exporter->SetFilePrefix(prefix.c_str());
+    exporter->SetTitle(chart.title.c_str());
+    exporter->CompressOff();
+    exporter->TextAsPathOff();  // text stays text: selectable, editable, searchable
+    exporter->SilentOn();       // GL2PS would print notices to stderr; the library never prints
+    exporter->Write();
+  } else {
+    vtkNew<vtkPDFExporter> exporter;
+    exporter->SetRenderWindow(view->GetRenderWindow());
+    exporter->SetFileName(tmp.path().c_str());
+    exporter->SetTitle(chart.title.c_str());
+    exporter->Write();
+  }
   std::error_code ec;
-  const fs::path out(path);
-  if (out.has_parent_path()) fs::create_directories(out.parent_path(), ec);
-  const std::string tmp = path + ".tmp.png";
-  vtkNew<vtkPNGWriter> writer;
-  writer->SetFileName(tmp.c_str());
-  writer->SetInputConnection(grab->GetOutputPort());
-  writer->Write();
-  if (writer->GetErrorCode() != 0 || !fs::exists(tmp) || fs::file_size(tmp, ec) == 0) {
-    fs::remove(tmp, ec);
-    return Error::output(path, "cannot write the PNG: check that the folder exists and is writable");
-  }
-  fs::rename(tmp, path, ec);
-  if (ec) {
-    fs::remove(tmp, ec);
-    return Error::output(path, "cannot move the PNG into place: " + ec.message());
-  }
-  return {};
+  if (!std::filesystem::exists(tmp.path()) || std::filesystem::file_size(tmp.path(), ec) == 0)
+    return Error::output(path, "the chart could not be written: check that the folder exists and is writable");
+  return tmp.commit();
 }
 
 }  // namespace temporal

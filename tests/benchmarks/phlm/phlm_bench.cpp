@@ -1,5 +1,6 @@
 // filter-phlm's methods at 1920x1080 (RGB, 1 spp noise, fractional motion so that the history fetches
-// interpolate), next to the streaming bound of PHLM's state traffic: a memcpy of the bytes the filter must
+// interpolate; the G-buffer has depth, so TAA's nearest-depth velocity reads its 3x3 depths), next to the streaming
+// bound of PHLM's state traffic: a memcpy of the bytes the filter must
 // read and write per frame (26 floats of models read at p + motion and 26 written, per pixel).
 // Run: build/<dir>/tests/benchmarks/phlm/phlm_bench [--benchmark_filter=...]
 #include "temporal/phlm/ema.h"
@@ -53,10 +54,10 @@ const Scene& scene() {
   return s;
 }
 
-template <typename Filter>
-void run_filter(benchmark::State& state) {
+template <typename Filter, typename Params>
+void run_filter(benchmark::State& state, const Params& params) {
   ThreadLimit limit(int(state.range(1)));
-  Filter filter;
+  Filter filter(params);
   Image out;
   const FilterInput in = scene().input(state.range(0) != 0);
   (void)filter.process(in, out);  // first frame: allocations and resets
@@ -67,9 +68,24 @@ void run_filter(benchmark::State& state) {
   state.SetItemsProcessed(state.iterations() * int64_t(kW) * kH);
 }
 
-void BM_Phlm(benchmark::State& s) { run_filter<PhlmFilter>(s); }
-void BM_Taa(benchmark::State& s) { run_filter<TaaFilter>(s); }
-void BM_Ema(benchmark::State& s) { run_filter<EmaFilter>(s); }
+void BM_Phlm(benchmark::State& s) { run_filter<PhlmFilter>(s, PhlmParams{}); }
+// PHLM with the Catmull-Rom model fetch (beta and the feature from 16 records).
+void BM_PhlmCatmullRom(benchmark::State& s) {
+  PhlmParams p;
+  p.model_fetch = "catmull-rom";
+  run_filter<PhlmFilter>(s, p);
+}
+// The engine-strength TAA (defaults: nearest-depth velocity, Catmull-Rom history, variance clipping) and the TAA
+// this suite had before issue 16 (pixel's own motion, min/max clipping, alpha 0.04): the cost of the strengthening.
+void BM_Taa(benchmark::State& s) { run_filter<TaaFilter>(s, TaaParams{}); }
+void BM_Taa2014(benchmark::State& s) {
+  TaaParams p;
+  p.velocity = "centre";
+  p.clip = "minmax";
+  p.alpha = 0.04f;
+  run_filter<TaaFilter>(s, p);
+}
+void BM_Ema(benchmark::State& s) { run_filter<EmaFilter>(s, EmaParams{}); }
 
 void BM_Fxaa(benchmark::State& state) {
   ThreadLimit limit(int(state.range(0)));
@@ -104,7 +120,11 @@ void BM_PhlmStateStreamBound(benchmark::State& state) {
 // scene), threads (0: every core; 1: one thread, whose time is meaningful on a loaded machine).
 BENCHMARK(BM_Phlm)->ArgNames({"motion", "threads"})->Args({1, 0})->Args({0, 0})->Args({1, 1})
     ->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_PhlmCatmullRom)->ArgNames({"motion", "threads"})->Args({1, 0})->Args({1, 1})
+    ->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_Taa)->ArgNames({"motion", "threads"})->Args({1, 0})->Args({0, 0})->Args({1, 1})
+    ->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_Taa2014)->ArgNames({"motion", "threads"})->Args({1, 0})->Args({1, 1})
     ->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_Ema)->ArgNames({"motion", "threads"})->Args({1, 0})->Args({1, 1})->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_Fxaa)->ArgNames({"threads"})->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->UseRealTime();

@@ -13,6 +13,7 @@
 #pragma once
 
 #include "temporal/core/error.h"
+#include "temporal/core/metadata.h"
 #include "temporal/core/runner.h"
 #include "temporal/core/sequence.h"
 #include "temporal/metrics/flip.h"
@@ -117,8 +118,12 @@ struct MetricColumn {
 struct MetricChart {
   std::string suffix;
   std::string title;
-  std::string y_label;
-  bool skip_without_values = false;  // no chart when no frame has a value (flicker of a single frame)
+  std::string y_label;                 // with the unit: "PSNR (dB)"
+  bool skip_without_values = false;    // no chart when no frame has a value (flicker of a single frame)
+  // The range the metric's values can take (SSIM <= 1, FLIP in [0, 1], flicker >= 0): the chart's automatic
+  // axis range never extends past them.
+  std::optional<double> lowest;
+  std::optional<double> highest;
 };
 
 struct MetricDefinition {
@@ -174,10 +179,24 @@ struct FrameMetrics {
   double value(std::string_view metric, std::size_t column = 0) const;
 };
 
+// What the compute time in a test's headers measures (docs/compare.md, "Speed"): decided from the first frame's
+// `temporal:tool` and attributes. Only Method times are the cost of a reconstruction method.
+enum class ComputeKind {
+  Method,      // a method's own time (upsample-st, filter-phlm, morph-120hz outputs; any other tool's files)
+  Render,      // written by render-gbuffer: its computeMs is the render pass (e.g. the 1-spp input of filter-phlm)
+  Simulation,  // morph-120hz --perceive outputs (`temporal:perceivedWindow`): the perception simulation's time
+};
+// "method", "render", "simulation".
+const char* compute_kind_name(ComputeKind kind);
+// The kind of compute time of a file with this header.
+ComputeKind compute_kind_of(const FrameMetadata& header);
+
 struct SequenceReport {
   std::string name;
   std::string pattern;
   std::string mask_source;  // "test", "gbuffer", "reference" or empty
+  std::string tool;         // `temporal:tool` of the first frame ("" when absent)
+  ComputeKind compute_kind = ComputeKind::Method;
   std::vector<FrameMetrics> frames;
 };
 
@@ -197,15 +216,46 @@ struct ComparisonReport {
   bool peak_from_data = false;
   FlipMode flip = FlipMode::Off;
   double pixels_per_degree = kFlipDefaultPixelsPerDegree;  // FLIP's viewing condition
+  std::optional<double> fps;                    // `temporal:fps` of the reference's first frame
   std::vector<std::string> metrics;             // names of the measured metrics, registry order
   int warmup_frames = 0;                        // ComparisonSetup::warmup_frames
   BootstrapOptions bootstrap;                   // ComparisonSetup::bootstrap
   std::vector<SequenceReport> sequences;
 };
 
+// One compared frame as the engine holds it, for observers that make pictures of it (temporal/pictures): every
+// pointer is valid only during the call.
+struct ComparedFrame {
+  int frame = 0;
+  std::size_t index = 0;                   // position in ComparisonReport::frames
+  std::size_t count = 0;                   // frames in the comparison
+  const Image* reference = nullptr;        // the reference's compared layer (and the mask when it lives there)
+  std::span<const std::string> reference_channels;
+  std::string reference_path;
+  const Image* gbuffer = nullptr;          // motion (+ depth, id, and ComparisonHooks::gbuffer_layers); null without
+  std::string gbuffer_path;
+  struct Test {
+    std::string name;                      // SequenceReport::name
+    const Image* image = nullptr;          // the test's compared layer
+    std::span<const std::string> channels; // its compared channels, in the reference's order
+    const Image* maps = nullptr;           // the error-map image (error.R/G/B/Y, error.ssim, error.flicker, error.flip,
+                                           // error.invalid); null unless kept (--error-maps or keep_maps)
+    const FrameMetrics* metrics = nullptr; // this frame's row
+    std::string path;
+  };
+  std::vector<Test> tests;                 // in ComparisonSetup::tests order
+};
+
 // Observers of a running comparison (the library never prints; the tool decides what to show): the runner's
-// hooks (temporal/core/runner.h), frame_done after each frame, warnings (e.g. NaN pixels found), --verbose lines.
-using ComparisonHooks = RunHooks;
+// hooks (temporal/core/runner.h), frame_done after each frame, warnings (e.g. NaN pixels found), --verbose lines;
+// and `frame`, called with the images of each frame once every test is measured (an error stops the run).
+struct ComparisonHooks : RunHooks {
+  ComparisonHooks() = default;
+  ComparisonHooks(RunHooks base) : RunHooks(std::move(base)) {}  // NOLINT: a tool's hooks are comparison hooks
+  std::function<Status(const ComparedFrame&)> frame;
+  bool keep_maps = false;                   // build each test frame's error-map image for `frame`
+  std::vector<std::string> gbuffer_layers;  // G-buffer layers to read too when the file has them (e.g. N)
+};
 
 // Runs the comparison. Errors: Usage (bad setup), Input (missing/corrupt files, missing layers, size or
 // channel-count mismatch, empty sequence, a layer FLIP cannot read), Output (error maps not writable).
@@ -214,6 +264,10 @@ Expected<ComparisonReport> compare_sequences(const ComparisonSetup& setup, const
 // Every file a comparison reads (reference, test and G-buffer frames), so that the caller can refuse an output
 // (CSV, JSON, chart) that would replace one of them; the engine itself refuses such error maps.
 Expected<ProtectedInputs> comparison_inputs(const ComparisonSetup& setup);
+
+// Sets the PSNR / SSIM peak from its text: a positive finite number (`peak`), or `max` (`peak_from_data`,
+// idiff's rule). Errors: Usage, naming the text.
+Status set_peak(const std::string& text, ComparisonSetup& setup);
 
 // The name `compare` gives a test sequence without --names: the file name without folder, frame number and
 // extension (`out/taa.####.exr` -> `taa`).

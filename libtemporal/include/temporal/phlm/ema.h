@@ -19,7 +19,7 @@
 namespace temporal {
 
 struct EmaParams {
-  float alpha = 0.9f;            // history weight of eq. 1
+  float alpha = 0.5f;            // history weight of eq. 1, chosen on the tuning set (docs/filter-phlm.md)
   float depth_tolerance = reproject::kDepthTolerance;  // relative depth difference of the disocclusion test
 };
 

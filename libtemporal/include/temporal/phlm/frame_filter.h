@@ -42,6 +42,12 @@ struct FilterStats {
   double max_trace_p = 0.0;         // PHLM: largest trace(P) after the update
 };
 
+// How a method fetches its history (or PHLM its models) at the fractional position p + motion, through
+// temporal/core/reproject.h: the 2x2 bilinear taps, the 4x4 Catmull-Rom taps, or the nearest pixel.
+enum class HistoryFetch { Bilinear, CatmullRom, Nearest };
+// "bilinear" | "catmull-rom" | "nearest"; a usage error naming `flag` otherwise.
+Expected<HistoryFetch> parse_history_fetch(const std::string& name, const char* flag);
+
 // Checks that `in` is usable: a colour image with the named float channels (1 or 3 of them). Input error
 // naming the missing channel otherwise.
 Status validate_filter_input(const FilterInput& in);

@@ -31,6 +31,22 @@ struct PhlmParams {
   float feature_b = 0.25f;
   // trace(P) never exceeds trace_factor * N * p_init (temporal/phlm/rls.h, wind-up guard).
   float trace_factor = 4.0f;
+
+  // Ablations and measured alternatives (docs/filter-phlm.md, "Ablations"); the defaults are the paper's method.
+  // Feature off: the predictor is x = [1] (the slopes stay 0 and P's feature rows untouched), i.e. an
+  // intercept-only RLS: a per-pixel exponentially weighted running mean (weight lambda^age) with the same resets.
+  bool no_feature = false;
+  // Box test off: Algorithm 1 lines 13-19 skipped; models are reset only off screen, at cuts and at frame 0.
+  bool no_box_test = false;
+  // Reading of the feature's alpha (section 5.1): "ue4" = weight of the new low-frequency sample (UE4's
+  // BlendFinal, whose code the constants come from); "eq1" = the literal eq. 1 reading, alpha weighs the history:
+  // z = alpha z_prev + (1 - alpha) low.
+  std::string alpha_reading = "ue4";
+  // Fetch of the previous models at p + motion: "bilinear" (section 6, hardware bilinear filtering of the model
+  // textures), "nearest" (the record of the nearest pixel), "catmull-rom" (beta and the feature with the 4x4
+  // Catmull-Rom taps of temporal/core/reproject.h, P's factors and the scale bilinearly: negative weights could
+  // make P indefinite).
+  std::string model_fetch = "bilinear";
 };
 
 // Floats of persistent state per pixel for C channels: beta (C * N), P as UD factors (N (N + 1) / 2),

@@ -1,5 +1,6 @@
-// PNG charts (VTK), behind a header that does not include VTK: only `compare` links the `temporal::plot`
-// target, which keeps libGL (pulled in by VTK) out of every other program (docs/building.md, OSMesa trap).
+// Charts (VTK) as PNG, SVG or PDF, behind a header that does not include VTK: only `compare` links the
+// `temporal::plot` target, which keeps libGL (pulled in by VTK) out of every other program (docs/building.md,
+// OSMesa trap).
 //
 // Debian's VTK renders through X11 only. VirtualDisplay provides a display when none is usable: it starts
 // `Xvfb -displayfd N -nolisten tcp` on a free display number and points $DISPLAY at it for this process.
@@ -20,6 +21,8 @@ struct ChartSeries {
   std::string name;  // legend entry
   std::vector<double> x;
   std::vector<double> y;
+  int color = -1;    // palette entry (Tableau 10); -1: the series' position. A method keeps its colour across charts
+  bool line = false;  // in a Points chart: drawn as a grey line without markers (the Pareto front of the speed chart)
 };
 
 enum class ChartStyle {
@@ -27,23 +30,41 @@ enum class ChartStyle {
   Points,  // markers only (speed against error: one point per method)
 };
 
-// Everything a chart shows. Axis ranges are automatic unless given.
+// Everything a chart shows. Axis ranges are automatic unless given. The legend sits to the right of the plot
+// area, outside it, so it never hides a curve and needs no headroom.
 struct Chart {
   std::string title;
-  std::string x_label;
-  std::string y_label;
+  std::string x_label;  // with the unit, e.g. "time (s)"
+  std::string y_label;  // with the unit, e.g. "PSNR (dB)"
   std::vector<ChartSeries> series;
   ChartStyle style = ChartStyle::Lines;
-  int width = 1280;  // PNG size in pixels
+  int width = 1280;  // size in pixels (PNG) or points (SVG, PDF)
   int height = 720;
-  std::optional<double> y_min;
+  std::optional<double> y_min;  // fixed ends of the y axis
   std::optional<double> y_max;
+  // The values the quantity can take (SSIM <= 1, FLIP in [0, 1]): the automatic range stops there.
+  std::optional<double> y_lowest;
+  std::optional<double> y_highest;
 };
 
-// Renders `chart` off screen and writes it as an 8-bit RGB PNG (atomically: temporary file, then rename).
-// Needs an X display (see VirtualDisplay). Errors: Output when the PNG cannot be written, Usage for an empty
-// chart.
-Status write_chart_png(const Chart& chart, const std::string& path);
+// The formats of write_chart, chosen by the file's extension.
+enum class ChartFormat { Png, Svg, Pdf };
+// `.png`, `.svg` or `.pdf` (any case); a Usage error naming the three for any other extension or none.
+Expected<ChartFormat> chart_format(const std::string& path);
+
+struct AxisRange {
+  double low = 0.0;
+  double high = 1.0;
+};
+// The y range `chart` is drawn with: y_min / y_max when given; otherwise the finite values' range with a 5 %
+// margin (a flat series gets +-10 % of its value, at least 1e-3), never past y_lowest / y_highest.
+AxisRange chart_y_range(const Chart& chart);
+
+// Renders `chart` off screen and writes it by the extension of `path` (chart_format): an 8-bit RGB PNG, or a
+// vector SVG (GL2PS) or PDF (VTK's PDF exporter) with its text as text. Written atomically (temporary file, then
+// rename). Needs an X display (see VirtualDisplay). Errors: Usage for an empty chart or another extension,
+// Output when the file cannot be written.
+Status write_chart(const Chart& chart, const std::string& path);
 
 // An X display for VTK for as long as this object lives.
 class VirtualDisplay {
@@ -75,11 +96,20 @@ class VirtualDisplay {
   bool had_previous_ = false;
 };
 
-// The charts of `--plot F.png`: the file name and the chart. One per measured metric, as its registry entry
-// names it (temporal/metrics/comparison.h): F.png per-frame PSNR (RGB); F-psnr-y.png, F-ssim.png,
-// F-flicker.png (only when there are two frames or more), F-flip.png with --flip; F-speed.png: mean PSNR against
-// mean compute time, when any test header has timings.
+// The charts of `--plot F.EXT` (EXT = png, svg or pdf): the file name and the chart. One per measured metric, as
+// its registry entry names it (temporal/metrics/comparison.h): F.EXT per-frame PSNR (RGB); F-psnr-y.EXT,
+// F-ssim.EXT, F-flicker.EXT (only when there are two frames or more), F-flip.EXT with --flip; F-speed.EXT: mean
+// PSNR against the mean compute time of each test whose headers time the method itself
+// (ComputeKind::Method: never a render's or a simulation's time), when there is one. Titles are the metric's,
+// after `title` ("walkers: PSNR (rgb) per frame") when given; series are the sequences' names (--names). The speed
+// chart also draws the Pareto front of its points (pareto_front) as a line named "Pareto front" when it has two
+// points or more.
 std::vector<std::pair<std::string, Chart>> comparison_charts(const ComparisonReport& report,
-                                                             const std::string& plot_path);
+                                                             const std::string& plot_path,
+                                                             const std::string& title = {});
+
+// Indices of the points not dominated in (lower cost, higher score): no other point has a cost <= and a score >=
+// with one of them strictly better. Sorted by cost. Points with a non-finite cost or score are left out.
+std::vector<std::size_t> pareto_front(const std::vector<double>& cost, const std::vector<double>& score);
 
 }  // namespace temporal

@@ -1,0 +1,115 @@
+#!/usr/bin/env bash
+# Issue 16 item 8: temporal filters scoring below their own 1-spp input on thin edges under camera motion, with a
+# noise-free payload (direct light and shadow only: the only error of the 1-spp input is aliasing). Renders each
+# case, runs phlm and taa with every history / model fetch (bilinear, Catmull-Rom, nearest), the previous TAA and
+# ema, and measures with compare (PSNR, flicker) and phlm_edge_split (the error on edge pixels against surface
+# interiors, and the sub-pixel shift that best aligns each output with the reference: 0 for blur, +-0.5 for a
+# half-pixel convention mismatch).
+#
+# Cases (CASES, one per line "name scene render-options"; a scene path that does not exist is skipped with a note,
+# so the shared assets are optional):
+#   fence          assets/scenes/fence.glb, its own drifting camera
+#   helmet-orbit   ../shared/assets/gltf/FlightHelmet/FlightHelmet.gltf, --camera-path orbit (straps, goggles,
+#                  fine textures: the third-party case of issue 16 item 8)
+#   helmet-static  the same scene, automatic camera standing still (--camera-path fixed): no motion, so no
+#                  history resampling; only jitter and the reference convention remain
+#   ivy-orbit      ../shared/assets/gltf/SponzaIvy/sponza_ivy.gltf, --camera-path orbit (thin foliage, small in
+#                  the frame)
+#
+# Usage: pipelines/filter-phlm-edges.sh [BUILD_DIR=build/release] [OUT_DIR=report/filter-phlm-edges]
+# Environment: SIZE (512x288), FRAMES (0-47), FPS (40), WARMUP (10), CASES, REUSE_RENDER=1, SHARED_ASSETS (the
+#   third-party assets folder, default ../shared/assets beside the repository; a worktree sets it to its path).
+set -euo pipefail
+
+here="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+BUILD="${1:-build/release}"
+OUT="${2:-report/filter-phlm-edges}"
+SIZE="${SIZE:-512x288}"
+FRAMES="${FRAMES:-0-47}"
+FPS="${FPS:-40}"
+WARMUP="${WARMUP:-10}"
+REUSE_RENDER="${REUSE_RENDER:-0}"
+shared="${SHARED_ASSETS:-$here/../shared/assets}/gltf"
+CASES="${CASES:-fence $here/assets/scenes/fence.glb
+helmet-orbit $shared/FlightHelmet/FlightHelmet.gltf --camera-path orbit
+helmet-static $shared/FlightHelmet/FlightHelmet.gltf --camera-path fixed
+ivy-orbit $shared/SponzaIvy/sponza_ivy.gltf --camera-path orbit}"
+
+case "$BUILD" in
+  /*) ;;
+  *) if [[ -d "$PWD/$BUILD" ]]; then BUILD="$PWD/$BUILD"; else BUILD="$here/$BUILD"; fi ;;
+esac
+render="$BUILD/apps/render-gbuffer/render-gbuffer"
+filter="$BUILD/apps/filter-phlm/filter-phlm"
+compare="$BUILD/apps/compare/compare"
+split="$BUILD/tests/benchmarks/phlm/phlm_edge_split"
+for t in "$render" "$filter" "$compare" "$split"; do
+  if [[ ! -x "$t" ]]; then
+    echo "filter-phlm-edges.sh: $t is missing: build the project first (cmake --build --preset release)" >&2
+    exit 2
+  fi
+done
+
+runs=("phlm phlm"
+  "phlm-catmull-rom phlm --model-fetch catmull-rom"
+  "phlm-nearest phlm --model-fetch nearest"
+  "taa taa"
+  "taa-bilinear taa --taa-history bilinear"
+  "taa-centre taa --taa-velocity centre"
+  "taa-2014 taa --taa-velocity centre --taa-clip minmax --taa-alpha 0.04"
+  "ema ema")
+mkdir -p "$OUT"
+summary="$OUT/summary.md"
+{
+  echo "# filter-phlm: edges under camera motion (issue 16, item 8)"
+  echo
+  echo "Payload direct + shadow (noise-free), 1 spp random jitter, 16-spp reference; $SIZE, frames $FRAMES at $FPS fps;"
+  echo "the first $WARMUP frames are left out of the edge split."
+  echo
+} > "$summary"
+
+while read -r name scene opts; do
+  [[ -z "$name" ]] && continue
+  if [[ ! -f "$scene" ]]; then
+    echo "== $name: $scene not found, skipped" >&2
+    echo "$name: skipped ($scene not found)" >> "$summary"
+    continue
+  fi
+  dir="$OUT/$name"
+  r="$dir/render"
+  if [[ "$REUSE_RENDER" == 1 && -d "$r" ]]; then
+    echo "== $name: reusing $r" >&2
+  else
+    echo "== $name: rendering $scene $opts" >&2
+    # shellcheck disable=SC2086
+    "$render" "$scene" --out "$r" --size "$SIZE" --fps "$FPS" --frames "$FRAMES" --outputs gbuffer,color,reference \
+      --jitter random --reference-spp 16 --payload direct,shadow $opts
+  fi
+  tests=("$r/color.####.exr")
+  names="input"
+  pairs=("input=$r/color.####.exr")
+  for run in "${runs[@]}"; do
+    read -r n m args <<< "$run"
+    echo "== $name: $n" >&2
+    # shellcheck disable=SC2086
+    "$filter" --input "$r/color.####.exr" --gbuffer "$r/gbuffer.####.exr" --out "$dir/$n/$n.####.exr" --method "$m" $args
+    tests+=("$dir/$n/$n.####.exr")
+    names+=",$n"
+    pairs+=("$n=$dir/$n/$n.####.exr")
+  done
+  "$compare" --reference "$r/reference.####.exr" "${tests[@]}" --names "$names" --gbuffer "$r/gbuffer.####.exr" \
+    --csv "$dir/metrics.csv" --json "$dir/metrics.json" > "$dir/table.txt"
+  "$split" --reference "$r/reference.####.exr" --gbuffer "$r/gbuffer.####.exr" --warmup "$WARMUP" "${pairs[@]}" \
+    > "$dir/edges.md"
+  {
+    echo "## $name ($(basename "$scene") $opts)"
+    echo
+    cat "$dir/edges.md"
+    echo
+    echo '```'
+    cat "$dir/table.txt"
+    echo '```'
+    echo
+  } >> "$summary"
+done <<< "$CASES"
+cat "$summary"

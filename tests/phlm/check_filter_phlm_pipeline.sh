@@ -1,0 +1,38 @@
+#!/usr/bin/env bash
+# Smoke test of pipelines/filter-phlm.sh and pipelines/filter-phlm-ablation.sh: a tiny render of the built-in fence
+# scene (64x48, 6 frames, 2-spp reference), every method and the default variants, then the ablation on the same
+# render. Checks the Table 2 summary (a row per scene with a finite PSNR for every sequence, the mean row, the
+# paired-difference table) and the ablation's paired table.
+# Usage: check_filter_phlm_pipeline.sh BUILD_DIR OUT_DIR
+set -euo pipefail
+here="$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)"
+build="$1"
+out="$2"
+rm -rf "$out"
+mkdir -p "$out"
+fail() { [[ -f "${2:-}" ]] && cat "$2" >&2; echo "check_filter_phlm_pipeline.sh: $1" >&2; exit 1; }
+SIZE=64x48 FRAMES=0-5 WARMUP=2 REFERENCE_SPP=2 RENDER_ARGS="--payload direct,shadow" \
+  bash "$here/pipelines/filter-phlm.sh" "$build" "$out/table2" "$here/assets/scenes/fence.glb" > "$out/table2.log" 2>&1 ||
+  fail "filter-phlm.sh failed" "$out/table2.log"
+summary="$out/table2/summary.md"
+[[ -f "$summary" ]] || fail "no summary.md" "$out/table2.log"
+header="$(grep -E '^\| scene \| input \| phlm \| taa \| ema \| fxaa \| taa-0.1 \| taa-2014 \|$' "$summary" || true)"
+[[ -n "$header" ]] || fail "no Table 2 header with every sequence" "$summary"
+row="$(grep -E '^\| fence \|' "$summary" | head -1)"
+# Every cell starts with a PSNR between 5 and 100 dB.
+awk -F'|' '{ for (i = 3; i < NF; ++i) { v = $i + 0; if (!(v > 5 && v < 100)) { print "cell " i ": " $i; exit 1 } } }' \
+  <<< "$row" || fail "bad Table 2 row: $row" "$summary"
+grep -qE '^\| mean of the scenes \|' "$summary" || fail "no mean row" "$summary"
+grep -qE '^\| scene \| phlm - taa: PSNR dB / flicker \|' "$summary" || fail "no paired-difference table" "$summary"
+[[ -f "$out/table2/fence/psnr.png" && -f "$out/table2/fence/metrics.json" ]] || fail "no chart or JSON"
+# The ablation reuses the render.
+SIZE=64x48 FRAMES=0-5 WARMUP=2 RENDERS="$out/table2" \
+  bash "$here/pipelines/filter-phlm-ablation.sh" "$build" "$out/ablation" "$here/assets/scenes/fence.glb" \
+  > "$out/ablation.log" 2>&1 || fail "filter-phlm-ablation.sh failed" "$out/ablation.log"
+grep -q "reusing" "$out/ablation.log" || fail "the ablation rendered again" "$out/ablation.log"
+grep -qE '^\| scene \| phlm-no-feature - phlm: PSNR dB / flicker \|' "$out/ablation/summary.md" ||
+  fail "no ablation table" "$out/ablation/summary.md"
+# The variant is recorded in the output header.
+grep -qa -- "--no-feature=on" "$out/ablation/fence/phlm-no-feature/phlm-no-feature.0003.exr" ||
+  fail "temporal:methodParameters does not record --no-feature"
+echo "check_filter_phlm_pipeline.sh: ok"
