@@ -132,6 +132,9 @@ struct ComparisonPictures::Impl {
   Status video_frame(const ComparedFrame& cf, const Picture& ref, const std::vector<Picture>& tests);
   Expected<PictureProducts> finish(const ComparisonReport& report);
   Status finish_sheet(const ComparisonReport& report);
+  // The report's sections of single maps (FLIP, error) and of the G-buffer pictures, after the sheet.
+  Status report_map_sections(const ComparisonReport& report, bool flip, float error_high,
+                             const std::vector<std::string>& map_links);
   Status finish_profiles(const ComparisonReport& report);
 };
 
@@ -534,6 +537,12 @@ Status ComparisonPictures::Impl::finish_sheet(const ComparisonReport& report) {
                       sheet->picture.width(), sheet->picture.height(), sheet->areas});
   products.sections.push_back(std::move(s));
 
+  return report_map_sections(report, flip, error_high, map_links);
+}
+
+Status ComparisonPictures::Impl::report_map_sections(const ComparisonReport& report, bool flip, float error_high,
+                                                      const std::vector<std::string>& map_links) {
+  const Captured& c = *captured;
   // Each map on its own, linked to its EXR: FLIP (with --flip) and the error of luminance.
   for (const bool flip_maps : {true, false}) {
     if (flip_maps && !flip) continue;
