@@ -1,17 +1,24 @@
 #!/usr/bin/env bash
 # Reproduction of seed 004 (Didyk et al. 2010): render built-in scenes at 40 Hz and at 120 Hz, upsample the 40 Hz
 # stream to 120 Hz with every morph-120hz method (and ffmpeg's minterpolate when ffmpeg is installed), and report
-#  - PSNR of the in-between frames (120 Hz frames 3n+1, 3n+2) against the native 120 Hz render (compare),
+#  - PSNR of the in-between frames (120 Hz frames 3n+1, 3n+2) against the native 120 Hz render (compare), both
+#    latency-free (output frame t against native frame t) and latency-aware (against native frame t + L, the
+#    instant it is shown; L = temporal:latencyFrames: blend and minterpolate 3, the others 0), each with compare's
+#    95% bootstrap interval (compare --merge of the in-between rows) and the paired differences,
 #  - the perceived-blur error: the image perceived on a hold-type display under smooth pursuit
 #    (morph-120hz --perceive, seed 004 section 3) of each method against that of the native 120 Hz render, as PSNR,
-#  - milliseconds per output frame (compute_ms of the headers; ffmpeg: wall time / frames, I/O included) and the
-#    render time of one frame (render-gbuffer's timings.csv).
+#    as perceived and with the lag removed (--lag-reference: best shift along the motion), and the lag in ms,
+#  - speed, like with like: compute per output frame (morph-120hz: temporal:computeMs of the headers, I/O
+#    excluded; ffmpeg: its minterpolate run into the null muxer minus the same run with frame repetition instead
+#    of minterpolate) and whole command per output frame (wall time of the morph-120hz and of the ffmpeg command,
+#    EXR in and out, median of REPEAT runs), and the render time of one frame (render-gbuffer's timings.csv).
 #
 # Usage: pipelines/morph-120hz.sh [BUILD_DIR] [OUT_DIR] [SCENE.glb ...]
 #   BUILD_DIR  default build/release;  OUT_DIR  default report/morph-120hz
 #   SCENE      default: every assets/scenes/*.glb
 # Environment: SIZE (default 256x256), FRAMES (rendered 40 Hz frames, default 8), METHODS (default: every
-#   method of the registry, `morph-120hz --list-methods`), FFMPEG=0 to skip minterpolate.
+#   method of the registry, `morph-120hz --list-methods`), FFMPEG=0 to skip minterpolate, REPEAT (timed runs of
+#   each command, default 3; the median is reported).
 set -euo pipefail
 
 ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
@@ -21,6 +28,8 @@ shift $(( $# >= 2 ? 2 : $# ))
 SIZE=${SIZE:-256x256}
 FRAMES=${FRAMES:-8}
 FACTOR=3
+REPEAT=${REPEAT:-3}
+WINDOW=3  # morph-120hz --perceive's default window
 
 case "$BUILD" in /*) ;; *) BUILD="$ROOT/$BUILD" ;; esac
 RENDER="$BUILD/apps/render-gbuffer/render-gbuffer"
@@ -43,6 +52,10 @@ if [[ ! -e "${SCENES[0]}" ]]; then
 fi
 
 have_ffmpeg=0
+if ! command -v python3 >/dev/null 2>&1; then
+  echo "morph-120hz.sh: python3 not found (it reads compare's JSON intervals)" >&2
+  exit 2
+fi
 if ! command -v oiiotool >/dev/null 2>&1; then
   echo "morph-120hz.sh: oiiotool not found: install openimageio-tools (it clamps the renders to [0, 1])" >&2
   exit 2
@@ -60,8 +73,67 @@ LAST120=$((FACTOR * FRAMES - 1))
 # method can extrapolate from it) to the last frame every method produces.
 FIRSTCMP=$FACTOR
 LASTCMP=$((FACTOR * FRAMES - 1))
+# The native render goes on past the last output frame: a method with one rendered frame of latency shows output
+# frame LASTCMP at LASTCMP + FACTOR (latency-aware scoring), and the eye integrates WINDOW - 1 frames further.
+LASTNATIVE=$((LASTCMP + FACTOR + WINDOW - 1))
 TABLE="$OUT/summary.csv"
-echo "scene,method,psnr_inbetween_db,psnr_all_db,perceived_psnr_db,ms_per_output_frame,render_ms_per_frame" > "$TABLE"
+PAIRED="$OUT/paired.csv"
+echo "scene,method,latency_frames,psnr_inbetween_db,psnr_inbetween_ci_low,psnr_inbetween_ci_high,psnr_inbetween_latency_db,psnr_inbetween_latency_ci_low,psnr_inbetween_latency_ci_high,psnr_all_db,perceived_psnr_db,perceived_latency_psnr_db,perceived_blur_psnr_db,lag_ms,compute_ms_per_output_frame,command_ms_per_output_frame,render_ms_per_frame" > "$TABLE"
+echo "scene,score,metric,a,b,frames,mean_difference_db,ci_low,ci_high" > "$PAIRED"
+
+# Median wall time in ms of REPEAT runs of a command (its output to /dev/null unless redirected inside).
+median_ms() {
+  local times=() t0 t1
+  for ((r = 0; r < REPEAT; ++r)); do
+    t0=$(date +%s.%N)
+    "$@"
+    t1=$(date +%s.%N)
+    times+=("$(awk -v a="$t0" -v b="$t1" 'BEGIN { printf "%.3f", (b - a) * 1000 }')")
+  done
+  printf '%s\n' "${times[@]}" | sort -g | awk '{ v[NR] = $1 } END { if (NR % 2) print v[(NR + 1) / 2]; else printf "%.3f\n", (v[NR / 2] + v[NR / 2 + 1]) / 2 }'
+}
+
+# Keep the header and the rows of compare's CSV whose frame is an in-between frame (frame % FACTOR != 0).
+inbetween_rows() {
+  awk -F, -v factor=$FACTOR 'NR == 1 { for (i = 1; i <= NF; ++i) if ($i == "frame") c = i; print; next } ($c % factor) != 0' "$1" > "$2"
+}
+
+# sequence METRIC -> "mean,ci_low,ci_high" from compare's JSON (empty fields when absent)
+json_interval() {
+  python3 - "$1" "$2" "$3" <<'PY'
+import json, sys
+j = json.load(open(sys.argv[1]))
+def fmt(v):  # compare writes +infinity (an identical frame) as "inf": shown, never dropped
+    return "" if v is None else "%.2f" % v if isinstance(v, (int, float)) else str(v)
+for s in j["sequences"]:
+    if s["name"] == sys.argv[2]:
+        m = s.get(sys.argv[3]) or {}
+        ci = m.get("ci95") or [None, None]
+        print(",".join(fmt(v) for v in (m.get("mean"), ci[0], ci[1])))
+        break
+else:
+    print(",,")
+PY
+}
+
+# Paired differences a - b of one metric from compare's JSON, as rows of paired.csv.
+json_paired() {
+  python3 - "$1" "$2" "$3" "$4" <<'PY'
+import json, sys
+j = json.load(open(sys.argv[1]))
+for p in j.get("paired", []):
+    if p["metric"] != sys.argv[4]:
+        continue
+    ci = p.get("ci95") or [None, None]
+    f = lambda v: "" if v is None or isinstance(v, str) else "%.3f" % v
+    print(",".join([sys.argv[2], sys.argv[3], p["metric"], p["a"], p["b"], str(p["frames"]), f(p["mean_difference"]), f(ci[0]), f(ci[1])]))
+PY
+}
+
+# `temporal:KEY` of an EXR header (oiiotool's listing), or empty
+header_value() {
+  oiiotool --info -v "$1" 2>/dev/null | awk -v key="temporal:$2" '$1 == key":" { v = $2; gsub(/"/, "", v); print v; exit }'
+}
 
 # mean of column NAME over the rows of CSV whose `sequence` is SEQ and whose frame passes FILTER (awk expr on f)
 csv_mean() {
@@ -76,14 +148,14 @@ csv_mean() {
 for scene in "${SCENES[@]}"; do
   name=$(basename "$scene"); name=${name%.*}
   D="$OUT/$name"
-  echo "== $name: rendering $FRAMES frames at 40 Hz and $((LAST120 + 1)) at 120 Hz ($SIZE)" >&2
+  echo "== $name: rendering $FRAMES frames at 40 Hz and $((LASTNATIVE + 1)) at 120 Hz ($SIZE)" >&2
   "$RENDER" "$scene" --out "$D/r40" --fps 40 --frames "0-$LAST40" --size "$SIZE" --outputs gbuffer,color --jitter none
-  "$RENDER" "$scene" --out "$D/r120" --fps 120 --frames "0-$LAST120" --size "$SIZE" --outputs gbuffer,color --jitter none
+  "$RENDER" "$scene" --out "$D/r120" --fps 120 --frames "0-$LASTNATIVE" --size "$SIZE" --outputs gbuffer,color --jitter none
   # Seed 004 works on tone-mapped, display-referred frames (section 6: the blur runs on 8-bit RGB after tone
   # mapping). The scenes are scene-linear with highlights above 1: clamp both renders to [0, 1] first, so every
   # method (and ffmpeg, which clips anyway) and the reference see the same displayable frames.
   mkdir -p "$D/ldr40" "$D/ldr120"
-  for ((n = 0; n <= LAST120; ++n)); do
+  for ((n = 0; n <= LASTNATIVE; ++n)); do
     printf -v f "%04d" "$n"
     oiiotool "$D/r120/color.$f.exr" --ch R,G,B --clamp:min=0:max=1 -d float --compression zip -o "$D/ldr120/color.$f.exr"
     if (( n <= LAST40 )); then
@@ -95,10 +167,12 @@ for scene in "${SCENES[@]}"; do
 
   names=()
   tests=()
+  declare -A command_ms=() compute_ms=()
   for m in $METHODS; do
-    echo "== $name: morph-120hz --method $m" >&2
-    "$MORPH" --input "$D/ldr40/color.####.exr" --gbuffer "$D/r40/gbuffer.####.exr" --out "$D/$m/color.####.exr" \
-      --method "$m" --factor $FACTOR --fps 40
+    echo "== $name: morph-120hz --method $m ($REPEAT timed runs)" >&2
+    wall=$(median_ms "$MORPH" --input "$D/ldr40/color.####.exr" --gbuffer "$D/r40/gbuffer.####.exr" \
+      --out "$D/$m/color.####.exr" --method "$m" --factor $FACTOR --fps 40)
+    command_ms[$m]=$(awk -v w="$wall" -v n=$((FACTOR * FRAMES)) 'BEGIN { printf "%.2f", w / n }')
     names+=("$m")
     tests+=("$D/$m/color.####.exr")
   done
@@ -112,19 +186,28 @@ for scene in "${SCENES[@]}"; do
       printf -v f "%04d" "$n"
       oiiotool "$D/ldr40/color.$f.exr" -d half --compression zip -o "$D/ffmpeg-in/c.$f.exr"
     done
-    t0=$(date +%s.%N)
-    ffmpeg -loglevel error -y -framerate 40 -start_number 0 -i "$D/ffmpeg-in/c.%04d.exr" \
-      -vf "format=yuv444p,minterpolate=fps=120:mi_mode=mci:mc_mode=aobmc:me_mode=bidir:vsbmc=1" \
-      -pix_fmt gbrpf32le -compression zip1 -start_number 0 "$D/minterpolate-raw/c.%04d.exr"
-    t1=$(date +%s.%N)
+    mi="minterpolate=fps=120:mi_mode=mci:mc_mode=aobmc:me_mode=bidir:vsbmc=1"
+    # Whole command: EXR in, minterpolate, EXR out (as morph-120hz's whole command: EXR in and out).
+    wall=$(median_ms ffmpeg -loglevel error -y -framerate 40 -start_number 0 -i "$D/ffmpeg-in/c.%04d.exr" \
+      -vf "format=yuv444p,$mi" -pix_fmt gbrpf32le -compression zip1 -start_number 0 "$D/minterpolate-raw/c.%04d.exr")
     produced=$(ls "$D/minterpolate-raw" | wc -l)
-    ffmpeg_ms=$(awk -v a="$t0" -v b="$t1" -v n="$produced" 'BEGIN { printf "%.2f", (b - a) * 1000 / (n > 0 ? n : 1) }')
-    # Pad to the full 120 Hz range by holding the last frame, so compare sees a contiguous sequence.
+    # Compute: the same decode and pixel-format conversions into the null muxer, with minterpolate and with plain
+    # frame repetition (fps=120) in its place; the difference is minterpolate's own time.
+    with_mi=$(median_ms ffmpeg -loglevel error -y -framerate 40 -start_number 0 -i "$D/ffmpeg-in/c.%04d.exr" \
+      -vf "format=yuv444p,$mi,format=gbrpf32le" -f null -)
+    without_mi=$(median_ms ffmpeg -loglevel error -y -framerate 40 -start_number 0 -i "$D/ffmpeg-in/c.%04d.exr" \
+      -vf "format=yuv444p,fps=120,format=gbrpf32le" -f null -)
+    command_ms[minterpolate]=$(awk -v w="$wall" -v n="$produced" 'BEGIN { printf "%.2f", w / (n > 0 ? n : 1) }')
+    compute_ms[minterpolate]=$(awk -v a="$with_mi" -v b="$without_mi" -v n="$produced" 'BEGIN { printf "%.2f", (a - b) / (n > 0 ? n : 1) }')
+    # Pad to the full 120 Hz range by holding the last frame, so compare sees a contiguous sequence; declare
+    # minterpolate's latency (it interpolates towards the next rendered frame: one rendered frame, FACTOR output
+    # frames) and the rate, as morph-120hz's headers do.
     for ((n = 0; n <= LAST120; ++n)); do
       printf -v f "%04d" "$n"
       src="$D/minterpolate-raw/c.$f.exr"
       [[ -f "$src" ]] || src=$(ls "$D/minterpolate-raw"/c.*.exr | tail -1)
-      cp "$src" "$D/minterpolate/color.$f.exr"
+      oiiotool "$src" --sattrib temporal:latencyFrames $FACTOR --attrib:type=float temporal:fps 120 \
+        --sattrib temporal:method minterpolate -d float --compression zip -o "$D/minterpolate/color.$f.exr"
     done
     names+=("minterpolate")
     tests+=("$D/minterpolate/color.####.exr")
@@ -133,33 +216,56 @@ for scene in "${SCENES[@]}"; do
   echo "== $name: compare (in-between frames vs native 120 Hz)" >&2
   IFS=, ; name_list="${names[*]}"; unset IFS
   "$COMPARE" --reference "$D/ldr120/color.####.exr" "${tests[@]}" --names "$name_list" --frames "$FIRSTCMP-$LASTCMP" \
-    --csv "$D/compare.csv" --json "$D/compare.json" --plot "$D/psnr.png"
+    --latency-aware --csv "$D/compare.csv" --json "$D/compare.json" --plot "$D/psnr.png"
+  # The in-between frames alone, with their intervals and paired differences (compare --merge of those rows).
+  inbetween_rows "$D/compare.csv" "$D/inbetween.csv"
+  "$COMPARE" --merge "$D/inbetween.csv" --json "$D/inbetween.json" > /dev/null
 
   echo "== $name: perceived images (hold-type blur under smooth pursuit)" >&2
-  "$MORPH" --perceive --input "$D/ldr120/color.####.exr" --gbuffer "$D/r120/gbuffer.####.exr" --frames "$FIRSTCMP-$LASTCMP" \
-    --out "$D/perceived/native/p.####.exr"
+  # The native stream's perceived images through LASTCMP + FACTOR (for the latency-aware score of a test shown
+  # FACTOR frames late); they are also the lag reference.
+  "$MORPH" --perceive --input "$D/ldr120/color.####.exr" --gbuffer "$D/r120/gbuffer.####.exr" \
+    --frames "$FIRSTCMP-$((LASTCMP + FACTOR))" --out "$D/perceived/native/p.####.exr"
   ptests=()
   for i in "${!names[@]}"; do
     m=${names[$i]}
     "$MORPH" --perceive --input "${tests[$i]}" --gbuffer "$D/r120/gbuffer.####.exr" --frames "$FIRSTCMP-$LASTCMP" \
-      --out "$D/perceived/$m/p.####.exr"
+      --lag-reference "$D/perceived/native/p.####.exr" --out "$D/perceived/$m/p.####.exr"
     ptests+=("$D/perceived/$m/p.####.exr")
   done
+  # As perceived (latency-free psnr_rgb, and psnr_latency against the native perceived image at the instant
+  # shown), and with the lag removed (layer aligned: aligned to native perceived frame t by the best shift along
+  # the motion; its psnr_rgb is the blur score).
   "$COMPARE" --reference "$D/perceived/native/p.####.exr" "${ptests[@]}" --names "$name_list" \
-    --frames "$FIRSTCMP-$LASTCMP" --csv "$D/perceived.csv" --json "$D/perceived.json" --plot "$D/perceived.png"
+    --frames "$FIRSTCMP-$LASTCMP" --latency-aware --csv "$D/perceived.csv" --json "$D/perceived.json" --plot "$D/perceived.png"
+  "$COMPARE" --reference "$D/perceived/native/p.####.exr" "${ptests[@]}" --names "$name_list" --layer aligned \
+    --reference-layer rgb --frames "$FIRSTCMP-$LASTCMP" --csv "$D/perceived-blur.csv" \
+    --json "$D/perceived-blur.json" > /dev/null
 
+  json_paired "$D/inbetween.json" "$name" inbetween psnr_rgb >> "$PAIRED"
+  json_paired "$D/inbetween.json" "$name" inbetween_latency psnr_latency >> "$PAIRED"
+  json_paired "$D/perceived-blur.json" "$name" perceived_blur psnr_rgb >> "$PAIRED"
   for m in "${names[@]}"; do
-    inb=$(csv_mean "$D/compare.csv" "$m" psnr_rgb_db "f % $FACTOR != 0")
-    all=$(csv_mean "$D/compare.csv" "$m" psnr_rgb_db "1")
+    inb=$(json_interval "$D/inbetween.json" "$m" psnr_rgb)
+    inb_lat=$(json_interval "$D/inbetween.json" "$m" psnr_latency)
+    all=$(json_interval "$D/compare.json" "$m" psnr_rgb | cut -d, -f1)  # "inf" when a frame is identical
+    latency=$(csv_mean "$D/compare.csv" "$m" latency_frames "1")
     per=$(csv_mean "$D/perceived.csv" "$m" psnr_rgb_db "1")
-    if [[ "$m" == minterpolate ]]; then ms=$ffmpeg_ms; else ms=$(csv_mean "$D/compare.csv" "$m" compute_ms "1"); fi
-    echo "$name,$m,$inb,$all,$per,$ms,$render_ms" >> "$TABLE"
+    per_lat=$(csv_mean "$D/perceived.csv" "$m" psnr_latency_db "1")
+    blur=$(csv_mean "$D/perceived-blur.csv" "$m" psnr_rgb_db "1")
+    # Mean lag over the compared frames, from the perceived images' headers (temporal:lagMs).
+    lag=$(for ((n = FIRSTCMP; n <= LASTCMP; ++n)); do printf -v f "%04d" "$n"; header_value "$D/perceived/$m/p.$f.exr" lagMs; done |
+      awk '{ s += $1; n++ } END { if (n) printf "%.2f", s / n; else printf "nan" }')
+    if [[ "$m" == minterpolate ]]; then ms=${compute_ms[$m]}; else ms=$(csv_mean "$D/compare.csv" "$m" compute_ms "1"); fi
+    echo "$name,$m,${latency%.00},$inb,$inb_lat,$all,$per,$per_lat,$blur,$lag,$ms,${command_ms[$m]},$render_ms" >> "$TABLE"
   done
+  unset command_ms compute_ms
 done
 
 echo
 echo "Seed 004 reproduction ($SIZE, $FRAMES frames at 40 Hz -> 120 Hz). PSNR in dB against the native 120 Hz render;"
-echo "perceived = PSNR of the smooth-pursuit perceived images; ms = compute per output frame (ffmpeg: wall, I/O incl.)."
+echo "perceived = PSNR of the smooth-pursuit perceived images (blur: lag removed); compute = the method's own time per"
+echo "output frame (I/O excluded), command = wall time of the whole command per output frame (EXR in and out)."
 column -s, -t < "$TABLE"
 echo
 echo "Table: $TABLE"
@@ -167,11 +273,13 @@ echo "Table: $TABLE"
   echo "# morph-120hz: seed 004 on the built-in scenes"
   echo
   echo "$SIZE, $FRAMES frames at 40 Hz -> 120 Hz. PSNR in dB against the native 120 Hz render (in-between frames"
-  echo "3n+1, 3n+2, and all frames); perceived = PSNR of the smooth-pursuit perceived images (hold-type blur, seed 004"
-  echo "section 3) against those of the native 120 Hz render; ms = compute per output frame (ffmpeg: wall, I/O included);"
-  echo "render ms = render-gbuffer per 40 Hz frame. Plots: <scene>/psnr*.png, <scene>/perceived*.png."
+  echo "3n+1, 3n+2 [95% interval], latency-free and at the instant shown; all frames); perceived = PSNR of the"
+  echo "smooth-pursuit perceived images (hold-type blur, seed 004 section 3) against those of the native 120 Hz render"
+  echo "(as perceived, at the instant shown, and with the lag removed), lag in ms; compute = the method's own time per"
+  echo "output frame (I/O excluded), command = whole command per output frame (EXR in and out); render ms ="
+  echo "render-gbuffer per 120 Hz frame. Paired differences: paired.csv. Plots: <scene>/psnr*.png, <scene>/perceived*.png."
   echo
-  echo "| scene | method | PSNR in-between | PSNR all | perceived PSNR | ms/output frame | render ms/frame |"
-  echo "|---|---|---|---|---|---|---|"
-  tail -n +2 "$TABLE" | sed 's/^/| /; s/,/ | /g; s/$/ |/'
+  echo "| scene | method | L | in-between | in-between, shown | all | perceived | perceived, shown | blur (lag removed) | lag ms | compute ms | command ms | render ms |"
+  echo "|---|---|---|---|---|---|---|---|---|---|---|---|---|"
+  tail -n +2 "$TABLE" | awk -F, '{ printf "| %s | %s | %s | %s [%s, %s] | %s [%s, %s] | %s | %s | %s | %s | %s | %s | %s | %s |\n", $1, $2, $3, $4, $5, $6, $7, $8, $9, $10, $11, $12, $13, $14, $15, $16, $17 }'
 } > "$OUT/summary.md"

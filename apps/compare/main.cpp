@@ -73,6 +73,10 @@ int main(int argc, char** argv) {
                  "Folder for error-map EXRs NAME.####.exr (error.R/G/B/Y, error.ssim, error.flicker, error.flip "
                  "with --flip, error.invalid)");
   app.add_option("--frames", frames, "Frames A-B (default: every reference frame on disk)");
+  app.add_flag("--latency-aware", setup.latency_aware,
+               "Also score each test frame t against the reference frame t + L shown at the same instant, L = the "
+               "test's temporal:latencyFrames (psnr_latency; psnr_rgb stays the latency-free score; "
+               "docs/conventions.md, Latency)");
   app.add_option("--warmup", setup.warmup_frames,
                  "The first N frames are summarised apart from the steady state (JSON `warmup`, `steady`)")
       ->check(CLI::Range(0, 1000000));

@@ -395,12 +395,16 @@ TEST(MetricRegistry, EntriesAreCompleteAndUnique) {
     EXPECT_EQ(find_metric(d.name), &d);
   }
   EXPECT_EQ(find_metric("no such metric"), nullptr);
-  EXPECT_EQ(options, (std::set<std::string>{"psnr", "ssim", "flicker", "flip"}));
-  // FLIP only when asked for.
+  EXPECT_EQ(options, (std::set<std::string>{"psnr", "ssim", "flicker", "flip", "psnr-latency"}));
+  // FLIP and the latency-aware PSNR only when asked for.
   ComparisonSetup setup;
   EXPECT_EQ(enabled_metrics(setup).size(), 4u);
   setup.flip = FlipMode::Ldr;
   EXPECT_EQ(enabled_metrics(setup).back()->name, "flip");
+  setup.flip = FlipMode::Off;
+  setup.latency_aware = true;
+  EXPECT_EQ(enabled_metrics(setup).size(), 5u);
+  EXPECT_EQ(enabled_metrics(setup).back()->name, "psnr_latency");
 }
 
 // Frames 0-1 of a reference and a noisy test (with a mask layer in the test), for the FLIP engine tests.

@@ -57,7 +57,12 @@ TEST_F(MorphCli, WritesFactorFramesPerInputWithDisplayRateTiming) {
                                   " --method blend", &out), 0) << out;
   info = read_exr_info((dir_ / "blend" / "o.0002.exr").string());
   ASSERT_TRUE(info);
-  EXPECT_EQ(info->metadata.extra.at("latencyFrames"), "1");
+  EXPECT_EQ(info->metadata.extra.at("latencyFrames"), "3") << "one rendered frame = 3 output frames at factor 3";
+  ASSERT_EQ(test::run_command(tool() + " --input " + in("color") + " --out " + (dir_ / "blend2" / "o.####.exr").string() +
+                                  " --method blend --factor 2", &out), 0) << out;
+  info = read_exr_info((dir_ / "blend2" / "o.0002.exr").string());
+  ASSERT_TRUE(info);
+  EXPECT_EQ(info->metadata.extra.at("latencyFrames"), "2") << "one rendered frame = 2 output frames at factor 2";
 
   // The perceived-blur mode runs on the upsampled sequence (display rate) with a display-rate motion.
   ASSERT_EQ(test::run_command(tool() + " --perceive --input " + (dir_ / "blend" / "o.####.exr").string() +

@@ -85,7 +85,8 @@ TEST_F(MorphStageRun, BlendSeesTheNextSelectedFrameAndTheLastOneRepeats) {
   EXPECT_DOUBLE_EQ(*md.fps, 120.0);
   EXPECT_NEAR(*md.time, 4.0 / 120.0, 1e-7);
   EXPECT_EQ(md.extra.at("method"), "blend");
-  EXPECT_EQ(md.extra.at("latencyFrames"), "1");
+  // One rendered frame of latency is factor = 3 output frames: slot k of frame n is shown 3 output frames late.
+  EXPECT_EQ(md.extra.at("latencyFrames"), "3");
   EXPECT_EQ(md.extra.at("sourceFrame"), "1");
   EXPECT_EQ(md.extra.at("slot"), "1");
   EXPECT_FALSE(md.world_to_camera.has_value()) << "an extrapolated slot has no camera of its own";
@@ -130,6 +131,62 @@ TEST_F(MorphStageRun, PerceiveReadsItsWindowPastTheSelectedFramesWhileTheyExist)
   ASSERT_TRUE(run(o, "c", "1-2", "g"));
   EXPECT_NEAR(value(1), (0.3f + 0.6f) / 2.0f, 1e-6f);
   EXPECT_NEAR(value(2), 0.6f, 1e-6f);
+}
+
+// --perceive --lag-reference: the native stream's bump moves right 1 px per 120 Hz frame; a stream whose content
+// is 2 frames late (found by the search against native frame t) and that declares temporal:latencyFrames = 3
+// (added) lags by 2 + 3 = 5 frames = 41.667 ms at 120 Hz.
+TEST_F(MorphStageRun, PerceiveWithALagReferenceReportsTheLagApartFromTheBlur) {
+  const int w = 64, h = 4;
+  auto bump_frame = [&](const std::string& file, float centre, const char* latency) {
+    Image c = test::make_color(w, h, [=](float x, float, int) {
+      const float d = (x - centre) / 3.0f;
+      return 0.5f * std::exp(-0.5f * d * d);
+    });
+    c.metadata().fps = 120.0;
+    if (latency) c.metadata().extra["latencyFrames"] = latency;
+    ASSERT_TRUE(write_exr(path(file), c));
+  };
+  for (int t = 0; t <= 12; ++t) {
+    const std::string n = std::to_string(1000 + t).substr(1);
+    bump_frame("native." + n + ".exr", 20.5f + float(t), nullptr);
+    bump_frame("late." + n + ".exr", 20.5f + float(t) - 2.0f, "3");
+    Image g = test::make_gbuffer(w, h, [](int, int, float& mx, float& my, float& d) {
+      mx = -1.0f;
+      my = 0.0f;
+      d = 2.0f;
+    });
+    ASSERT_TRUE(write_exr(path("mg." + n + ".exr"), g));
+  }
+  MorphStageOptions o;
+  o.perceive = true;
+  auto stage = make_morph_stage(o);
+  ASSERT_TRUE(stage);
+  SequenceOptions seq;
+  seq.input = path("native.###.exr");
+  seq.gbuffer = path("mg.###.exr");
+  seq.out = path("pn/p.####.exr");
+  seq.frames = "0-10";
+  ASSERT_TRUE(run_sequence(seq, **stage, {"morph-120hz test", "test"}, {}));
+  o.lag_reference = path("pn/p.####.exr");
+  ASSERT_TRUE(run(o, "late", "2-4", "mg"));
+  auto img = read_exr(path("out/o.0003.exr"));
+  ASSERT_TRUE(img);
+  const auto& md = img->metadata();
+  EXPECT_EQ(md.extra.at("lagContentFrames"), "2.00000");
+  EXPECT_EQ(md.extra.at("lagFrames"), "5.00000");
+  EXPECT_EQ(md.extra.at("lagMs"), "41.6667");  // 5 * 1000 / 120
+  EXPECT_EQ(md.extra.at("lagReferenceFrame"), "3");
+  // The aligned layer is the native perceived frame 3 (interior pixels; the border repeats its edge tap).
+  auto native3 = read_exr(path("pn/p.0003.exr"));
+  ASSERT_TRUE(native3);
+  for (int x = 8; x < w - 8; ++x) EXPECT_NEAR(img->plane("aligned.G")[x], native3->plane("G")[x], 1e-5f) << x;
+  // A frame past the native perceived frames that exist: a clear input error.
+  auto r = run(o, "late", "11-11", "mg");
+  ASSERT_FALSE(r);
+  EXPECT_EQ(r.error().kind, ErrorKind::Input);
+  EXPECT_NE(r.error().message.find("run --perceive on the native sequence through frame 11"), std::string::npos)
+      << r.error().message;
 }
 
 TEST_F(MorphStageRun, ClearErrors) {

@@ -73,6 +73,15 @@ struct TestState {
   SequenceReport report;
   std::optional<Image> image, maps;  // this frame's test image and error maps, kept for ComparisonHooks::frame
   std::vector<std::string> channels;
+  int latency = 0;                   // `temporal:latencyFrames` of the first frame (latency-aware scoring)
+  std::size_t unshown = 0;           // compared frames whose reference frame + latency is not on disk
+};
+
+// A reference frame read ahead for latency-aware scoring: its compared planes and where they are finite.
+struct ShownReference {
+  std::optional<Image> image;        // empty: the file does not exist
+  std::vector<const float*> planes;
+  std::vector<std::uint8_t> finite;
 };
 
 // One comparison run: setup checks and inputs (open), then per frame the reference (reference_frame) and each
@@ -87,11 +96,16 @@ class Run {
     // before it, without reporting it: the first compared frame then gets the flicker value a single run over the
     // whole sequence gives it, and per-shard results merge exactly (docs/compare.md, "Shards").
     std::vector<int> order = report_.frames;
+    // The latency of each test, from its first compared frame's header (docs/conventions.md, "Latency").
+    if (setup_.latency_aware)
+      for (auto& t : tests_)
+        if (auto st = read_latency(t); !st) return st.error();
     const bool prime = setup_.frames && previous_frame_exists(report_.frames.front() - 1);
     if (prime) order.insert(order.begin(), report_.frames.front() - 1);
     for (std::size_t fi = 0; fi < order.size(); ++fi) {
       const int frame = order[fi];
       priming_ = prime && fi == 0;
+      shown_.erase(shown_.begin(), shown_.lower_bound(frame));  // frames before this one are never shown again
       if (auto st = reference_frame(fi, frame); !st) return st.error();
       for (auto& t : tests_) {
         if (auto st = test_frame(t, fi, frame); !st) return st.error();
@@ -109,7 +123,14 @@ class Run {
         hooks_.frame_done(frame, int(fi + (prime ? 0 : 1)), int(report_.frames.size()));
     }
     priming_ = false;
-    for (auto& t : tests_) report_.sequences.push_back(std::move(t.report));
+    for (auto& t : tests_) {
+      if (t.unshown)
+        warn(t.pattern.path(report_.frames.back()),
+             std::to_string(t.unshown) + " compared frames have no reference frame " + std::to_string(t.latency) +
+                 " frames later (the instant they are shown, temporal:latencyFrames = " + std::to_string(t.latency) +
+                 "): no psnr_latency value there; give the reference " + std::to_string(t.latency) + " more frames");
+      report_.sequences.push_back(std::move(t.report));
+    }
     return std::move(report_);
   }
 
@@ -125,6 +146,8 @@ class Run {
   Status open_tests(const FrameRange& range);
   Status find_masks();
   Status reference_frame(std::size_t fi, int frame);
+  Status read_latency(TestState& t);
+  Expected<const ShownReference*> shown_reference(int frame);
   Status test_frame(TestState& t, std::size_t fi, int frame);
   FrameInputs inputs(TestState& t, int frame, std::span<const float* const> planes,
                      std::span<const std::string> names, const float* mask, double peak, bool change, Image* maps);
@@ -160,7 +183,8 @@ class Run {
   std::vector<std::string> ref_names_;
   std::vector<const float*> ref_planes_;
   std::vector<float> ref_y_, ref_prev_y_, ref_delta_, warped_;
-  std::vector<std::uint8_t> ref_valid_, valid_;
+  std::vector<std::uint8_t> ref_valid_, valid_, shown_valid_;
+  std::map<int, ShownReference> shown_;  // reference frames read ahead for latency-aware scoring
   std::size_t ref_invalid_ = 0;
   bool ref_has_prev_ = false, history_ = false;
   std::size_t n_ = 0;
@@ -395,6 +419,45 @@ Status Run::reference_frame(std::size_t fi, int frame) {
   return {};
 }
 
+// `temporal:latencyFrames` of the test's first compared frame: a whole number of frames >= 0 (absent: 0).
+Status Run::read_latency(TestState& t) {
+  const std::string path = t.pattern.path(report_.frames.front());
+  auto info = read_exr_info(path);
+  if (!info) return info.error();
+  const auto it = info->metadata.extra.find("latencyFrames");
+  if (it == info->metadata.extra.end()) return {};
+  char* end = nullptr;
+  const long v = std::strtol(it->second.c_str(), &end, 10);
+  if (end == it->second.c_str() || *end != '\0' || v < 0 || v > 100000)
+    return Error::input(path, "temporal:latencyFrames is '" + it->second +
+                                  "', not a whole number of frames >= 0 (docs/conventions.md, \"Latency\")");
+  t.latency = int(v);
+  return {};
+}
+
+// Reference frame `frame` for latency-aware scoring, read once and kept until the comparison passes it; a
+// frame that is not on disk is remembered as absent.
+Expected<const ShownReference*> Run::shown_reference(int frame) {
+  if (auto it = shown_.find(frame); it != shown_.end()) return &it->second;
+  ShownReference& s = shown_[frame];
+  const std::string path = ref_pattern_->path(frame);
+  if (!fs::exists(path)) return &s;
+  auto img = read_exr(path, ref_sel_);
+  if (!img) return img.error();
+  if (img->width() != width_ || img->height() != height_)
+    return Error::input(path, "is " + size_text(img->width(), img->height()) + " but frame " +
+                                  std::to_string(report_.frames.front()) + " is " + size_text(width_, height_) +
+                                  "; every frame of a sequence must have one size");
+  if (compared_channels(*img, report_.reference_layer) != report_.reference_channels)
+    return Error::input(path, "has other channels for layer '" + report_.reference_layer + "' than frame " +
+                                  std::to_string(report_.frames.front()));
+  s.image = std::move(*img);
+  s.planes = planes_of(*s.image, report_.reference_channels);
+  s.finite.resize(n_);
+  finite_mask(s.planes, {}, n_, s.finite.data());
+  return &s;
+}
+
 // One test frame: checks, the shared inputs (validity, luminance, temporal change), every measure, error maps.
 Status Run::test_frame(TestState& t, std::size_t fi, int frame) {
   const std::string path = t.pattern.path(frame);
@@ -450,7 +513,27 @@ Status Run::test_frame(TestState& t, std::size_t fi, int frame) {
 
   std::optional<Image> maps;
   if (!priming_ && (!setup_.error_maps.empty() || (hooks_.frame && hooks_.keep_maps))) maps.emplace(width_, height_);
-  const FrameInputs in = inputs(t, frame, planes, names, mask, m.peak, change, maps ? &*maps : nullptr);
+  FrameInputs in = inputs(t, frame, planes, names, mask, m.peak, change, maps ? &*maps : nullptr);
+  if (setup_.latency_aware) {
+    // The reference at the instant this frame is shown: frame + L (docs/conventions.md, "Latency").
+    in.latency_frames = t.latency;
+    if (t.latency == 0) {
+      in.shown_reference = ref_planes_;
+      in.shown_valid = valid_.data();
+    } else {
+      auto shown = shown_reference(frame + t.latency);
+      if (!shown) return shown.error();
+      if ((*shown)->image) {
+        shown_valid_.resize(n_);
+        finite_mask(planes, {}, n_, shown_valid_.data());
+        for (std::size_t i = 0; i < n_; ++i) shown_valid_[i] &= (*shown)->finite[i];
+        in.shown_reference = (*shown)->planes;
+        in.shown_valid = shown_valid_.data();
+      } else if (!priming_) {
+        ++t.unshown;
+      }
+    }
+  }
   for (std::size_t k = 0; k < measures_.size(); ++k) {
     MetricSample sample;
     sample.metric = definitions_[k]->name;

@@ -13,6 +13,7 @@ const std::vector<MetricDefinition>& metric_registry() {
     r.push_back(ssim_metric());
     r.push_back(flicker_metric());
     r.push_back(flip_metric());
+    r.push_back(psnr_latency_metric());
     return r;
   }();
   return registry;

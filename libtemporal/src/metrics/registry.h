@@ -11,5 +11,6 @@ MetricDefinition psnr_y_metric();    // metric_psnr.cpp
 MetricDefinition ssim_metric();      // metric_ssim.cpp
 MetricDefinition flicker_metric();   // metric_flicker.cpp
 MetricDefinition flip_metric();      // metric_flip.cpp
+MetricDefinition psnr_latency_metric();  // metric_psnr_latency.cpp
 
 }  // namespace temporal

@@ -66,4 +66,91 @@ Expected<Image> perceive_hold(std::span<const Image* const> frames, const std::v
   return out;
 }
 
+namespace {
+
+// perceived(r + tau * motion(r)) into out (one plane per channel). Pixel centres are at integers in the
+// reprojection module's coordinates.
+void shift_along_motion(std::span<const float* const> src, std::span<float* const> dst, const float* mx,
+                        const float* my, int w, int h, float tau) {
+  parallel_rows(h, [&](int y0, int y1) {
+    for (int y = y0; y < y1; ++y)
+      for (int x = 0; x < w; ++x) {
+        const std::size_t i = std::size_t(y) * std::size_t(w) + std::size_t(x);
+        const float vx = std::isfinite(mx[i]) ? mx[i] : 0.0f, vy = std::isfinite(my[i]) ? my[i] : 0.0f;
+        const reproject::Bilinear b = reproject::bilinear(float(x) + tau * vx, float(y) + tau * vy, w, h);
+        for (std::size_t c = 0; c < src.size(); ++c) dst[c][i] = b(src[c]);
+      }
+  });
+}
+
+}  // namespace
+
+Expected<LagAlignment> align_lag(const Image& perceived, const Image& reference, const std::vector<std::string>& channels,
+                                 const float* motion_x, const float* motion_y, const LagSearchOptions& options) {
+  if (!(options.max_lag_frames >= 0.0f) || !(options.coarse_step > 0.0f) || !(options.fine_step > 0.0f) ||
+      !std::isfinite(options.max_lag_frames))
+    return Error::usage("align_lag: max_lag_frames must be >= 0 and the steps > 0");
+  if (!motion_x || !motion_y) return Error::input({}, "align_lag: the motion layer (motion.X, motion.Y) is missing");
+  const int w = perceived.width(), h = perceived.height();
+  if (reference.width() != w || reference.height() != h)
+    return Error::input({}, "align_lag: the reference's perceived image has another size");
+  const std::size_t nc = channels.size(), n = perceived.pixel_count();
+  std::vector<const float*> src(nc), ref(nc);
+  for (std::size_t c = 0; c < nc; ++c) {
+    src[c] = perceived.plane(channels[c]);
+    ref[c] = reference.plane(channels[c]);
+    if (!src[c] || !ref[c]) return Error::input({}, "align_lag: no float channel '" + channels[c] + "'");
+  }
+  LagAlignment result;
+  result.aligned = Image(w, h);
+  std::vector<float*> dst(nc);
+  for (std::size_t c = 0; c < nc; ++c) dst[c] = result.aligned.add_channel(channels[c]);
+  std::vector<double> row_sum(static_cast<std::size_t>(h));
+  // Mean squared error of the image shifted by tau; rows summed in order, so the result does not depend on the
+  // thread count. Non-finite values (never written by the stage) would be skipped.
+  auto error_at = [&](float tau) {
+    shift_along_motion(src, dst, motion_x, motion_y, w, h, tau);
+    parallel_rows(h, [&](int y0, int y1) {
+      for (int y = y0; y < y1; ++y) {
+        double s = 0.0;
+        for (std::size_t c = 0; c < nc; ++c)
+          for (int x = 0; x < w; ++x) {
+            const std::size_t i = std::size_t(y) * std::size_t(w) + std::size_t(x);
+            const double d = double(dst[c][i]) - double(ref[c][i]);
+            if (std::isfinite(d)) s += d * d;
+          }
+        row_sum[std::size_t(y)] = s;
+      }
+    });
+    double s = 0.0;
+    for (const double r : row_sum) s += r;
+    return s / double(std::max<std::size_t>(1, n * nc));
+  };
+  // Candidates in order of |tau| (0, +s, -s, +2s, ...): a later one must be better by a relative 1e-9 to win,
+  // so ties go to the smallest lag.
+  float best = 0.0f;
+  double best_err = error_at(0.0f);
+  result.mse_unaligned = best_err;
+  auto consider = [&](float tau) {
+    const double e = error_at(tau);
+    if (e < best_err * (1.0 - 1e-9)) {
+      best_err = e;
+      best = tau;
+    }
+  };
+  const int coarse = int(std::floor(options.max_lag_frames / options.coarse_step + 1e-6f));
+  for (int k = 1; k <= coarse; ++k)
+    for (const float sign : {1.0f, -1.0f}) consider(sign * float(k) * options.coarse_step);
+  const float centre = best;
+  const int fine = int(std::floor(options.coarse_step / options.fine_step + 1e-6f));
+  for (int k = 1; k <= fine; ++k)
+    for (const float sign : {1.0f, -1.0f}) {
+      const float tau = centre + sign * float(k) * options.fine_step;
+      if (std::fabs(tau) <= options.max_lag_frames + 1e-6f) consider(tau);
+    }
+  result.lag_frames = best;
+  result.mse = error_at(best);  // also leaves the best shift in `aligned`
+  return result;
+}
+
 }  // namespace temporal

@@ -3,11 +3,14 @@
 
 #include "method_common.h"
 #include "temporal/core/color.h"
+#include "temporal/core/exr.h"
+#include "temporal/core/sequence.h"
 #include "temporal/morph/methods.h"
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <optional>
 
 namespace temporal {
@@ -108,7 +111,10 @@ class UpsampleStage final : public FrameStage {
       o.compute_ms = total_ms_ / n;  // the rendered frame's work produces all its slots: each gets an equal share
       o.timings_ms = {{"flow", timings_.flow_ms}, {"morph", timings_.morph_ms}, {"blur", timings_.blur_ms}};
       o.extra = {{"method", info_.name},
-                 {"latencyFrames", std::to_string(info_.latency_frames)},
+                 // In frames of the output sequence: slot k of rendered frame n can be shown only once the
+                 // method's lookahead has been rendered, latency_frames rendered frames = latency_frames * n
+                 // display frames later (docs/conventions.md, "Latency").
+                 {"latencyFrames", std::to_string(info_.latency_frames * n)},
                  {"sourceFrame", std::to_string(f.frame)},
                  {"slot", std::to_string(k)}};
       o.keep_input_metadata = false;
@@ -143,7 +149,8 @@ class UpsampleStage final : public FrameStage {
 // input frame, integrating the window of displayed frames that starts at it.
 class PerceiveStage final : public FrameStage {
  public:
-  explicit PerceiveStage(const HoldBlurOptions& hold) : hold_(hold) {
+  PerceiveStage(const HoldBlurOptions& hold, std::optional<SequencePattern> lag_reference, const LagSearchOptions& lag)
+      : hold_(hold), lag_reference_(std::move(lag_reference)), lag_(lag) {
     inputs_.input_layers = {"rgb"};
     inputs_.gbuffer_layers = {{"motion", true}};
     inputs_.gbuffer_required = true;
@@ -168,12 +175,64 @@ class PerceiveStage final : public FrameStage {
     o.image = &result_;
     o.compute_ms = ms_since(t0);
     o.extra = {{"perceivedWindow", std::to_string(window.size())}};
+    if (lag_reference_)
+      if (Status s = align(f, *g, o); !s) return s;
     out.push_back(std::move(o));
     return Status::ok();
   }
 
  private:
+  // The lag apart from the blur. The declared latency L (temporal:latencyFrames) is known exactly and is added,
+  // not searched; the search finds the lag of the content itself (repeat's held frames, an extrapolation that
+  // falls short) against the native perceived frame of the same instant, t. Aligning against frame t + L
+  // instead would ask one shift to explain L frames of native motion, which it cannot where the motion is not a
+  // translation (rotation, disocclusions over L frames), and that residual would be charged as blur.
+  Status align(const StageFrame& f, const Image& gbuffer, StageOutput& o) {
+    int latency = 0;
+    const auto& extra = f.input->metadata().extra;
+    if (const auto it = extra.find("latencyFrames"); it != extra.end()) {
+      char* end = nullptr;
+      const long v = std::strtol(it->second.c_str(), &end, 10);
+      if (end == it->second.c_str() || *end != '\0' || v < 0 || v > 100000)
+        return Error::input(f.input_path, "temporal:latencyFrames is '" + it->second + "', not a whole number >= 0");
+      latency = int(v);
+    }
+    const std::string path = lag_reference_->path(f.frame);
+    auto ref = read_exr(path, ExrSelection{{"rgb"}});
+    if (!ref)
+      return Error::input(path, "no perceived reference image for frame " + std::to_string(f.frame) +
+                                    ": run --perceive on the native sequence through frame " + std::to_string(f.frame) +
+                                    " (" + ref.error().message + ")");
+    const auto t0 = std::chrono::steady_clock::now();
+    auto a = align_lag(result_, *ref, kColor, gbuffer.plane("motion.X"), gbuffer.plane("motion.Y"), lag_);
+    if (!a) {
+      Error e = a.error();
+      if (e.file.empty()) e.file = path;
+      return e;
+    }
+    for (const auto& c : kColor) {
+      const float* src = a->aligned.plane(c);
+      float* dst = result_.add_channel("aligned." + c);
+      std::copy(src, src + result_.pixel_count(), dst);
+    }
+    const double lag = a->lag_frames + double(latency);
+    char text[64];
+    std::snprintf(text, sizeof text, "%.5f", a->lag_frames);
+    o.extra["lagContentFrames"] = text;
+    std::snprintf(text, sizeof text, "%.5f", lag);
+    o.extra["lagFrames"] = text;
+    o.extra["lagReferenceFrame"] = std::to_string(f.frame);
+    if (const auto fps = f.input->metadata().fps; fps && *fps > 0.0) {
+      std::snprintf(text, sizeof text, "%.4f", lag * 1000.0 / *fps);
+      o.extra["lagMs"] = text;
+    }
+    o.timings_ms["lag"] = ms_since(t0);
+    return Status::ok();
+  }
+
   HoldBlurOptions hold_;
+  std::optional<SequencePattern> lag_reference_;
+  LagSearchOptions lag_;
   StageInputs inputs_;
   std::vector<Image> scratch_;  // finite copies of the window (only of frames with NaN/Inf)
   Image gbuffer_, result_;
@@ -202,6 +261,13 @@ ParamList morph_stage_params(MorphStageOptions& o) {
                      "(--input at its display rate, --gbuffer its display-rate motion)",
                      &o.perceive),
       Param::integer("--window", "--perceive: displayed frames integrated by the eye", &o.hold.window, 1, 64),
+      {.flag = "--lag-reference",
+       .help = "--perceive: perceived images of the native stream (P.####.exr); adds layer aligned.R,G,B (the best "
+               "shift along the motion against the native frame t) and temporal:lagFrames, lagMs (plus the declared "
+               "temporal:latencyFrames)",
+       .value = &o.lag_reference},
+      Param::real("--max-lag", "--perceive --lag-reference: largest lag searched, display frames", &o.lag.max_lag_frames,
+                  0, 64),
   };
   for (const auto& m : morph_methods()) {
     if (!m.params) continue;
@@ -216,7 +282,13 @@ ParamList morph_stage_params(MorphStageOptions& o) {
 Expected<std::unique_ptr<FrameStage>> make_morph_stage(const MorphStageOptions& options) {
   if (options.perceive) {
     if (options.hold.window < 1) return Error::usage("--window must be at least 1");
-    return std::unique_ptr<FrameStage>(std::make_unique<PerceiveStage>(options.hold));
+    std::optional<SequencePattern> lag_reference;
+    if (!options.lag_reference.empty()) {
+      auto p = SequencePattern::parse(options.lag_reference);
+      if (!p) return p.error();
+      lag_reference = *p;
+    }
+    return std::unique_ptr<FrameStage>(std::make_unique<PerceiveStage>(options.hold, lag_reference, options.lag));
   }
   auto info = find_morph_method(options.morph.method);
   if (!info) return info.error();

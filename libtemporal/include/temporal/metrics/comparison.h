@@ -58,6 +58,10 @@ struct ComparisonSetup {
   FlipOptions flip_options;            // viewing condition (pixels per degree) and HDR-FLIP settings
   std::string error_maps;              // folder for <name>.####.exr error maps; empty: none
   int warmup_frames = 0;               // the first N compared frames are summarised apart from the steady state
+  // Also score each test frame t against the reference frame t + L shown at the same instant, L = the test's
+  // `temporal:latencyFrames` (frames of its own sequence; absent: 0), as the `psnr_latency` metric
+  // (docs/conventions.md, "Latency"). The reference is read past `frames` where the files exist.
+  bool latency_aware = false;
   BootstrapOptions bootstrap;          // intervals of the JSON summary (temporal/metrics/statistics.h)
   std::string tool;                    // `temporal:tool` of the error maps
   std::string parameters;              // `temporal:parameters` of the error maps
@@ -95,6 +99,12 @@ struct FrameInputs {
   const float* test_change = nullptr;
   const float* reference_change = nullptr;
   Image* maps = nullptr;                     // the frame's error-map image (add channels); null without maps
+  // With ComparisonSetup::latency_aware: the test's latency L in frames (`temporal:latencyFrames`), the
+  // reference's compared channels at frame + L (empty when that file does not exist) and the pixels where
+  // they and the test are finite.
+  int latency_frames = 0;
+  std::span<const float* const> shown_reference;
+  const std::uint8_t* shown_valid = nullptr;
 };
 
 // The per-frame work of one metric. One instance per comparison measures every test frame in turn, so it may

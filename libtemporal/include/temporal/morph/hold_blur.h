@@ -38,4 +38,38 @@ struct HoldBlurOptions {
 Expected<Image> perceive_hold(std::span<const Image* const> frames, const std::vector<std::string>& channels,
                               const float* motion_x, const float* motion_y, const HoldBlurOptions& options = {});
 
+// --- Lag apart from blur (docs/morph-120hz.md, "Perceived blur: lag apart") --------------------------------
+//
+// A method that shows the scene tau display frames late (repeat holds frame n for 2 more frames; blend is shown
+// one rendered frame late) gives the tracking eye the image of P_j shifted along the motion: with the scene
+// moving at u = -motion pixels per frame and the eye following it (section 3), the retina sees what the native
+// stream showed tau frames earlier: displayed frame D(t - tau) on the pursuit path r + (i + s) u gives
+//
+//     P_method_j(r) = P_native_j(r + tau * u(r)) = P_native_j(r - tau * motion(r))
+//
+// one scalar tau for every pixel of a frame, because a delay is a property of the display stream, not of a
+// surface. Scoring P_method against P_native directly charges that displacement as blur. align_lag finds the
+// tau that brings the method's perceived image closest (least squared error over every channel) to the
+// reference's, A(r) = P_method(r + tau * motion(r)), and returns A: what remains between A and P_native is
+// blur (and other error), tau * 1000 / fps is the lag in milliseconds.
+
+struct LagSearchOptions {
+  float max_lag_frames = 8.0f;      // tau is searched in [-max, max] display frames
+  float coarse_step = 0.25f;        // first pass: every coarse_step frames
+  float fine_step = 1.0f / 32.0f;   // second pass: +-coarse_step around the best, every fine_step frames
+};
+
+struct LagAlignment {
+  double lag_frames = 0.0;   // tau, display frames (> 0: the method is late)
+  double mse = 0.0;          // mean squared error of the aligned image against the reference
+  double mse_unaligned = 0.0;  // ... and of the image as perceived (tau = 0)
+  Image aligned;             // A(r) = perceived(r + tau * motion(r)), `channels` only
+};
+
+// Among equal errors (e.g. no motion anywhere) the smallest |tau| wins, so a static frame has no lag.
+// Sampling: the bilinear fetch of temporal/core/reproject.h (edge taps repeated). Errors: sizes differ, a
+// channel or the motion is missing, bad options.
+Expected<LagAlignment> align_lag(const Image& perceived, const Image& reference, const std::vector<std::string>& channels,
+                                 const float* motion_x, const float* motion_y, const LagSearchOptions& options = {});
+
 }  // namespace temporal

@@ -43,7 +43,9 @@ struct MorphMethodInfo {
   // G-buffer layers it reads ("motion": motion.X/Y, "depth": depth.Z); empty: it needs no G-buffer.
   std::vector<std::string> gbuffer_layers;
   int lookahead = 0;       // rendered frames after the current one it reads (blend: 1)
-  int latency_frames = 0;  // rendered frames of display latency it adds (`temporal:latencyFrames`; blend: 1)
+  // Rendered frames of display latency it adds (blend: 1). The outputs' `temporal:latencyFrames` is in output
+  // (display) frames: latency_frames * factor (docs/conventions.md, "Latency").
+  int latency_frames = 0;
   // Its own parameters, bound to fields of the options (defaults live there); null: none. Parameters shared
   // by several methods are listed by each and bound once.
   ParamList (*params)(MorphStageOptions& options) = nullptr;

@@ -4,13 +4,15 @@
 //  - input frame n becomes output frames n*factor + k, k = 0..factor-1, with temporal:fps = fps*factor and
 //    temporal:time = (n*factor + k) / (fps*factor); fps is --fps or the input header's temporal:fps;
 //  - slots k >= 1 drop the rendered frame's camera matrices, jitter and camera cut (they do not describe an
-//    extrapolated frame); every slot records method, latencyFrames, sourceFrame, slot and the flow / morph /
+//    extrapolated frame); every slot records method, latencyFrames (output frames: the method's rendered
+//    frames of latency times factor), sourceFrame, slot and the flow / morph /
 //    blur timings (seed 004 Table 1);
 //  - methods with lookahead (blend) see frame n+1 of the selected frames (the last one repeats);
 //  - NaN and Inf input values (counted and reported by the runner) are replaced by 0 before a method sees them;
 //  - the eye-tracking limit's pixels per degree comes from the viewing geometry and the image width;
 //  - `perceive`: instead of upsampling, the hold-type blur simulation of temporal/morph/hold_blur.h, whose window
-//    of displayed frames reads past the selected frames while files exist (the eye keeps integrating).
+//    of displayed frames reads past the selected frames while files exist (the eye keeps integrating); with a
+//    lag reference, the lag apart from the blur (align_lag).
 #pragma once
 
 #include "temporal/core/error.h"
@@ -47,6 +49,12 @@ struct MorphStageOptions {
   ViewingOptions viewing;
   bool perceive = false;  // simulate hold-type blur instead of upsampling
   HoldBlurOptions hold;   // perceive: the eye's window
+  // perceive: the perceived images of the reference (native) stream, PATTERN.####.exr. When set, each frame t is
+  // also aligned to the reference's perceived frame t by the best shift tau along the motion (align_lag,
+  // hold_blur.h): layer `aligned.R,G,B`; headers temporal:lagContentFrames (tau), temporal:lagFrames (tau + L,
+  // L = the input's temporal:latencyFrames, known exactly and so added, not searched) and temporal:lagMs.
+  std::string lag_reference;
+  LagSearchOptions lag;
 };
 
 // Every parameter of the tool: the method (its choices and help from the registry), factor, fps, debug layers,
