@@ -206,6 +206,9 @@ Expected<ComparisonReport> merge_comparison_csvs(const std::vector<std::string>&
   auto merged = merge_comparisons(parts, csvs);
   if (!merged) return merged;
   merged->warmup_frames = setup.warmup_frames;
+  // The CSV does not carry the compared layers: the merge's own options name them (the shards' must be the same).
+  merged->layer = setup.layer;
+  merged->reference_layer = setup.reference_layer.empty() ? setup.layer : setup.reference_layer;
   merged->bootstrap = setup.bootstrap;
   return merged;
 }

@@ -70,7 +70,8 @@ std::vector<std::pair<std::string, Chart>> comparison_charts(const ComparisonRep
   Chart speed;
   speed.title = with_title(title, "Speed against error (mean over frames)");
   speed.x_label = "method compute time per frame (ms, temporal:computeMs, I/O excluded)";
-  speed.y_label = "mean PSNR (" + report.layer + ", dB)";
+  // A merged report (compare --merge) does not know its layer: the CSV does not carry it.
+  speed.y_label = report.layer.empty() ? std::string("mean PSNR (dB)") : "mean PSNR (" + report.layer + ", dB)";
   speed.style = ChartStyle::Points;
   for (std::size_t i = 0; i < report.sequences.size(); ++i) {
     const SequenceReport& s = report.sequences[i];
