@@ -43,7 +43,7 @@ int main(int argc, char** argv) {
   app.add_option("--json", out.json, "JSON summary to write (mean with 95% interval per sequence, paired differences)");
   app.add_option("--plot", out.plot,
                  "Charts F.EXT, EXT = png, svg or pdf: F (PSNR per frame), F-psnr-y, F-ssim, F-flicker, F-flip (with "
-                 "--flip), F-speed (PSNR against the methods' own compute time)");
+                 "--flip), F-psnr-latency (with --latency-aware), F-speed (PSNR against the methods' own compute time)");
   app.add_option("--title", out.title, "Title of the charts, the contact sheet and the report (e.g. the scene)");
   app.add_option("--report", pic.report_dir,
                  "Folder for an offline HTML report (index.html): tables, charts, contact sheet, FLIP and error "

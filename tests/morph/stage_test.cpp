@@ -210,6 +210,14 @@ TEST_F(MorphStageRun, ClearErrors) {
   EXPECT_EQ(r.error().kind, ErrorKind::Usage);
   EXPECT_NE(r.error().message.find("--gbuffer"), std::string::npos) << r.error().message;
 
+  // --lag-reference without --perceive would do nothing: refused.
+  MorphStageOptions lag;
+  lag.lag_reference = "native.####.exr";
+  auto refused = make_morph_stage(lag);
+  ASSERT_FALSE(refused);
+  EXPECT_EQ(refused.error().kind, ErrorKind::Usage);
+  EXPECT_NE(refused.error().message.find("--perceive"), std::string::npos) << refused.error().message;
+
   // Several outputs per input frame need a placeholder in --out, even for a single input file.
   auto stage = make_morph_stage(MorphStageOptions{});
   ASSERT_TRUE(stage);

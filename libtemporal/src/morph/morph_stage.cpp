@@ -290,6 +290,8 @@ Expected<std::unique_ptr<FrameStage>> make_morph_stage(const MorphStageOptions& 
     }
     return std::unique_ptr<FrameStage>(std::make_unique<PerceiveStage>(options.hold, lag_reference, options.lag));
   }
+  if (!options.lag_reference.empty())  // an option that would do nothing is an error, not silence
+    return Error::usage("--lag-reference measures the lag of a --perceive run: add --perceive, or drop it");
   auto info = find_morph_method(options.morph.method);
   if (!info) return info.error();
   MorphStageOptions resolved = options;
