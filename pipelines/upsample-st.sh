@@ -11,7 +11,7 @@
 #   OUT_DIR    report folder (default report/upsample-st)
 #   SCENE      scenes to run (default: the built-in walkers (the horses scene), tower and fan of assets/scenes)
 # Environment: SIZE (default 640x512; the paper used 1280x1024), FRAMES (default 0-47), FPS (default 30),
-#   FACTOR (default 4), METHODS (default "spatial temporal herzog herzog-favor-spatial drobot spatial-demod
+#   FACTOR (default 4), METHODS (default "spatial temporal herzog herzog-favor-spatial drobot taau spatial-demod
 #   herzog-demod"; names of the method table as `upsample-st --list-methods` prints them: a method, a named variant
 #   such as herzog-lagged (--lagged-wf), herzog-favor-spatial (a = 0.7, the paper's elephant scene) or
 #   drobot-refresh (--mode refresh), optionally with a suffix the table lists, such as -demod (--demodulate:
@@ -38,7 +38,7 @@ SIZE="${SIZE:-640x512}"
 FRAMES="${FRAMES:-0-47}"
 FPS="${FPS:-30}"
 FACTOR="${FACTOR:-4}"
-METHODS="${METHODS:-spatial temporal herzog herzog-favor-spatial drobot spatial-demod herzog-demod}"
+METHODS="${METHODS:-spatial temporal herzog herzog-favor-spatial drobot taau spatial-demod herzog-demod}"
 REFERENCE_SPP="${REFERENCE_SPP:-0}"
 RENDER_ARGS="${RENDER_ARGS:---payload direct,shadow,ssao,gi}"
 UPSAMPLE_ARGS="${UPSAMPLE_ARGS:-}"

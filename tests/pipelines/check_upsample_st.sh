@@ -8,7 +8,7 @@ here="$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)"
 build="$1"
 out="$2"
 rm -rf "$out"
-SIZE=64x48 FRAMES=0-5 REFERENCE_SPP=2 METHODS="spatial temporal herzog herzog-favor-spatial spatial-demod" \
+SIZE=64x48 FRAMES=0-5 REFERENCE_SPP=2 METHODS="spatial temporal herzog herzog-favor-spatial taau spatial-demod" \
   bash "$here/pipelines/upsample-st.sh" "$build" "$out" "$here/assets/scenes/tower.glb" > "$out.log" 2>&1 || {
   cat "$out.log"
   echo "check_upsample_st.sh: the pipeline failed" >&2
@@ -17,7 +17,7 @@ SIZE=64x48 FRAMES=0-5 REFERENCE_SPP=2 METHODS="spatial temporal herzog herzog-fa
 summary="$out/summary.md"
 fail() { cat "$summary" >&2; echo "check_upsample_st.sh: $*" >&2; exit 1; }
 [[ -f "$summary" ]] || fail "no summary.md"
-for m in spatial temporal herzog herzog-favor-spatial spatial-demod; do
+for m in spatial temporal herzog herzog-favor-spatial taau spatial-demod; do
   row="$(grep -E "^\| $m \|" "$summary" || true)"
   [[ -n "$row" ]] || fail "no row for $m"
   # | method | shade | up | total | full | speed-up | PSNR | PSNR vs 2 spp |

@@ -46,7 +46,7 @@ std::string tool() { return temporal::test::tool_path("upsample-st").string(); }
 
 TEST(UpsampleCli, WritesFramesWithHeaders) {
   const fs::path dir = write_sequence("upsample_cli", 4);
-  for (const char* method : {"spatial", "temporal", "herzog", "drobot"}) {
+  for (const char* method : {"spatial", "temporal", "herzog", "drobot", "taau"}) {
     std::string output;
     const std::string cmd = tool() + " --gbuffer " + (dir / "gbuffer.####.exr").string() + " --input " +
                             (dir / "shade.####.exr").string() + " --out " + (dir / method).string() +

@@ -1,5 +1,6 @@
 #include "reference.h"
 
+#include "temporal/core/color.h"
 #include "temporal/core/reproject.h"
 #include "temporal/upsample/drobot.h"
 #include "temporal/upsample/history.h"
@@ -147,6 +148,7 @@ Image PlainUpsampler::process(const Image& g, const Image& low, const std::vecto
   if (method_ == "spatial") spatial(f, out);
   else if (method_ == "temporal") temporal(f, out);
   else if (method_ == "herzog") herzog(f, out);
+  else if (method_ == "taau") taau(f, out);
   else if (mode == "refresh") drobot_refresh(f, out);
   else if (method_ == "drobot") drobot_cache(f, out);
   else throw std::logic_error("no plain implementation of method " + method_);
@@ -561,6 +563,175 @@ void PlainUpsampler::drobot_refresh(const Frame& f, Image& out) {
         out.plane(name)[i] = v;
       }
     }
+}
+
+// `taau` (docs/upsample-st.md, "taau"; FSR 2 / UE4 TAAU) one pixel at a time: the fetch, the 3x3 Lanczos-2
+// reconstruction, the YCoCg box, the accumulation and the locks, written from the docs' formulas.
+void PlainUpsampler::taau(const Frame& f, Image& out) {
+  const bool locks = param(options_, "--no-locks") != 0;  // the field behind the inverted flag: true = locks on
+  const float box_scale = float(param(options_, "--box-scale"));
+  const float luma_change = float(param(options_, "--lock-luma-change"));
+  const float motion_acc = float(param(options_, "--motion-accumulation"));
+  const bool catmull_rom = text_param(options_, "--history") == "catmull-rom";
+  const int W = f.W, H = f.H, k = f.k, C = f.C;
+  const std::size_t N = std::size_t(W) * H;
+  if (!have_history_) {
+    acc_.assign(N, 0.0f);
+    lock_.assign(N, 0.0f);
+    lock_luma_.assign(N, 0.0f);
+  }
+  auto lanczos = [](float x2) {  // FSR 2 Lanczos2ApproxSq
+    x2 = std::min(x2, 4.0f);
+    return (25.0f / 16.0f * (0.4f * x2 - 1) * (0.4f * x2 - 1) - 9.0f / 16.0f) * (0.25f * x2 - 1) * (0.25f * x2 - 1);
+  };
+  auto to_ycgco = [C](float* v) {
+    for (int t = 0; t + 3 <= C; t += 3) rgb_to_ycgco(v[t], v[t + 1], v[t + 2], v[t], v[t + 1], v[t + 2]);
+  };
+  auto from_ycgco = [C](float* v) {
+    for (int t = 0; t + 3 <= C; t += 3) {
+      const float y = v[t], cg = v[t + 1], co = v[t + 2];
+      ycgco_to_rgb(y, cg, co, v[t], v[t + 1], v[t + 2]);
+    }
+  };
+  // Sample luminance and thin features (FSR 2 ComputeThinFeatureConfidence).
+  std::vector<float> luma(std::size_t(f.lw) * f.lh, 0.0f);
+  for (int c = 0; c < C; ++c)
+    for (std::size_t s = 0; s < luma.size(); ++s) luma[s] += f.luma[c] * (f.valid[s] ? f.low[c][s] : 0.0f);
+  auto thin = [&](int x, int y) {
+    const float n = luma[std::size_t(y) * f.lw + x];
+    bool similar[9] = {};
+    similar[4] = true;
+    float dmin = std::numeric_limits<float>::max(), dmax = 0;
+    for (int j = 0; j < 9; ++j) {
+      if (j == 4) continue;
+      const int xx = std::clamp(x + j % 3 - 1, 0, f.lw - 1), yy = std::clamp(y + j / 3 - 1, 0, f.lh - 1);
+      const float v = luma[std::size_t(yy) * f.lw + xx];
+      const float ratio = std::max(v, n) / std::min(v, n);
+      if (ratio > 0 && ratio < 1.05f) {
+        similar[j] = true;
+      } else {
+        dmin = std::min(dmin, v);
+        dmax = std::max(dmax, v);
+      }
+    }
+    if (!(n > dmax || n < dmin)) return false;
+    for (int q : {0, 1, 3, 4})  // top-left corners of the four 2x2 quads that hold the centre
+      if (similar[q] && similar[q + 1] && similar[q + 3] && similar[q + 4]) return false;
+    return true;
+  };
+  const float influence = std::min(20.0f, std::pow(float(k * k), 3.0f));
+  std::vector<float> acc_new(N), lock_new(N), luma_new(N);
+  for (int Y = 0; Y < H; ++Y)
+    for (int X = 0; X < W; ++X) {
+      const std::size_t i = f.at(X, Y);
+      Fetch h;
+      if (have_history_)
+        h = fetch(f.mx[i], f.my[i], float(X), float(Y), W, H, f.z[i], f.id ? f.id[i] : 0, prev_z_.data(),
+                  f.id ? prev_id_.data() : nullptr, options_.surface_test());
+      const float vel = std::isfinite(f.mx[i]) && std::isfinite(f.my[i]) ? std::hypot(f.mx[i], f.my[i]) : 0.0f;
+      float hv[16], sum[16] = {}, bs[16] = {}, lo[16] = {}, hi[16] = {}, res[16] = {}, rec[16] = {};
+      for (int c = 0; c < C; ++c) hv[c] = h(prev_out_.plane(out.channel_name(std::size_t(c))));
+      if (h.hit && catmull_rom) {  // Catmull-Rom where the fetch kept all four taps at their bilinear weights
+        const float u = float(X) + f.mx[i], v = float(Y) + f.my[i];
+        const rp::Bilinear b = rp::bilinear(u, v, W, H);
+        const float raw[4] = {b.w00, b.w10, b.w01, b.w11};
+        bool full = true;
+        for (int j = 0; j < 4; ++j) full = full && std::abs(h.w[j] - raw[j]) <= 1e-5f;
+        if (full)
+          for (int c = 0; c < C; ++c)
+            hv[c] = rp::catmull_rom(u, v, W, H)(prev_out_.plane(out.channel_name(std::size_t(c))));
+      }
+      to_ycgco(hv);
+      float acc = h(acc_.data()), lock = h(lock_.data()), lluma = h(lock_luma_.data());
+      // The nearest sample (ties to the right/below) and its 3x3 neighbourhood.
+      const int xn = std::clamp(int(std::floor((float(X - f.sx) + 0.5f * float(k)) / float(k))), 0, f.lw - 1);
+      const int yn = std::clamp(int(std::floor((float(Y - f.sy) + 0.5f * float(k)) / float(k))), 0, f.lh - 1);
+      const float bias = h.hit ? std::min(1.99f, float(k)) : 1.0f;
+      const float curve = -2.0f - std::min(1.0f, vel / 50.0f);
+      float ws = 0, bw = 0;
+      int n = 0;
+      std::vector<std::pair<float, std::vector<float>>> box;  // (weight, sample) for the spread about the mean
+      for (int ly = yn - 1; ly <= yn + 1; ++ly)
+        for (int lx = xn - 1; lx <= xn + 1; ++lx) {
+          if (lx < 0 || ly < 0 || lx >= f.lw || ly >= f.lh || !f.valid[std::size_t(ly) * f.lw + lx]) continue;
+          const float ox = float(k * lx + f.sx - X) / float(k), oy = float(k * ly + f.sy - Y) / float(k);
+          const float d2 = ox * ox + oy * oy;
+          const float wl = lanczos(d2 * bias * bias), wb = std::exp(curve * d2);
+          float v[16];
+          for (int c = 0; c < C; ++c) v[c] = f.low[c][std::size_t(ly) * f.lw + lx];
+          to_ycgco(v);
+          for (int c = 0; c < C; ++c) {
+            sum[c] += wl * v[c];
+            bs[c] += wb * v[c];
+            lo[c] = n ? std::min(lo[c], v[c]) : v[c];
+            hi[c] = n ? std::max(hi[c], v[c]) : v[c];
+          }
+          ws += wl;
+          bw += wb;
+          box.push_back({wb, std::vector<float>(v, v + C)});
+          ++n;
+        }
+      float w_new = 0;
+      if (n == 0) {
+        for (int c = 0; c < C; ++c) res[c] = h.hit ? hv[c] : 0.0f;
+        if (!h.hit) acc = 0;
+      } else {
+        for (int c = 0; c < C; ++c) rec[c] = ws > 1e-3f ? std::clamp(sum[c] / ws, lo[c], hi[c]) : bs[c] / bw;
+        if (ws > 1e-3f) w_new = ws / 12.0f;
+        if (!h.hit) {
+          for (int c = 0; c < C; ++c) res[c] = rec[c];
+          acc = w_new;
+        } else {
+          const float max_acc = 1.0f + (motion_acc - 1.0f) * std::min(1.0f, vel * 10.0f);
+          acc = std::min(acc, max_acc);
+          const float s = box_scale > 0 ? box_scale : influence + (1 - influence) * std::min(1.0f, vel / 20.0f);
+          const float lock_keep = locks ? std::clamp(4.0f * (lock - 1.0f), 0.0f, 1.0f) : 0.0f;
+          float keep_min = 1;
+          for (int c = 0; c < C; ++c) {
+            const float mean = bs[c] / bw;
+            double var = 0;
+            for (const auto& [wb, v] : box) var += double(wb) * (v[c] - mean) * (v[c] - mean);
+            const float sigma = float(std::sqrt(var / bw));
+            const float bmin = std::max(lo[c], mean - s * sigma), bmax = std::min(hi[c], mean + s * sigma);
+            const float cl = std::clamp(hv[c], bmin, bmax), centre = (bmin + bmax) / 2;
+            const float tau = 1e-5f * (1 + std::max(std::abs(lo[c]), std::abs(hi[c])));
+            const float keep = std::min(1.0f, (std::abs(cl - centre) + tau) / (std::abs(hv[c] - centre) + tau) + lock_keep);
+            hv[c] = cl + keep * (hv[c] - cl);
+            keep_min = std::min(keep_min, keep);
+          }
+          acc = std::min(acc, 0.1f) + keep_min * (acc - std::min(acc, 0.1f));
+          const float a = std::max(1e-3f, acc + w_new);
+          for (int c = 0; c < C; ++c) res[c] = hv[c] + (rec[c] - hv[c]) * (w_new / a);
+          acc = std::min(a, max_acc);
+        }
+      }
+      from_ycgco(res);
+      if (locks) {
+        if (!h.hit) lock = 0;
+        float yr = 0;
+        for (int c = 0; c < C; ++c) yr += f.luma[c] * res[c];
+        const float m = std::max(std::abs(yr), std::abs(lluma));
+        if (lock > 0 && m > 0 && std::abs(yr - lluma) / m > luma_change) lock = 0;
+        const bool at_sample = (X - f.sx) % k == 0 && (Y - f.sy) % k == 0 && X >= f.sx && Y >= f.sy &&
+                               (X - f.sx) / k < f.lw && (Y - f.sy) / k < f.lh;
+        if (at_sample && thin((X - f.sx) / k, (Y - f.sy) / k)) {
+          lock = lock > 0 ? 2.0f : 1.0f;
+          lluma = luma[std::size_t((Y - f.sy) / k) * f.lw + (X - f.sx) / k];
+        }
+        lock = std::max(0.0f, lock - w_new / (float(k * k) * 0.74f / 12.0f));
+      } else {
+        lock = 0;
+      }
+      bool ok = true;
+      for (int c = 0; c < C; ++c) ok = ok && std::isfinite(res[c]);
+      for (int c = 0; c < C; ++c) out.plane(out.channel_name(std::size_t(c)))[i] = ok ? res[c] : 0.0f;
+      acc_new[i] = ok ? acc : 0.0f;
+      lock_new[i] = ok ? lock : 0.0f;
+      luma_new[i] = lluma;
+    }
+  acc_ = std::move(acc_new);
+  lock_ = std::move(lock_new);
+  lock_luma_ = std::move(luma_new);
 }
 
 }  // namespace temporal::test

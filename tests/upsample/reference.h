@@ -25,6 +25,7 @@ class PlainUpsampler {
   void spatial(const Frame& f, Image& out) const;
   void temporal(const Frame& f, Image& out);
   void herzog(const Frame& f, Image& out);
+  void taau(const Frame& f, Image& out);
   void drobot_cache(const Frame& f, Image& out);
   void drobot_refresh(const Frame& f, Image& out);
 
@@ -36,6 +37,7 @@ class PlainUpsampler {
   std::vector<float> prev_z_;
   std::vector<std::uint32_t> prev_id_;
   std::vector<float> hw_, wf_, dhist_[3];  // herzog
+  std::vector<float> acc_, lock_, lock_luma_;  // taau
   std::vector<std::vector<float>> cache_;  // drobot: value planes, then depth, then frame count
   std::vector<std::uint32_t> cache_id_;
 };

@@ -122,7 +122,8 @@ double max_difference(const up::Options& o, const std::vector<Frame>& frames) {
 // Payload values are in [0, 1]. The fast kernels differ from the plain loops by float rounding only: reordered
 // sums and products, FMA, fast_exp2 for herzog's kernel powers (relative error < 2e-6), pow(dot, 32) by squaring and
 // a division instead of a reciprocal in drobot's Listing 7.1. Measured on this project's AVX-512 machine (GCC 12,
-// -march=native): at most 3.6e-7 for spatial, temporal and herzog, and 5.2e-6 for drobot, whose Listing 7.2
+// -march=native): at most 3.6e-7 for spatial, temporal and herzog, 3.4e-6 for taau (its Lanczos-2 sums cancel
+// between the negative lobes), and 5.2e-6 for drobot, whose Listing 7.2
 // confidence multiplies depth roundings by IN_ConvergenceTime (50); the tolerances leave a factor of 10-30 for other
 // CPUs and compilers. A wrong weight, tap or rule gives differences of 1e-3 to 1 (the payload is random): drobot's
 // fetch before it used the reprojection module differed from this plain version by up to 0.94.
@@ -161,6 +162,8 @@ TEST(UpsampleReference, NoIdsAndOtherParameters) {
       {"herzog", "--fallback", "flat", "--min-kernel-gamma", "0.5"},
       {"drobot", "--cache-point", "--miss-threshold", "0.05", "--max-frames", "8"},
       {"drobot", "--mode", "refresh", "--no-ids", "--depth-only"},
+      {"taau", "--no-locks", "--box-scale", "2", "--motion-accumulation", "0.6", "--history", "bilinear"},
+      {"taau", "--no-ids", "--lock-luma-change", "0.3", "--depth-tolerance", "0.2"},
   };
   for (const auto& run : runs) {
     auto o = up::make_options(run[0], std::vector<std::string>(run.begin() + 1, run.end()));

@@ -16,10 +16,11 @@ const MethodEntry& spatial_method();   // spatial.cpp
 const MethodEntry& temporal_method();  // temporal.cpp
 const MethodEntry& herzog_method();    // herzog.cpp
 const MethodEntry& drobot_method();    // drobot.cpp
+const MethodEntry& taau_method();      // taau.cpp
 
 const std::vector<const MethodEntry*>& registry() {
   static const std::vector<const MethodEntry*> table = {&spatial_method(), &temporal_method(), &herzog_method(),
-                                                        &drobot_method()};
+                                                        &drobot_method(), &taau_method()};
   return table;
 }
 
