@@ -156,6 +156,8 @@ class TaauState : public MethodState {
   }
 
   Image& run(const FrameContext& f, bool history, FrameStats& stats) override;
+  void update_lock(const FrameContext& f, const TaauOptions& to, const ColorSpace& cs, bool hit, const float* result,
+                   int X, int Y, float w_new, float lifetime_per_weight, float& lock, float& lock_luma) const;
 
   void save(Image& state) const override {
     const int c = out_.index();
@@ -184,6 +186,151 @@ class TaauState : public MethodState {
   std::vector<float> low_luma_;
   std::vector<char> thin_;
 };
+
+// Step 2 for one output pixel (X, Y): the 3x3 low-resolution samples around the nearest one (xn, yn), in filter
+// space (cs): their Lanczos-2 sum (FSR 2's approximation, kernel `bias`), and the box of step 3: the weighted mean
+// (weights exp(curve d^2), FSR 2's fRectificationCurveBias), spread, min and max.
+struct SampleBox {
+  float sum[16] = {}, bsum[16] = {}, bsq[16] = {}, lo[16] = {}, hi[16] = {};
+  float wsum = 0.0f, bw = 0.0f;
+  int samples = 0;
+};
+
+SampleBox gather_samples(const FrameContext& f, const ColorSpace& cs, int xn, int yn, int X, int Y, float bias,
+                         float curve) {
+  const int C = f.C, lw = f.lw, lh = f.lh, k = f.grid.k, sx = f.grid.sx, sy = f.grid.sy;
+  const float inv_k = 1.0f / float(k);
+  SampleBox b;
+  float* sum = b.sum;
+  float* bsum = b.bsum;
+  float* bsq = b.bsq;
+  float* lo = b.lo;
+  float* hi = b.hi;
+  float& wsum = b.wsum;
+  float& bw = b.bw;
+  int& samples = b.samples;
+  float vals[9][16], wbs[9];  // the samples (filter space) and box weights, for the box's second pass
+  for (int dy = -1; dy <= 1; ++dy) {
+    const int ly = yn + dy;
+    if (ly < 0 || ly >= lh) continue;  // FSR 2's fOnScreenFactor
+    for (int dx = -1; dx <= 1; ++dx) {
+      const int lx = xn + dx;
+      if (lx < 0 || lx >= lw) continue;
+      const std::size_t s = std::size_t(ly) * lw + lx;
+      if (!(f.lvalid[s] > 0)) continue;  // a non-finite sample or geometry does not exist
+      const float ox = float(k * lx + sx - X) * inv_k, oy = float(k * ly + sy - Y) * inv_k;
+      const float d2 = ox * ox + oy * oy;
+      const float wl = lanczos2_approx_sq(d2 * bias * bias);
+      const float wb = std::exp(curve * d2);
+      float* v = vals[samples];
+      wbs[samples] = wb;
+      for (int c = 0; c < C; ++c) v[c] = f.low[c][s];
+      cs.to(v);
+      for (int c = 0; c < C; ++c) {
+        sum[c] += wl * v[c];
+        bsum[c] += wb * v[c];
+        lo[c] = samples ? std::min(lo[c], v[c]) : v[c];
+        hi[c] = samples ? std::max(hi[c], v[c]) : v[c];
+      }
+      wsum += wl;
+      bw += wb;
+      ++samples;
+    }
+  }
+  // The box's spread in a second pass about its mean: E[v^2] - mean^2 (FSR 2's form) loses every digit to
+  // cancellation on smooth content, and the box edge mean +- 20 sigma would then follow rounding noise.
+  for (int j = 0; j < samples; ++j)
+    for (int c = 0; c < C; ++c) {
+      const float d = vals[j][c] - bsum[c] / bw;
+      bsq[c] += wbs[j] * d * d;
+    }
+  return b;
+}
+
+// Steps 3 and 4 for a pixel with history (FSR 2.2 RectifyHistory, FSR 2 Accumulate): the history `hv` (filter
+// space) clipped towards the box of `b` as far as it left it, the accumulation weight `acc` cut as much, then the
+// blend with this frame's reconstruction `recon` of weight `w_new`. Writes `result`, `alpha` (this frame's share)
+// and `acc`; returns how much of the history was cut (0 kept .. 1 cut: debug.gradient).
+float rectify_and_accumulate(const TaauOptions& to, const SampleBox& b, int C, float velocity, float scale_influence,
+                             float lock, const float* recon, float w_new, float* hv, float& acc, float& alpha,
+                             float* result) {
+  const float* bsum = b.bsum;
+  const float* bsq = b.bsq;
+  const float* lo = b.lo;
+  const float* hi = b.hi;
+  const float bw = b.bw;
+  // FSR 2.0 ComputeMaxAccumulationWeight: 1, 3/12 once the pixel moves by 0.1 px.
+  const float max_acc = kMaxAccumulation + (to.motion_accumulation - kMaxAccumulation) *
+                                               std::min(1.0f, velocity * 10.0f);
+  acc = std::min(acc, max_acc);
+  // Step 3: rectification (FSR 2.2 RectifyHistory).
+  const float s = to.box_scale > 0
+                      ? to.box_scale
+                      : scale_influence + (1.0f - scale_influence) * std::min(1.0f, velocity / 20.0f);
+  // How much of the history survives, per channel: FSR 2.0's HistoryColorWeight |clamped - centre| /
+  // |history - centre| (1 inside the box, falling as the history leaves it), plus the lock's
+  // contribution (FSR 2 GetLockContributionThisFrame: saturate(saturate(lifetime - 1) * 4)). Continuous
+  // in the history, unlike FSR 2.2's any-channel-outside test, so that float roundings cannot flip it.
+  const float lock_keep = to.locks ? std::clamp((lock - 1.0f) * 4.0f, 0.0f, 1.0f) : 0.0f;
+  float keep_all = 1.0f;
+  for (int c = 0; c < C; ++c) {
+    const float mean = bsum[c] / bw;
+    const float sigma = std::sqrt(bsq[c] / bw);
+    const float bmin = std::max(lo[c], mean - s * sigma), bmax = std::min(hi[c], mean + s * sigma);
+    const float clamped = std::clamp(hv[c], bmin, bmax);
+    // tau: a flat channel (a zero-width box, e.g. Co of a grey surface) must not turn rounding noise in
+    // the history into a clamp; deviations below 1e-5 of the payload's scale count as inside.
+    const float centre = 0.5f * (bmin + bmax), tau = 1e-5f * (1.0f + std::max(std::abs(lo[c]), std::abs(hi[c])));
+    const float ratio = (std::abs(clamped - centre) + tau) / (std::abs(hv[c] - centre) + tau);
+    const float keep = std::min(1.0f, ratio + lock_keep);
+    hv[c] = clamped + (hv[c] - clamped) * keep;
+    keep_all = std::min(keep_all, keep);
+  }
+  // FSR 2.2: a rectified history's accumulation falls to at most 0.1, as much as the history was cut.
+  const float acc_min = std::min(acc, kRectifiedAccumulation);
+  acc = acc_min + (acc - acc_min) * keep_all;
+  // Step 4 (FSR 2 Accumulate).
+  const float a = std::max(kEpsilon, acc + w_new);
+  alpha = w_new / a;
+  for (int c = 0; c < C; ++c) result[c] = hv[c] + (recon[c] - hv[c]) * alpha;
+  acc = std::min(a, max_acc);
+  return 1.0f - keep_all;
+}
+
+// Step 5 for one pixel (FSR 2 locks): a lock ends when the luminance of this frame's result moved more than
+// --lock-luma-change from the one it was made with; a thin-feature sample at this pixel makes (or renews) one; its
+// lifetime is spent by the weight accumulated.
+void TaauState::update_lock(const FrameContext& f, const TaauOptions& to, const ColorSpace& cs, bool hit,
+                            const float* result, int X, int Y, float w_new, float lifetime_per_weight, float& lock,
+                            float& lock_luma) const {
+  const int C = f.C, lw = f.lw, lh = f.lh, k = f.grid.k, sx = f.grid.sx, sy = f.grid.sy;
+  // Step 5: locks. Luminance of this frame's reconstruction where it has weight (else the result's).
+  if (to.locks) {
+    if (!hit) lock = 0.0f;
+    float yr = 0.0f;
+    {
+      float rgb[16];
+      for (int c = 0; c < C; ++c) rgb[c] = result[c];
+      cs.from(rgb);
+      for (int c = 0; c < C; ++c) yr += f.luma[c] * rgb[c];
+    }
+    if (lock > 0) {
+      const float m = std::max(std::abs(yr), std::abs(lock_luma));
+      const float change = m > 0 ? std::abs(yr - lock_luma) / m : 0.0f;
+      if (change > to.lock_luma_change) lock = 0.0f;
+    }
+    // A new lock at the pixel of a thin-feature sample (FSR 2 writes it at the sample's display pixel).
+    const int dxs = X - sx, dys = Y - sy;
+    if (dxs >= 0 && dys >= 0 && dxs % k == 0 && dys % k == 0 && dxs / k < lw && dys / k < lh &&
+        thin_[std::size_t(dys / k) * lw + dxs / k]) {
+      lock = lock > 0 ? 2.0f : 1.0f;  // FSR 2: a lock found again while alive
+      lock_luma = low_luma_[std::size_t(dys / k) * lw + dxs / k];
+    }
+    lock = std::max(0.0f, lock - w_new * lifetime_per_weight);
+  } else {
+    lock = 0.0f;
+  }
+}
 
 Image& TaauState::run(const FrameContext& f, bool history, FrameStats& stats) {
   const TaauOptions& to = taau_options(*f.options);
@@ -219,7 +366,6 @@ Image& TaauState::run(const FrameContext& f, bool history, FrameStats& stats) {
   const float bias_history = std::min(1.99f, 1.0f + (float(k) - 1.0f));
   // Lock lifetime spent per unit of accumulated weight (FSR 2 FinalizeLockStatus): a jitter cycle of average weight.
   const float lifetime_per_weight = 1.0f / (float(k * k) * kAverageLanczosWeight);
-  const float inv_k = 1.0f / float(k);
   const bool catmull_rom = to.history == "catmull-rom";
 
   std::atomic<std::size_t> hits{0};
@@ -260,44 +406,13 @@ Image& TaauState::run(const FrameContext& f, bool history, FrameStats& stats) {
         const int xn = std::clamp(JitterGrid::floor_div(2 * (X - sx) + k, 2 * k), 0, lw - 1);
         const float bias = hit ? bias_history : 1.0f;  // FSR 2: lerp(bias max, bias min, new sample) = 1 when new
         const float curve = -2.0f - std::min(1.0f, velocity / 50.0f);  // fRectificationCurveBias
-        float sum[16] = {}, bsum[16] = {}, bsq[16] = {}, lo[16] = {}, hi[16] = {};
-        float vals[9][16], wbs[9];  // the samples (filter space) and box weights, for the box's second pass
-        float wsum = 0.0f, bw = 0.0f;
-        int samples = 0;
-        for (int dy = -1; dy <= 1; ++dy) {
-          const int ly = yn + dy;
-          if (ly < 0 || ly >= lh) continue;  // FSR 2's fOnScreenFactor
-          for (int dx = -1; dx <= 1; ++dx) {
-            const int lx = xn + dx;
-            if (lx < 0 || lx >= lw) continue;
-            const std::size_t s = std::size_t(ly) * lw + lx;
-            if (!(f.lvalid[s] > 0)) continue;  // a non-finite sample or geometry does not exist
-            const float ox = float(k * lx + sx - X) * inv_k, oy = float(k * ly + sy - Y) * inv_k;
-            const float d2 = ox * ox + oy * oy;
-            const float wl = lanczos2_approx_sq(d2 * bias * bias);
-            const float wb = std::exp(curve * d2);
-            float* v = vals[samples];
-            wbs[samples] = wb;
-            for (int c = 0; c < C; ++c) v[c] = f.low[c][s];
-            cs.to(v);
-            for (int c = 0; c < C; ++c) {
-              sum[c] += wl * v[c];
-              bsum[c] += wb * v[c];
-              lo[c] = samples ? std::min(lo[c], v[c]) : v[c];
-              hi[c] = samples ? std::max(hi[c], v[c]) : v[c];
-            }
-            wsum += wl;
-            bw += wb;
-            ++samples;
-          }
-        }
-        // The box's spread in a second pass about its mean: E[v^2] - mean^2 (FSR 2's form) loses every digit to
-        // cancellation on smooth content, and the box edge mean +- 20 sigma would then follow rounding noise.
-        for (int j = 0; j < samples; ++j)
-          for (int c = 0; c < C; ++c) {
-            const float d = vals[j][c] - bsum[c] / bw;
-            bsq[c] += wbs[j] * d * d;
-          }
+        const SampleBox b = gather_samples(f, cs, xn, yn, X, Y, bias, curve);
+        const float* sum = b.sum;
+        const float* bsum = b.bsum;
+        const float* lo = b.lo;
+        const float* hi = b.hi;
+        const float wsum = b.wsum, bw = b.bw;
+        const int samples = b.samples;
         float hv[16], recon[16];
         for (int c = 0; c < C; ++c) hv[c] = hit ? fetched[std::size_t(c) * W + X] : 0.0f;
         if (hit && catmull_rom) {
@@ -335,70 +450,11 @@ Image& TaauState::run(const FrameContext& f, bool history, FrameStats& stats) {
             acc = w_new;
             alpha = 1.0f;
           } else {
-            // FSR 2.0 ComputeMaxAccumulationWeight: 1, 3/12 once the pixel moves by 0.1 px.
-            const float max_acc = kMaxAccumulation + (to.motion_accumulation - kMaxAccumulation) *
-                                                         std::min(1.0f, velocity * 10.0f);
-            acc = std::min(acc, max_acc);
-            // Step 3: rectification (FSR 2.2 RectifyHistory).
-            const float s = to.box_scale > 0
-                                ? to.box_scale
-                                : scale_influence + (1.0f - scale_influence) * std::min(1.0f, velocity / 20.0f);
-            // How much of the history survives, per channel: FSR 2.0's HistoryColorWeight |clamped - centre| /
-            // |history - centre| (1 inside the box, falling as the history leaves it), plus the lock's
-            // contribution (FSR 2 GetLockContributionThisFrame: saturate(saturate(lifetime - 1) * 4)). Continuous
-            // in the history, unlike FSR 2.2's any-channel-outside test, so that float roundings cannot flip it.
-            const float lock_keep = to.locks ? std::clamp((lock - 1.0f) * 4.0f, 0.0f, 1.0f) : 0.0f;
-            float keep_all = 1.0f;
-            for (int c = 0; c < C; ++c) {
-              const float mean = bsum[c] / bw;
-              const float sigma = std::sqrt(bsq[c] / bw);
-              const float bmin = std::max(lo[c], mean - s * sigma), bmax = std::min(hi[c], mean + s * sigma);
-              const float clamped = std::clamp(hv[c], bmin, bmax);
-              // tau: a flat channel (a zero-width box, e.g. Co of a grey surface) must not turn rounding noise in
-              // the history into a clamp; deviations below 1e-5 of the payload's scale count as inside.
-              const float centre = 0.5f * (bmin + bmax), tau = 1e-5f * (1.0f + std::max(std::abs(lo[c]), std::abs(hi[c])));
-              const float ratio = (std::abs(clamped - centre) + tau) / (std::abs(hv[c] - centre) + tau);
-              const float keep = std::min(1.0f, ratio + lock_keep);
-              hv[c] = clamped + (hv[c] - clamped) * keep;
-              keep_all = std::min(keep_all, keep);
-            }
-            // FSR 2.2: a rectified history's accumulation falls to at most 0.1, as much as the history was cut.
-            const float acc_min = std::min(acc, kRectifiedAccumulation);
-            acc = acc_min + (acc - acc_min) * keep_all;
-            rectified = 1.0f - keep_all;
-            // Step 4 (FSR 2 Accumulate).
-            const float a = std::max(kEpsilon, acc + w_new);
-            alpha = w_new / a;
-            for (int c = 0; c < C; ++c) result[c] = hv[c] + (recon[c] - hv[c]) * alpha;
-            acc = std::min(a, max_acc);
+            rectified = rectify_and_accumulate(to, b, C, velocity, scale_influence, lock, recon, w_new, hv, acc, alpha,
+                                               result);
           }
         }
-        // Step 5: locks. Luminance of this frame's reconstruction where it has weight (else the result's).
-        if (to.locks) {
-          if (!hit) lock = 0.0f;
-          float yr = 0.0f;
-          {
-            float rgb[16];
-            for (int c = 0; c < C; ++c) rgb[c] = result[c];
-            cs.from(rgb);
-            for (int c = 0; c < C; ++c) yr += f.luma[c] * rgb[c];
-          }
-          if (lock > 0) {
-            const float m = std::max(std::abs(yr), std::abs(lock_luma));
-            const float change = m > 0 ? std::abs(yr - lock_luma) / m : 0.0f;
-            if (change > to.lock_luma_change) lock = 0.0f;
-          }
-          // A new lock at the pixel of a thin-feature sample (FSR 2 writes it at the sample's display pixel).
-          const int dxs = X - sx, dys = Y - sy;
-          if (dxs >= 0 && dys >= 0 && dxs % k == 0 && dys % k == 0 && dxs / k < lw && dys / k < lh &&
-              thin_[std::size_t(dys / k) * lw + dxs / k]) {
-            lock = lock > 0 ? 2.0f : 1.0f;  // FSR 2: a lock found again while alive
-            lock_luma = low_luma_[std::size_t(dys / k) * lw + dxs / k];
-          }
-          lock = std::max(0.0f, lock - w_new * lifetime_per_weight);
-        } else {
-          lock = 0.0f;
-        }
+        update_lock(f, to, cs, hit, result, X, Y, w_new, lifetime_per_weight, lock, lock_luma);
         cs.from(result);
         bool ok = true;
         for (int c = 0; c < C; ++c) ok = ok && std::abs(result[c]) <= 3.0e38f;  // false for NaN and Inf
