@@ -4,6 +4,7 @@
 #include "temporal/pictures/video.h"
 
 #include "temporal/core/atomic_file.h"
+#include "temporal/core/executable.h"
 
 #include <fcntl.h>
 #include <signal.h>
@@ -22,22 +23,7 @@
 
 namespace temporal {
 
-std::string find_ffmpeg() {
-  const char* path = std::getenv("PATH");
-  std::string dirs = path ? path : "/usr/local/bin:/usr/bin:/bin";
-  std::size_t start = 0;
-  while (start <= dirs.size()) {
-    const auto end = dirs.find(':', start);
-    const std::string dir = dirs.substr(start, end == std::string::npos ? std::string::npos : end - start);
-    const std::string candidate = (dir.empty() ? std::string(".") : dir) + "/ffmpeg";
-    struct stat st {};
-    if (::stat(candidate.c_str(), &st) == 0 && S_ISREG(st.st_mode) && ::access(candidate.c_str(), X_OK) == 0)
-      return candidate;
-    if (end == std::string::npos) break;
-    start = end + 1;
-  }
-  return {};
-}
+std::string find_ffmpeg() { return find_in_path("ffmpeg"); }
 
 struct VideoWriter::Impl {
   std::string path;

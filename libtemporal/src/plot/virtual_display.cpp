@@ -1,6 +1,8 @@
 // An X display for VTK (temporal/plot/plot.h): Debian's VTK 9.1 is built for X11 only and aborts without a display.
 #include "temporal/plot/plot.h"
 
+#include "temporal/core/executable.h"
+
 #include <X11/Xlib.h>
 #undef Status  // Xlib defines Status as a macro; temporal::Status must stay usable
 #include <fcntl.h>
@@ -25,23 +27,6 @@ bool display_answers(const char* name) {
   if (!d) return false;
   XCloseDisplay(d);
   return true;
-}
-
-std::string find_in_path(const std::string& program) {
-  const char* path = std::getenv("PATH");
-  std::string dirs = path ? path : "/usr/local/bin:/usr/bin:/bin";
-  std::size_t start = 0;
-  while (start <= dirs.size()) {
-    const auto end = dirs.find(':', start);
-    const std::string dir = dirs.substr(start, end == std::string::npos ? std::string::npos : end - start);
-    const std::string candidate = (dir.empty() ? std::string(".") : dir) + "/" + program;
-    struct stat st {};
-    if (::stat(candidate.c_str(), &st) == 0 && S_ISREG(st.st_mode) && ::access(candidate.c_str(), X_OK) == 0)
-      return candidate;
-    if (end == std::string::npos) break;
-    start = end + 1;
-  }
-  return {};
 }
 
 }  // namespace

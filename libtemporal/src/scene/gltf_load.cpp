@@ -20,6 +20,17 @@ std::string quoted_or_index(const std::string& name, std::size_t index) {
   return s;
 }
 
+bool is_index(const std::string& s) {
+  return !s.empty() && s.size() <= 9 &&
+         std::all_of(s.begin(), s.end(), [](unsigned char c) { return std::isdigit(c) != 0; });
+}
+
+std::string join_names(const std::vector<std::string>& names) {
+  std::string s;
+  for (const auto& x : names) s += (s.empty() ? "" : ", ") + x;
+  return s.empty() ? "none" : s;
+}
+
 namespace {
 
 const std::set<std::string>& supported_required_extensions() {
@@ -34,18 +45,6 @@ std::string one_line(std::string s) {
   return s;
 }
 
-// A decimal index of at most 9 digits (a longer number cannot be an index, and would overflow std::stoul): such
-// a name is then looked up as a name and refused as unknown.
-bool is_index(const std::string& s) {
-  return !s.empty() && s.size() <= 9 &&
-         std::all_of(s.begin(), s.end(), [](unsigned char c) { return std::isdigit(c) != 0; });
-}
-
-std::string join(const std::vector<std::string>& v) {
-  std::string s;
-  for (const auto& x : v) s += (s.empty() ? "" : ", ") + x;
-  return s.empty() ? "none" : s;
-}
 
 }  // namespace
 
@@ -251,7 +250,7 @@ Status Loader::select_clips(const std::string& clip, std::vector<std::size_t>& s
     }
     if (selected.empty() && is_index(clip) && std::stoul(clip) < model.animations.size()) selected.push_back(std::stoul(clip));
     if (selected.empty()) {
-      return Error{ErrorKind::Usage, file, "no animation clip '" + clip + "' (have: " + join(out.clip_names) +
+      return Error{ErrorKind::Usage, file, "no animation clip '" + clip + "' (have: " + join_names(out.clip_names) +
                                                "; give a name, an index or 'all')"};
     }
   }

@@ -176,6 +176,11 @@ struct Impl : SceneDescription {
 
 // "'name'" or "#index" for messages.
 std::string quoted_or_index(const std::string& name, std::size_t index);
+// A decimal index of at most 9 digits (a longer number cannot be an index, and would overflow std::stoul): a clip
+// or camera named so is looked up by index, else by name (and refused as unknown).
+bool is_index(const std::string& s);
+// "a, b, c" ("none" when empty), for the messages that list what a scene has.
+std::string join_names(const std::vector<std::string>& names);
 
 }  // namespace temporal::scene_detail
 

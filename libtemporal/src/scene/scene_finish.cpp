@@ -14,19 +14,9 @@ namespace temporal {
 namespace {
 
 using scene_detail::Impl;
+using scene_detail::is_index;
+using scene_detail::join_names;
 
-// A decimal index of at most 9 digits (a longer number cannot be an index, and would overflow std::stoul): such
-// a name is then looked up as a name and refused as unknown.
-bool is_index(const std::string& s) {
-  return !s.empty() && s.size() <= 9 &&
-         std::all_of(s.begin(), s.end(), [](unsigned char c) { return std::isdigit(c) != 0; });
-}
-
-std::string join(const std::vector<std::string>& v) {
-  std::string s;
-  for (const auto& x : v) s += (s.empty() ? "" : ", ") + x;
-  return s.empty() ? "none" : s;
-}
 
 // The camera definition `wanted` names (name, USD path or index; the last of several equal names wins), or -1.
 int find_camera(const Impl& impl, const std::string& wanted) {
@@ -98,7 +88,7 @@ Status Scene::finish(const SceneLoadOptions& options) {
   if (!co.camera.empty()) {
     camera_index = find_camera(impl, co.camera);
     if (camera_index < 0) {
-      return Error{ErrorKind::Usage, path, "no camera '" + co.camera + "' (have: " + join(camera_names()) +
+      return Error{ErrorKind::Usage, path, "no camera '" + co.camera + "' (have: " + join_names(camera_names()) +
                                                "); give a name or an index, or omit it for the automatic camera"};
     }
     if (impl.cameras[static_cast<std::size_t>(camera_index)].orthographic) {

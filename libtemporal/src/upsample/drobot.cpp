@@ -564,12 +564,6 @@ Status DrobotState::load(const Image& state) {
 }
 
 // The history fetch's disocclusion test compares material ids unless --no-ids.
-std::vector<LayerNeed> layers(const Options& o) {
-  std::vector<LayerNeed> l = {{"depth"}, {"N"}, {"motion"}};
-  if (!o.no_ids) l.push_back({"id", true, "or pass --no-ids"});
-  return l;
-}
-
 std::size_t streamed_bytes(const Options& o, int W, int H, int k, int C) {
   const std::size_t full = std::size_t(W) * H * 4, low = full / (std::size_t(k) * k);
   std::size_t b = 4 * full + C * low + C * full;  // depth + N, payload in, payload out
@@ -593,7 +587,7 @@ const MethodEntry& drobot_method() {
        true,
        {{"drobot-refresh", "drobot", {"--mode", "refresh"}, "the refresh-buffer reconstruction of Figure 7.12"}}},
       OptionsOf<DrobotOptions>::make,
-      layers,
+      history_method_layers,
       [](const Options& o, const Geometry& g) -> std::unique_ptr<MethodState> {
         return std::make_unique<DrobotState>(o, g);
       },

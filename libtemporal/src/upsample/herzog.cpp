@@ -937,12 +937,6 @@ Image& HerzogState::run(const FrameContext& f, bool history, FrameStats& stats) 
 
 // --- Registry entry --------------------------------------------------------------------------------------------
 
-std::vector<LayerNeed> layers(const Options& o) {
-  std::vector<LayerNeed> l = {{"depth"}, {"N"}, {"motion"}};
-  if (!o.no_ids) l.push_back({"id", true, "or pass --no-ids"});
-  return l;
-}
-
 // depth + N, payload in and out; motion, id; the previous depth and id read and written; the history read; h_w
 // read and written.
 std::size_t streamed_bytes(const Options&, int W, int H, int k, int C) {
@@ -964,7 +958,7 @@ const MethodEntry& herzog_method() {
        {{"herzog-lagged", "herzog", {"--lagged-wf"}, "eq. 7 with the previous frame's w_f: one fused pass"},
         {"herzog-favor-spatial", "herzog", {"--favor-spatial"}, "a = 0.7 (the paper's elephant scene)"}}},
       OptionsOf<HerzogOptions>::make,
-      layers,
+      history_method_layers,
       [](const Options& o, const Geometry& g) -> std::unique_ptr<MethodState> {
         return std::make_unique<HerzogState>(o, g);
       },

@@ -35,6 +35,14 @@ class MethodState {
   virtual Status load(const Image& state) = 0;
 };
 
+// The G-buffer layers of a method that reprojects a history (temporal, herzog, drobot, taau): depth and N for the
+// samples' geometry, motion for the fetch, and the ids of the disocclusion test unless --no-ids.
+inline std::vector<LayerNeed> history_method_layers(const Options& o) {
+  std::vector<LayerNeed> l = {{"depth"}, {"N"}, {"motion"}};
+  if (!o.no_ids) l.push_back({"id", true, "or pass --no-ids"});
+  return l;
+}
+
 // One row of the registry (docs/upsample-st.md, "Methods as units").
 struct MethodEntry {
   MethodInfo info;

@@ -481,12 +481,6 @@ Image& TaauState::run(const FrameContext& f, bool history, FrameStats& stats) {
   return out;
 }
 
-std::vector<LayerNeed> layers(const Options& o) {
-  std::vector<LayerNeed> l = {{"depth"}, {"N"}, {"motion"}};
-  if (!o.no_ids) l.push_back({"id", true, "or pass --no-ids"});
-  return l;
-}
-
 // depth + N (the frame context's sample validity), payload in and out; motion, id; the previous depth and id read
 // and written; the history read; weight, lock lifetime and lock luminance read and written.
 std::size_t streamed_bytes(const Options&, int W, int H, int k, int C) {
@@ -504,7 +498,7 @@ const MethodEntry& taau_method() {
        true,
        {}},
       OptionsOf<TaauOptions>::make,
-      layers,
+      history_method_layers,
       [](const Options& o, const Geometry& g) -> std::unique_ptr<MethodState> {
         return std::make_unique<TaauState>(o, g);
       },

@@ -141,12 +141,6 @@ class TemporalState : public MethodState {
   PreviousGeometry prev_;
 };
 
-std::vector<LayerNeed> layers(const Options& o) {
-  std::vector<LayerNeed> l = {{"depth"}, {"N"}, {"motion"}};
-  if (!o.no_ids) l.push_back({"id", true, "or pass --no-ids"});
-  return l;
-}
-
 // depth + N, payload in and out; motion, id; the previous depth and id read and written; the history read.
 std::size_t streamed_bytes(const Options&, int W, int H, int k, int C) {
   const std::size_t full = std::size_t(W) * H * 4, low = full / (std::size_t(k) * k);
@@ -162,7 +156,7 @@ const MethodEntry& temporal_method() {
        "p + motion elsewhere, holes filled spatially",
        true, {}},
       nullptr,
-      layers,
+      history_method_layers,
       [](const Options&, const Geometry& g) -> std::unique_ptr<MethodState> { return std::make_unique<TemporalState>(g); },
       streamed_bytes,
       nullptr};
