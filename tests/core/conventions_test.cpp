@@ -18,7 +18,7 @@ namespace {
 // The float channels the conventions table names (the uint `id` is checked separately).
 const std::vector<std::string> kFloatChannels = {
     "R",        "G",        "B",        "A",        "depth.Z",  "N.X",      "N.Y",      "N.Z",     "motion.X",
-    "motion.Y", "albedo.R", "albedo.G", "albedo.B", "direct.R", "direct.G", "direct.B", "shadow.Y", "ssao.Y",
+    "motion.Y", "prevDepth.Z", "albedo.R", "albedo.G", "albedo.B", "direct.R", "direct.G", "direct.B", "shadow.Y", "ssao.Y",
     "gi.R",     "gi.G",     "gi.B",     "error.R",  "error.G",  "error.B",  "error.Y"};
 
 bool bit_equal(float a, float b) { return std::memcmp(&a, &b, sizeof a) == 0; }

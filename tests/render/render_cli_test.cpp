@@ -195,7 +195,7 @@ TEST(RenderCli, WritesOnlyTheLayersAskedFor) {
   std::vector<std::string> gc = g->channels;
   std::sort(gc.begin(), gc.end());
   EXPECT_EQ(gc, (std::vector<std::string>{"N.X", "N.Y", "N.Z", "albedo.B", "albedo.G", "albedo.R", "depth.Z", "id",
-                                          "motion.X", "motion.Y"}));
+                                          "motion.X", "motion.Y", "prevDepth.Z"}));
   auto s = read_exr_info((out / "shade.0001.exr").string());
   ASSERT_TRUE(s) << s.error().message;
   std::vector<std::string> sc = s->channels;

@@ -144,6 +144,66 @@ TEST(RenderMotion, BackgroundCarriesCameraMotionAndFarDepth) {
   EXPECT_GT(std::fabs(g.plane("motion.X")[0]), 0.1f);
 }
 
+// prevDepth.Z (the depth the surface point under the pixel had in the previous frame, seed 000 section 3.2's
+// warped depth): equal to depth.Z bit for bit where nothing moved and on frame 0.
+TEST(RenderPrevDepth, StaticSceneAndFrameZeroEqualDepthBitForBit) {
+  for (unsigned motion : {unsigned(SyntheticScene::kStatic),
+                          unsigned(SyntheticScene::kCamera | SyntheticScene::kNode | SyntheticScene::kDeform)}) {
+    SyntheticScene scene;
+    scene.motion = motion;
+    RenderOptions o = small_options(64, 48);
+    o.outputs = RenderOutputs{true, false, false, false};
+    auto r = Renderer::create(o, scene.geometry());
+    ASSERT_TRUE(r) << r.error().message;
+    for (int frame : {0, 5}) {
+      if (motion != SyntheticScene::kStatic && frame != 0) continue;  // a moving scene: frame 0 only
+      const Image g = render_gbuffer(*r, scene, frame, 40.0);
+      const float *z = g.plane("depth.Z"), *zp = g.plane("prevDepth.Z");
+      ASSERT_NE(zp, nullptr);
+      ASSERT_EQ(std::memcmp(z, zp, g.pixel_count() * sizeof(float)), 0) << "motion " << motion << " frame " << frame;
+    }
+  }
+}
+
+// A camera dolly along its view axis: the camera of frame N is d nearer (along its forward axis) than that of
+// frame N-1, nothing else moves, so every surface point was d further away: prevDepth = depth + d. Float
+// rounding of the two view transforms (depths ~5-10, coordinates ~7): within 1e-5 relative (about 10 ulps).
+// Background: clipFar, like depth.
+TEST(RenderPrevDepth, CameraDollyAddsTheDollyDistance) {
+  SyntheticScene scene;
+  RenderOptions o = small_options(64, 48);
+  o.outputs = RenderOutputs{true, false, false, false};
+  auto r = Renderer::create(o, scene.geometry());
+  ASSERT_TRUE(r) << r.error().message;
+  const float d = 0.75f;
+  FrameState cur = scene.evaluate(0.0), prev = scene.evaluate(0.0);
+  const glm::vec3 eye(0.0f, 3.5f, 7.0f), target(0.0f, 0.5f, 0.0f);
+  const glm::vec3 forward = glm::normalize(target - eye);
+  cur.camera.view = glm::lookAt(eye, target, glm::vec3(0, 1, 0));
+  prev.camera.view = glm::lookAt(eye - d * forward, target, glm::vec3(0, 1, 0));
+  FrameInput in;
+  in.frame = 1;
+  in.fps = 40.0;
+  in.current = &cur;
+  in.previous = &prev;
+  auto out = r->render(in);
+  ASSERT_TRUE(out) << out.error().message;
+  const Image& g = *out->gbuffer;
+  const float *z = g.plane("depth.Z"), *zp = g.plane("prevDepth.Z");
+  const std::uint32_t* id = g.uint_plane("id");
+  ASSERT_NE(zp, nullptr);
+  std::size_t surface = 0;
+  for (std::size_t i = 0; i < g.pixel_count(); ++i) {
+    if (id[i] == 0) {
+      EXPECT_EQ(zp[i], 50.0f) << i;  // clipFar
+      continue;
+    }
+    ++surface;
+    ASSERT_NEAR(zp[i], z[i] + d, 1e-5f * (z[i] + d)) << "pixel " << i << " depth " << z[i];
+  }
+  EXPECT_GT(surface, g.pixel_count() / 2);
+}
+
 // The jitter tests' set-up: 64x48, direct light only (no random terms), the low-resolution payload and the
 // unjittered full-resolution colour.
 static RenderOptions jitter_test_options() {

@@ -109,7 +109,8 @@ void delete_fbo(const GlFunctions& gl, Fbo& f) {
 
 // G-buffer attachments (shaders.cpp, kGbufferFragment).
 enum GbufferAttachment { kAlbedo = 0, kNormal = 1, kMotion = 2, kWorld = 3, kId = 4 };
-const std::vector<GLenum> kGbufferFormats = {GL_RGBA32F, GL_RGBA32F, GL_RG32F, GL_RGBA32F, GL_R32UI};
+// Motion is RGBA32F: motion.X/Y and prevDepth.Z (the fourth component is unused).
+const std::vector<GLenum> kGbufferFormats = {GL_RGBA32F, GL_RGBA32F, GL_RGBA32F, GL_RGBA32F, GL_R32UI};
 // Shade attachments: direct + shadow, gi + ssao, sum.
 const std::vector<GLenum> kShadeFormats = {GL_RGBA32F, GL_RGBA32F, GL_RGBA32F};
 const std::vector<GLenum> kRsmFormats = {GL_RGBA32F, GL_RGBA32F, GL_RGBA32F};
@@ -162,7 +163,7 @@ struct Renderer::Impl {
   Status light_maps(const FrameState& state);
   void select_vpls(std::uint32_t instant, int sample);
   struct View {
-    glm::mat4 view{1.0f}, proj{1.0f}, proj_jittered{1.0f}, prev_vp{1.0f};
+    glm::mat4 view{1.0f}, proj{1.0f}, proj_jittered{1.0f}, prev_vp{1.0f}, prev_view{1.0f};
     glm::vec3 camera_pos{0.0f};
     float znear = 0.1f, zfar = 100.0f;
   };
@@ -395,6 +396,7 @@ Renderer::Impl::View Renderer::Impl::make_view(const FrameInput& in, int w, int 
   v.proj_jittered = jitter_projection(v.proj, jitter, w, h);
   const CameraState& pcam = in.previous ? in.previous->camera : cam;
   v.prev_vp = camera_projection(pcam, w, h) * pcam.view;
+  v.prev_view = pcam.view;
   v.camera_pos = glm::vec3(glm::inverse(cam.view)[3]);
   v.znear = cam.znear > 0.0f ? cam.znear : 0.01f;
   v.zfar = cam.zfar > v.znear ? cam.zfar : 1000.0f * v.znear;
@@ -422,6 +424,7 @@ void Renderer::Impl::draw_gbuffer(const Fbo& target, const View& v, float lod_bi
   g.UniformMatrix4fv(g.GetUniformLocation(prog, "u_cur_vp"), 1, GL_FALSE, glm::value_ptr(cur_vp));
   g.UniformMatrix4fv(g.GetUniformLocation(prog, "u_prev_vp"), 1, GL_FALSE, glm::value_ptr(v.prev_vp));
   g.UniformMatrix4fv(g.GetUniformLocation(prog, "u_view"), 1, GL_FALSE, glm::value_ptr(v.view));
+  g.UniformMatrix4fv(g.GetUniformLocation(prog, "u_prev_view"), 1, GL_FALSE, glm::value_ptr(v.prev_view));
   g.Uniform2f(g.GetUniformLocation(prog, "u_size"), float(target.width), float(target.height));
   g.Uniform1f(g.GetUniformLocation(prog, "u_lod_bias"), lod_bias);
   gpu->draw_all(prog, true);
@@ -520,6 +523,7 @@ Image Renderer::Impl::gbuffer_image(const Fbo& f, const View& v, const FrameInpu
   float* nz = img.add_channel("N.Z");
   float* mx = img.add_channel("motion.X");
   float* my = img.add_channel("motion.Y");
+  float* prev_depth = img.add_channel("prevDepth.Z");
   std::uint32_t* id = img.add_uint_channel("id");
   float* ar = img.add_channel("albedo.R");
   float* ag = img.add_channel("albedo.G");
@@ -530,13 +534,13 @@ Image Renderer::Impl::gbuffer_image(const Fbo& f, const View& v, const FrameInpu
   scatter(readback, w, h, 4, {{0, nx}, {1, ny}, {2, nz}});
   read_rgba(f, kWorld, 4);
   scatter(readback, w, h, 4, {{3, depth}});
-  read_rgba(f, kMotion, 2);
-  scatter(readback, w, h, 2, {{0, mx}, {1, my}});
+  read_rgba(f, kMotion, 4);
+  scatter(readback, w, h, 4, {{0, mx}, {1, my}, {2, prev_depth}});
   read_uint(f, kId);
   for (int y = 0; y < h; ++y)
     std::copy_n(readback_u.data() + std::size_t(h - 1 - y) * std::size_t(w), w, id + std::size_t(y) * std::size_t(w));
 
-  // Background: depth = clipFar and the camera-only motion of a point on the far plane.
+  // Background: depth = prevDepth = clipFar and the camera-only motion of a point on the far plane.
   const glm::mat4 inv_vp = glm::inverse(v.proj * v.view);
   const bool moving = in.previous != nullptr && v.prev_vp != v.proj * v.view;
   parallel_rows(h, [&](int y0, int y1) {
@@ -545,6 +549,7 @@ Image Renderer::Impl::gbuffer_image(const Fbo& f, const View& v, const FrameInpu
         const std::size_t i = std::size_t(y) * std::size_t(w) + std::size_t(x);
         if (id[i] != 0) continue;
         depth[i] = v.zfar;
+        prev_depth[i] = v.zfar;
         if (!moving) continue;
         const float px = float(x) + 0.5f, py = float(y) + 0.5f;
         const glm::vec4 ndc(2.0f * px / float(w) - 1.0f, 1.0f - 2.0f * py / float(h), 1.0f, 1.0f);

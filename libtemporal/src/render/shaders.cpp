@@ -14,12 +14,14 @@ uniform mat4 u_view_proj;  // this pass: projection (jittered) * view
 uniform mat4 u_cur_vp;     // unjittered current projection * view (motion)
 uniform mat4 u_prev_vp;    // unjittered previous projection * view (motion)
 uniform mat4 u_view;       // world -> camera (linear depth)
+uniform mat4 u_prev_view;  // previous world -> camera (the previous depth of the surface point, prevDepth.Z)
 out vec3 v_world;
 out vec3 v_normal;
 out vec2 v_uv;
 out vec4 v_cur;
 out vec4 v_prev;
 out float v_view_depth;
+out float v_prev_view_depth;
 void main() {
   vec4 world = u_model * vec4(a_position, 1.0);
   vec4 prev_world = u_prev_model * vec4(a_prev_position, 1.0);
@@ -34,6 +36,10 @@ void main() {
   bool same = u_prev_vp == u_cur_vp && u_prev_model == u_model && a_prev_position == a_position;
   v_prev = same ? v_cur : u_prev_vp * prev_world;
   v_view_depth = -(u_view * world).z;
+  // The depth this point had in the previous frame (seed 000 section 3.2's warped depth); exactly the current
+  // depth when neither the vertex nor the camera moved (the same trick as for motion).
+  bool same_depth = u_prev_view == u_view && u_prev_model == u_model && a_prev_position == a_position;
+  v_prev_view_depth = same_depth ? v_view_depth : -(u_prev_view * prev_world).z;
   gl_Position = u_view_proj * world;
 }
 )GLSL";
@@ -51,6 +57,7 @@ void main() {
   "in vec4 v_cur;\n"                                                    \
   "in vec4 v_prev;\n"                                                   \
   "in float v_view_depth;\n"                                            \
+  "in float v_prev_view_depth;\n"                                       \
   "vec4 base_color() {\n"                                               \
   "  vec4 c = u_base_color;\n"                                          \
   "  if (u_has_texture) c *= texture(u_texture, v_uv, u_lod_bias);\n"   \
@@ -65,7 +72,7 @@ void main() {
 const char* const kGbufferFragment = "#version 450 core\n" TEMPORAL_MATERIAL_GLSL R"GLSL(
 layout(location = 0) out vec4 o_albedo;  // rgb linear base colour, a metallic
 layout(location = 1) out vec4 o_normal;  // xyz world normal facing the camera, w roughness
-layout(location = 2) out vec2 o_motion;  // pixels, y down, p_prev = p + motion
+layout(location = 2) out vec4 o_motion;  // xy pixels, y down, p_prev = p + motion; z previous view depth
 layout(location = 3) out vec4 o_world;   // xyz world position, w linear view depth (> 0; 0 = background)
 layout(location = 4) out uint o_id;
 uniform vec2 u_size;
@@ -79,7 +86,7 @@ void main() {
   o_albedo = vec4(base.rgb, u_metallic);
   o_normal = vec4(facing_normal(), u_roughness);
   // NDC -> pixels: x * width / 2 to the right, y * height / 2 up, so image y (down) flips the sign.
-  o_motion = vec2((prev.x - cur.x) * 0.5 * u_size.x, (cur.y - prev.y) * 0.5 * u_size.y);
+  o_motion = vec4((prev.x - cur.x) * 0.5 * u_size.x, (cur.y - prev.y) * 0.5 * u_size.y, v_prev_view_depth, 0.0);
   o_world = vec4(v_world, v_view_depth);
   o_id = u_id;
 }
