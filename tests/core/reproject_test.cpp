@@ -131,3 +131,39 @@ TEST(Reproject, WarpPlanesIsNaNWhereTheFetchMisses) {
   rp::warp_planes(still, prev, o);
   for (int i = 0; i < 24; ++i) EXPECT_EQ(out[i], p.value[i]);
 }
+
+// Seed 000 section 3.2's warped depth: z_exp is the depth the current pixel's surface point had in the previous
+// frame (G-buffer prevDepth.Z), compared at kWarpedDepthTolerance. A surface approaching the camera by 10 % per
+// frame keeps its history with it and loses it with the current depth; a real disocclusion is a miss either way.
+TEST(Reproject, WarpedDepthKeepsAnApproachingSurfaceAndStillFindsDisocclusions) {
+  // Previous frame: 6x4, depth 10 on the left half (id 1, the approaching surface), 20 on the right (id 2).
+  Prev p;
+  // Current frame, no motion in the image: the left half is now at depth 9 (10 % nearer; it was at 10), the right
+  // half shows the background at 50 (the far surface of the previous frame moved away: uncovered, id 2 kept so
+  // that only depth decides). Warped depth: 10 on the left (where it was), 50 on the right (the background did
+  // not move).
+  std::vector<float> mx(24, 0.0f), my(24, 0.0f), z(24), zw(24);
+  std::vector<std::uint32_t> id(24);
+  for (int x = 0; x < 6; ++x)
+    for (int y = 0; y < 4; ++y) {
+      const int i = y * 6 + x;
+      z[i] = x < 3 ? 9.0f : 50.0f;
+      zw[i] = x < 3 ? 10.0f : 50.0f;
+      id[i] = x < 3 ? 1u : 2u;
+    }
+  rp::HistoryRow h;
+  // Current depth at 5 %: |9 - 10| / 10 = 10 % -> the approaching surface is a miss; the background too.
+  rp::Frames cur{p.w, p.h, mx.data(), my.data(), z.data(), id.data(), p.z.data(), p.id.data(), {}};
+  rp::reproject_row(cur, 1, h);
+  for (int x = 0; x < 6; ++x) EXPECT_EQ(h.hit[x], 0.0f) << x;
+  // Warped depth at the tight tolerance: |10 - 10| = 0 -> hit (weight 1 on its own pixel); 50 vs 20 -> miss.
+  rp::Frames warped{p.w, p.h, mx.data(), my.data(), zw.data(), id.data(), p.z.data(), p.id.data(),
+                    {rp::kWarpedDepthTolerance, true}};
+  rp::reproject_row(warped, 1, h);
+  for (int x = 0; x < 3; ++x) EXPECT_EQ(h.hit[x], 1.0f) << x;
+  for (int x = 3; x < 6; ++x) EXPECT_EQ(h.hit[x], 0.0f) << x;
+  // The tight tolerance is relative: 10 vs 10 * (1 + tol) still passes, 10 * (1 + 2 tol) does not.
+  const rp::SurfaceTest t{rp::kWarpedDepthTolerance, true};
+  EXPECT_TRUE(rp::same_surface(10.0f, 1, 10.0f * (1.0f + 0.99f * rp::kWarpedDepthTolerance), 1, t));
+  EXPECT_FALSE(rp::same_surface(10.0f, 1, 10.0f * (1.0f + 2.0f * rp::kWarpedDepthTolerance), 1, t));
+}

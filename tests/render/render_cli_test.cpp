@@ -290,7 +290,7 @@ TEST(RenderCli, ShardedRenderEqualsOneRun) {
 
 // Issue 16: noise patterns (SSAO, VPL sets, random jitter) are keyed by the instant, so a 40 Hz frame n and a
 // 120 Hz frame 3n are the same render: every payload, the reference and the colour, and the G-buffer's geometry
-// (its motion differs: it points to the previous frame of each rate).
+// (its motion and prevDepth differ: they describe the previous frame of each rate).
 TEST(RenderCli, FramesAtTheSameInstantRenderAlikeAtAnyRate) {
   const auto dir = test::scratch_dir("render_cli_instants");
   const auto scene = write_test_scene(dir).string();
@@ -306,7 +306,7 @@ TEST(RenderCli, FramesAtTheSameInstantRenderAlikeAtAnyRate) {
     for (const char* name : {"shade", "reference", "color"})
       EXPECT_TRUE(same_pixels(dir / "r40" / (std::string(name) + a), dir / "r120" / (std::string(name) + b))) << name << n;
     EXPECT_TRUE(same_pixels(dir / "r40" / (std::string("gbuffer") + a), dir / "r120" / (std::string("gbuffer") + b),
-                            {"motion.X", "motion.Y"}));
+                            {"motion.X", "motion.Y", "prevDepth.Z"}));
   }
 }
 

@@ -26,6 +26,7 @@ std::string dims(int w, int h) { return std::to_string(w) + "x" + std::to_string
 // The channels a layer name stands for in a G-buffer.
 std::vector<std::string> layer_channel_names(const std::string& layer) {
   if (layer == "depth") return {"depth.Z"};
+  if (layer == "prevDepth") return {"prevDepth.Z"};
   if (layer == "N") return {"N.X", "N.Y", "N.Z"};
   if (layer == "motion") return {"motion.X", "motion.Y"};
   if (layer == "albedo") return {"albedo.R", "albedo.G", "albedo.B"};
@@ -95,10 +96,26 @@ Expected<Plan> make_plan(const SequenceOptions& o, const StageInputs& needs) {
   return plan;
 }
 
-// The G-buffer layers to read (selection for read_exr).
-std::vector<std::string> gbuffer_selection(const StageInputs& needs) {
+// The G-buffer layers to read (selection for read_exr): the required ones, and each optional one that the first
+// G-buffer file has (e.g. prevDepth: read when present, absent otherwise; a sequence has the same layers throughout).
+std::vector<std::string> gbuffer_selection(const StageInputs& needs, const std::string& first_gbuffer) {
+  std::optional<std::vector<std::string>> have;
   std::vector<std::string> layers;
-  for (const auto& n : needs.gbuffer_layers) layers.push_back(n.layer);
+  for (const auto& n : needs.gbuffer_layers) {
+    if (!n.required) {
+      if (!have) {
+        auto info = read_exr_info(first_gbuffer);
+        have = info ? info->channels : std::vector<std::string>{};
+      }
+      auto channels = layer_channel_names(n.layer);
+      bool present = false;
+      for (const auto& c : *have)
+        present = present || (channels.empty() ? c.rfind(n.layer + ".", 0) == 0
+                                               : std::find(channels.begin(), channels.end(), c) != channels.end());
+      if (!present) continue;
+    }
+    layers.push_back(n.layer);
+  }
   return layers;
 }
 
@@ -268,7 +285,8 @@ Expected<RunSummary> run_sequence(const SequenceOptions& options, FrameStage& st
   RunSummary summary;
   InputWindow window(*plan, needs);
   int width = 0, height = 0;
-  const std::vector<std::string> gsel = gbuffer_selection(needs);
+  const std::vector<std::string> gsel =
+      plan->gbuffer ? gbuffer_selection(needs, plan->gbuffer->path(plan->frames.front())) : std::vector<std::string>{};
   std::vector<StageOutput> outputs;
   int prev = -1;
   const std::size_t n = plan->frames.size();

@@ -174,6 +174,7 @@ class Run {
     return !gbuf_pattern_ || std::filesystem::exists(gbuf_pattern_->path(f));
   }
   bool gbuf_geometry_ = false, have_prev_geometry_ = false;  // G-buffer depth and ids for the disocclusion test
+  bool gbuf_warped_ = false;  // and prevDepth.Z, the expected previous depth (temporal/core/reproject.h)
   std::vector<float> prev_z_;
   std::vector<std::uint32_t> prev_id_;
   ExrSelection ref_sel_, gbuf_sel_;
@@ -253,6 +254,9 @@ Status Run::open() {
     const auto& c = info->channels;
     gbuf_geometry_ = std::find(c.begin(), c.end(), "depth.Z") != c.end() && std::find(c.begin(), c.end(), "id") != c.end();
     if (gbuf_geometry_) gbuf_sel_.layers.insert(gbuf_sel_.layers.end(), {"depth", "id"});
+    // The warped depth (seed 000 section 3.2), when the G-buffer has it: the disocclusion test compares it.
+    gbuf_warped_ = gbuf_geometry_ && std::find(c.begin(), c.end(), "prevDepth.Z") != c.end();
+    if (gbuf_warped_) gbuf_sel_.layers.push_back("prevDepth");
     report_.disocclusion_tested = gbuf_geometry_;
   }
   if (gbuf_mask_) gbuf_sel_.layers.push_back(setup_.mask);
@@ -401,7 +405,9 @@ Status Run::reference_frame(std::size_t fi, int frame) {
     fr.motion_x = gbuf_ ? gbuf_->plane("motion.X") : nullptr;
     fr.motion_y = gbuf_ ? gbuf_->plane("motion.Y") : nullptr;
     if (gbuf_geometry_ && have_prev_geometry_) {
-      fr.z = gbuf_->plane("depth.Z");
+      const float* warped = gbuf_warped_ ? gbuf_->plane("prevDepth.Z") : nullptr;
+      fr.z = warped ? warped : gbuf_->plane("depth.Z");
+      if (warped) fr.test.depth_tolerance = reproject::kWarpedDepthTolerance;
       fr.id = gbuf_->uint_plane("id");
       fr.prev_z = prev_z_.data();
       fr.prev_id = prev_id_.data();

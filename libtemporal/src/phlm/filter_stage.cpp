@@ -74,6 +74,7 @@ class FilterStage final : public FrameStage {
       in.motion_y = f.gbuffer->plane("motion.Y");
       in.depth = f.gbuffer->plane("depth.Z");
       in.id = f.gbuffer->uint_plane("id");
+      in.prev_depth = f.gbuffer->plane("prevDepth.Z");  // read only by the methods that list it (ema)
     }
     const auto t0 = std::chrono::steady_clock::now();
     stats_ = {};

@@ -49,6 +49,9 @@ ParamList ema_params(FilterOptions& o) {
       Param::positive("--ema-depth-tolerance",
                       "ema: relative depth difference of the disocclusion test (temporal/core/reproject.h)",
                       &o.ema.depth_tolerance),
+      Param::positive("--ema-warped-depth-tolerance",
+                      "ema: the same when the G-buffer has prevDepth.Z (the warped depth, temporal/core/reproject.h)",
+                      &o.ema.warped_depth_tolerance),
   };
 }
 ParamList fxaa_params(FilterOptions& o) {
@@ -78,7 +81,7 @@ const std::vector<FilterMethod>& filter_methods() {
        "(Salvi 2016)",
        {kMotion, {"depth", false}}, taa_params,
        [](const FilterOptions& o) { return make<TaaFilter>(o.taa); }},
-      {"ema", "weak reference: the exponential history of seed 003 eq. 1, disocclusion by depth and id", {kMotion, {"depth"}, {"id"}},
+      {"ema", "weak reference: the exponential history of seed 003 eq. 1, disocclusion by depth and id", {kMotion, {"depth"}, {"id"}, {"prevDepth", false}},
        ema_params, [](const FilterOptions& o) { return make<EmaFilter>(o.ema); }},
       {"fxaa", "weak reference: FXAA 3.11 (Lottes 2011), spatial only", {}, fxaa_params,
        [](const FilterOptions& o) { return make<FxaaFilter>(o.fxaa); }},

@@ -78,7 +78,7 @@ struct DrobotState : MethodState {
   std::vector<float> cb_conf, cb_hit, cb_w, cb_strength, cb_avail, cb_avail_h;
   // cache grid: one sample per k x k block at its centre: geometry, id, and motion in cache texels.
   TapTable cache_cols, cache_rows;
-  std::vector<float> cz, cnx, cny, cnz, cmx, cmy, cache_table;
+  std::vector<float> cz, czw, cnx, cny, cnz, cmx, cmy, cache_table;  // czw: prevDepth.Z (empty without)
   std::vector<std::uint32_t> cid;
   // refresh mode: the previous depth (and ids), Listing 7.1's bilinear table.
   PreviousGeometry prev;
@@ -234,6 +234,7 @@ void build_cache_grid(DrobotState& s, const FrameContext& f) {
   }
   const std::size_t LN = std::size_t(lw) * lh;
   s.cz.resize(LN);
+  s.czw.resize(f.prev_z ? LN : 0);
   s.cnx.resize(LN);
   s.cny.resize(LN);
   s.cnz.resize(LN);
@@ -246,6 +247,7 @@ void build_cache_grid(DrobotState& s, const FrameContext& f) {
       const std::size_t j = std::size_t(y) * lw + x;
       const std::size_t i = std::size_t(std::min(f.H - 1, k * y + k / 2)) * f.W + std::min(f.W - 1, k * x + k / 2);
       s.cz[j] = f.z[i];
+      if (f.prev_z) s.czw[j] = f.prev_z[i];
       s.cnx[j] = f.nx[i];
       s.cny[j] = f.ny[i];
       s.cnz[j] = f.nz[i];
@@ -305,11 +307,12 @@ std::size_t accumulate_cache_row(DrobotState& s, const FrameContext& f, bool his
     fr.height = f.lh;
     fr.motion_x = s.cmx.data();
     fr.motion_y = s.cmy.data();
-    fr.z = s.cz.data();
+    const bool warped = !s.czw.empty();  // the warped depth of seed 000 section 3.2 when the G-buffer has it
+    fr.z = warped ? s.czw.data() : s.cz.data();
     fr.prev_z = s.hb_z[prv].data();
     fr.id = s.cid.empty() ? nullptr : s.cid.data();
     fr.prev_id = s.hb_id[prv].empty() ? nullptr : s.hb_id[prv].data();
-    fr.test = f.options->surface_test();
+    fr.test = f.options->surface_test(warped);
     reproject::reproject_row(fr, y, h);
     if (o.cache_point) {  // Figure 7.5's point filtering: the surviving tap with the largest weight
       for (int x = 0; x < lw; ++x) {

@@ -36,10 +36,12 @@ class MethodState {
 };
 
 // The G-buffer layers of a method that reprojects a history (temporal, herzog, drobot, taau): depth and N for the
-// samples' geometry, motion for the fetch, and the ids of the disocclusion test unless --no-ids.
+// samples' geometry, motion for the fetch, the ids of the disocclusion test unless --no-ids, and the warped depth
+// prevDepth.Z when the G-buffer has it (optional; not read with --no-depth-velocity).
 inline std::vector<LayerNeed> history_method_layers(const Options& o) {
   std::vector<LayerNeed> l = {{"depth"}, {"N"}, {"motion"}};
   if (!o.no_ids) l.push_back({"id", true, "or pass --no-ids"});
+  if (!o.no_depth_velocity) l.push_back({"prevDepth", false});
   return l;
 }
 

@@ -110,6 +110,12 @@ ParamList params(Options& o) {
       Param::real("--depth-tolerance",
                   "Relative depth difference above which a history tap is disoccluded (temporal/core/reproject.h)",
                   &o.depth_tolerance, 0.0, 10.0),
+      Param::real("--warped-depth-tolerance",
+                  "Relative depth tolerance when the G-buffer has prevDepth.Z (the warped depth of seed 000 section 3.2)",
+                  &o.warped_depth_tolerance, 0.0, 10.0),
+      Param::flag_on("--no-depth-velocity",
+                     "Ignore the G-buffer's prevDepth.Z: compare the current depth at --depth-tolerance (ablation)",
+                     &o.no_depth_velocity),
       Param::flag_on("--no-ids", "Disocclusion test on depth only (no material-id comparison, seed 000 Figure 3)",
                      &o.no_ids),
   };

@@ -62,6 +62,7 @@ struct FrameContext {
   std::vector<const float*> low;  // C low-resolution planes
   const float *z = nullptr, *nx = nullptr, *ny = nullptr, *nz = nullptr, *mx = nullptr, *my = nullptr;
   const std::uint32_t* id = nullptr;
+  const float* prev_z = nullptr;  // prevDepth.Z, the warped depth (seed 000 3.2); null: absent or --no-depth-velocity
   float sigma_d = 1.0f;      // world units
   float depth_range = 1.0f;  // far - near (world units), for the Listing 7.1 depth weight
   std::vector<float> luma;   // C weights of the gradient's scalar "norm" (Rec.709 luminance for R,G,B)
@@ -84,7 +85,8 @@ struct PreviousGeometry {
 };
 
 // The history taps of full-resolution row Y (temporal/core/reproject.h): the previous frame's depth and ids, this
-// frame's G-buffer, the disocclusion settings of the options.
+// frame's G-buffer, the disocclusion settings of the options. The expected previous depth is the warped depth
+// prevDepth.Z when the frame has it (seed 000 section 3.2), else the current depth.
 using reproject::HistoryRow;
 inline void history_row(const FrameContext& f, const PreviousGeometry& prev, int Y, HistoryRow& h) {
   reproject::Frames fr;
@@ -92,11 +94,11 @@ inline void history_row(const FrameContext& f, const PreviousGeometry& prev, int
   fr.height = f.H;
   fr.motion_x = f.mx;
   fr.motion_y = f.my;
-  fr.z = f.z;
+  fr.z = f.prev_z ? f.prev_z : f.z;
   fr.prev_z = prev.z.data();
   fr.id = f.id;
   fr.prev_id = prev.id.empty() ? nullptr : prev.id.data();
-  fr.test = f.options->surface_test();
+  fr.test = f.options->surface_test(f.prev_z != nullptr);
   reproject::reproject_row(fr, Y, h);
 }
 

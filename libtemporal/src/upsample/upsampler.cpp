@@ -160,6 +160,7 @@ void Upsampler::Impl::build_context(const Image& gbuffer, const Image& low, std:
   f.mx = gbuffer.plane("motion.X");
   f.my = gbuffer.plane("motion.Y");
   f.id = gbuffer.uint_plane("id");
+  f.prev_z = o.no_depth_velocity ? nullptr : gbuffer.plane("prevDepth.Z");
   // Scalar "norm" of the payload for the temporal gradient (seed 000 3.5.1): luminance of R,G,B triples.
   f.luma.assign(f.C, 0.0f);
   float total = 0;

@@ -126,6 +126,15 @@ inline CatmullRom catmull_rom(float fx, float fy, int width, int height) {
 // bilinear taps differ in depth by the slope) while rejecting any foreground/background pair of the built-in
 // scenes (docs/conventions.md, "Reprojection").
 inline constexpr float kDepthTolerance = 0.05f;
+// Relative tolerance when z_exp is the warped depth (G-buffer layer prevDepth.Z: the depth the current surface
+// point had in the previous frame, seed 000 section 3.2). Motion along the view axis no longer enters, so the
+// tolerance only has to cover the surface's own depth change between the fetch position and its bilinear taps
+// (up to one pixel away in x and y: the slope of the previous depth over one pixel) and float rounding. For a plane
+// at angle theta from the view direction the relative change per pixel is about tan(theta) x (the pixel's angle),
+// so a relative tolerance keeps taps up to some theta; measured on walkers, tower and fan at 320x256
+// (docs/upsample-st.md, "Warped depth (issue 15 item 5)"): 0.5 % and 1 % drop the taps of the tower's sloped
+// walls under its moving camera (-0.4 / -0.1 dB), 2 % is level there and still gains on walkers (+0.06 / +0.22 dB).
+inline constexpr float kWarpedDepthTolerance = 0.02f;
 // A fetch whose surviving bilinear weight is below this is a miss (numerically: no tap passed).
 inline constexpr float kMinHitWeight = 1e-3f;
 
@@ -175,7 +184,8 @@ struct Frames {
   int width = 0, height = 0;
   const float* motion_x = nullptr;
   const float* motion_y = nullptr;
-  const float* z = nullptr;                // expected previous depth of the current pixels (the current depth)
+  const float* z = nullptr;                // expected previous depth of the current pixels: the current depth, or
+                                           // the warped depth (prevDepth.Z) with kWarpedDepthTolerance
   const std::uint32_t* id = nullptr;       // current material ids
   const float* prev_z = nullptr;           // previous frame's depth
   const std::uint32_t* prev_id = nullptr;  // previous frame's material ids

@@ -21,6 +21,8 @@ namespace temporal {
 struct EmaParams {
   float alpha = 0.5f;            // history weight of eq. 1, chosen on the tuning set (docs/filter-phlm.md)
   float depth_tolerance = reproject::kDepthTolerance;  // relative depth difference of the disocclusion test
+  // The same with the warped depth (FilterInput::prev_depth), which does not change with motion along the view axis.
+  float warped_depth_tolerance = reproject::kWarpedDepthTolerance;
 };
 
 class EmaFilter final : public FrameFilter {

@@ -25,6 +25,9 @@ struct FilterInput {
   // G-buffer data for the history rejection of `ema` (null: no rejection). Depth: linear view depth.
   const float* depth = nullptr;
   const std::uint32_t* id = nullptr;
+  // prevDepth.Z: the depth each pixel's surface point had in the previous frame (null: absent). `ema` compares
+  // it, instead of `depth`, with the previous depth (seed 000 section 3.2's warped depth).
+  const float* prev_depth = nullptr;
   // `temporal:jitter` of this frame, pixels in [-0.5, 0.5): the sample of pixel (x, y) was taken at
   // (x + 0.5 + jx, y + 0.5 + jy). Used by `taa` to reconstruct pixel centres.
   glm::vec2 jitter{0.0f, 0.0f};

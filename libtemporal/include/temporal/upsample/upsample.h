@@ -82,6 +82,11 @@ struct Options {
   // --- the history fetch (temporal/core/reproject.h: the disocclusion test every history method uses) ---
   float depth_tolerance = reproject::kDepthTolerance;  // relative depth difference of a disoccluded tap
   bool no_ids = false;                                 // depth only: do not compare material ids (Figure 3)
+  // Seed 000 section 3.2 compares the warped depth: with a G-buffer layer prevDepth.Z (the depth each pixel's
+  // surface point had in the previous frame) the test compares it, at warped_depth_tolerance, instead of the
+  // current depth at depth_tolerance. no_depth_velocity ignores the layer (ablation).
+  float warped_depth_tolerance = reproject::kWarpedDepthTolerance;
+  bool no_depth_velocity = false;
 
   // --- seed 000 section 4 ---
   int aa_factor = 1;  // m: G-buffer is m x m the output; the result is box-downsampled
@@ -96,8 +101,10 @@ struct Options {
 
   MethodOptionSet per_method;  // each method's own parameters
 
-  // The disocclusion test of the history fetch.
-  reproject::SurfaceTest surface_test() const { return {depth_tolerance, !no_ids}; }
+  // The disocclusion test of the history fetch; `warped`: its expected depth is prevDepth.Z.
+  reproject::SurfaceTest surface_test(bool warped = false) const {
+    return {warped ? warped_depth_tolerance : depth_tolerance, !no_ids};
+  }
 };
 
 // Every parameter of the stage, pointing at the fields of `options`: the shared ones, then each method's (help
