@@ -17,13 +17,14 @@
 # Usage: pipelines/upsample-st-ablation.sh [BUILD_DIR=build/release] [OUT_DIR=report/upsample-st-ablation]
 #        [SCENE.glb ...]
 # Environment: upsample-st.sh's SIZE, FRAMES, FPS, FACTOR, RENDER_ARGS, NOISE_AVERAGED_SPP, RENDERS, REUSE_RENDER;
-#   EXTRA_VARIANTS (more lines "NAME herzog OPTIONS").
+#   METHODS (default "spatial temporal herzog"; add e.g. drobot taau for the full table), EXTRA_VARIANTS (more
+#   lines "NAME herzog OPTIONS").
 set -euo pipefail
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 BUILD="${1:-build/release}"
 OUT="${2:-report/upsample-st-ablation}"
 shift $(( $# > 2 ? 2 : $# ))
-export METHODS="spatial temporal herzog"
+export METHODS="${METHODS:-spatial temporal herzog}"
 export VARIANTS="herzog-fixed-wf-1 herzog --fixed-wf 1
 herzog-fixed-wf-0.5 herzog --fixed-wf 0.5
 herzog-no-temporal herzog --gradient-filter none
