@@ -17,8 +17,10 @@
 #   BUILD_DIR  default build/release;  OUT_DIR  default report/morph-120hz
 #   SCENE      default: every assets/scenes/*.glb
 # Environment: SIZE (default 256x256), FRAMES (rendered 40 Hz frames, default 8), METHODS (default: every
-#   method of the registry, `morph-120hz --list-methods`), FFMPEG=0 to skip minterpolate, REPEAT (timed runs of
-#   each command, default 3; the median is reported).
+#   method of the registry, `morph-120hz --list-methods`), VARIANTS (more runs, one per line "NAME METHOD
+#   morph-120hz options", e.g. "didyk-nosnap didyk --no-snap"; pipelines/morph-120hz-ablation.sh sets didyk's
+#   ablations), FFMPEG=0 to skip minterpolate, REPEAT (timed runs of each command, default 3; the median is
+#   reported).
 set -euo pipefail
 
 ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
@@ -44,6 +46,10 @@ done
 if (( FRAMES < 2 )); then echo "morph-120hz.sh: FRAMES must be at least 2" >&2; exit 1; fi
 # The methods come from the tool's registry (one name and a tab-separated summary per line).
 METHODS=${METHODS:-$("$MORPH" --list-methods | cut -f1 | tr '\n' ' ')}
+# Every run: "NAME METHOD OPTIONS" (the METHODS as they are, then the VARIANTS lines).
+RUNS=()
+for m in $METHODS; do RUNS+=("$m $m"); done
+while read -r line; do [[ -n "$line" ]] && RUNS+=("$line"); done <<< "${VARIANTS:-}"
 
 if (( $# > 0 )); then SCENES=("$@"); else SCENES=("$ROOT"/assets/scenes/*.glb); fi
 if [[ ! -e "${SCENES[0]}" ]]; then
@@ -168,10 +174,12 @@ for scene in "${SCENES[@]}"; do
   names=()
   tests=()
   declare -A command_ms=() compute_ms=()
-  for m in $METHODS; do
-    echo "== $name: morph-120hz --method $m ($REPEAT timed runs)" >&2
+  for run in "${RUNS[@]}"; do
+    read -r m method args <<< "$run"
+    echo "== $name: $m = morph-120hz --method $method $args ($REPEAT timed runs)" >&2
+    # shellcheck disable=SC2086
     wall=$(median_ms "$MORPH" --input "$D/ldr40/color.####.exr" --gbuffer "$D/r40/gbuffer.####.exr" \
-      --out "$D/$m/color.####.exr" --method "$m" --factor $FACTOR --fps 40)
+      --out "$D/$m/color.####.exr" --method "$method" $args --factor $FACTOR --fps 40)
     command_ms[$m]=$(awk -v w="$wall" -v n=$((FACTOR * FRAMES)) 'BEGIN { printf "%.2f", w / n }')
     names+=("$m")
     tests+=("$D/$m/color.####.exr")
@@ -250,9 +258,10 @@ for scene in "${SCENES[@]}"; do
     inb_lat=$(json_interval "$D/inbetween.json" "$m" psnr_latency)
     all=$(json_interval "$D/compare.json" "$m" psnr_rgb | cut -d, -f1)  # "inf" when a frame is identical
     latency=$(csv_mean "$D/compare.csv" "$m" latency_frames "1")
-    per=$(csv_mean "$D/perceived.csv" "$m" psnr_rgb_db "1")
-    per_lat=$(csv_mean "$D/perceived.csv" "$m" psnr_latency_db "1")
-    blur=$(csv_mean "$D/perceived-blur.csv" "$m" psnr_rgb_db "1")
+    # compare's means: a frame of infinite PSNR (an identical image) makes the mean "inf" - shown, never dropped.
+    per=$(json_interval "$D/perceived.json" "$m" psnr_rgb | cut -d, -f1)
+    per_lat=$(json_interval "$D/perceived.json" "$m" psnr_latency | cut -d, -f1)
+    blur=$(json_interval "$D/perceived-blur.json" "$m" psnr_rgb | cut -d, -f1)
     # Mean lag over the compared frames, from the perceived images' headers (temporal:lagMs).
     lag=$(for ((n = FIRSTCMP; n <= LASTCMP; ++n)); do printf -v f "%04d" "$n"; header_value "$D/perceived/$m/p.$f.exr" lagMs; done |
       awk '{ s += $1; n++ } END { if (n) printf "%.2f", s / n; else printf "nan" }')

@@ -9,6 +9,8 @@ means, 95% intervals and paired differences are compare's, docs/compare.md).
       per scene: mean PSNR (RGB) over frames with its 95% interval and the steady-state mean (after compare's
       --warmup frames), mean flicker; the mean over the scenes; then the paired differences A - B (PSNR, and
       flicker) with their 95% intervals for each PAIR "A:B" (names as given to compare --names)
+  phlm_tables.py scenes-by-row OUT_DIR ...
+      the same, with the paired differences one row per pair and one column per scene, PSNR only (ablations)
 Fields compare does not write (an older compare without intervals) are shown as "n/a".
 """
 import csv
@@ -87,7 +89,7 @@ def cell(mean, ci, digits=2, sign=False):
     return s
 
 
-def scenes(out_dir, scene_list, seq_list, pair_list):
+def scenes(out_dir, scene_list, seq_list, pair_list, by_row=False):
     data = {s: load(out_dir, s) for s in scene_list}
     out = ["| scene | " + " | ".join(seq_list) + " |", "|---|" + "---|" * len(seq_list)]
     sums = defaultdict(list)
@@ -118,6 +120,9 @@ def scenes(out_dir, scene_list, seq_list, pair_list):
     out.append("| mean of the scenes | " + " | ".join(means) + " |")
     print("\n".join(out))
     if not pair_list:
+        return
+    if by_row:
+        pairs_by_row(data, scene_list, pair_list)
         return
     for part, title in (("all", "all frames"), ("steady", "steady state (after compare's --warmup frames)")):
         print()
@@ -152,6 +157,34 @@ def scenes(out_dir, scene_list, seq_list, pair_list):
             print(f"| {s} | " + " | ".join(cells) + " |")
 
 
+def paired_value(paired, key, a, b, part):
+    """(mean of a - b, sorted 95% interval or None) from compare's `paired`, over all frames or the steady state."""
+    for p in paired or []:
+        if p.get("metric") == key and {p.get("a"), p.get("b")} == {a, b}:
+            sign = 1.0 if p["a"] == a else -1.0
+            hit = p.get("steady") if part == "steady" else p
+            if hit is None or hit.get("mean_difference") is None:
+                return None, None
+            ci = hit.get("ci95")
+            return sign * float(hit["mean_difference"]), (sorted([sign * float(ci[0]), sign * float(ci[1])]) if ci else None)
+    return None, None
+
+
+def pairs_by_row(data, scene_list, pair_list):
+    """Many pairs (an ablation): one row per pair, one column per scene, PSNR only."""
+    for part, title in (("all", "all frames"), ("steady", "steady state (after compare's --warmup frames)")):
+        print()
+        print(f"Paired differences A - B of PSNR (RGB, dB), {title}: mean over frames [95% interval] (compare's `paired`):\n")
+        print("| A - B | " + " | ".join(scene_list) + " |")
+        print("|---|" + "---|" * len(scene_list))
+        for a, b in pair_list:
+            cells = []
+            for s in scene_list:
+                d, ci = paired_value(data[s].get("paired"), "psnr_rgb", a, b, part)
+                cells.append(cell(d, ci, 2, sign=True) if d is not None else "n/a")
+            print(f"| {a} - {b} | " + " | ".join(cells) + " |")
+
+
 def _orient(paired, key, a, b):
     """True when compare's entry for {a, b} and `key` is a - b (not b - a)."""
     for p in paired:
@@ -163,9 +196,9 @@ def _orient(paired, key, a, b):
 def main():
     if len(sys.argv) >= 3 and sys.argv[1] == "tuning":
         tuning(sys.argv[2])
-    elif len(sys.argv) >= 5 and sys.argv[1] == "scenes":
+    elif len(sys.argv) >= 5 and sys.argv[1] in ("scenes", "scenes-by-row"):
         pairs = [tuple(p.split(":", 1)) for p in sys.argv[5].split(",")] if len(sys.argv) > 5 and sys.argv[5] else []
-        scenes(sys.argv[2], sys.argv[3].split(","), sys.argv[4].split(","), pairs)
+        scenes(sys.argv[2], sys.argv[3].split(","), sys.argv[4].split(","), pairs, sys.argv[1] == "scenes-by-row")
     else:
         sys.stderr.write(__doc__)
         sys.exit(1)

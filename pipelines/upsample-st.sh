@@ -18,7 +18,16 @@
 #   lighting upsampled, albedo from the G-buffer; seed 000 section 4)), REFERENCE_SPP (default 0: none; N > 0 also
 #   renders an N-spp supersampled reference and
 #   adds a PSNR column against it), RENDER_ARGS (extra render-gbuffer options; default "--payload
-#   direct,shadow,ssao,gi", Table 1's "Horses (AO+GI)"), UPSAMPLE_ARGS (extra upsample-st options for every method).
+#   direct,shadow,ssao,gi", Table 1's "Horses (AO+GI)"), UPSAMPLE_ARGS (extra upsample-st options for every method),
+#   VARIANTS (more runs, one per line "NAME METHOD upsample-st options", e.g. "herzog-cap8 herzog --kernel-gamma 8
+#   --max-kernel-gamma 8"; a NAME ending in -raster runs on the payload rendered with the raster pattern order,
+#   --shade-jitter regular-raster, which is then rendered too), PAIRS (paired differences "A:B,..." printed with
+#   their 95 % intervals; default herzog against spatial, temporal and taau), WARMUP (frames compare reports apart
+#   as the warm-up, default FACTOR^2: the pattern's length), NOISE_AVERAGED_SPP (default 0; N > 0 also renders the
+#   noise-averaged reference - N samples at every pixel centre, each with its own SSAO pattern and VPL set,
+#   render-gbuffer --reference-jitter none - and scores every method against it too: the target of methods that
+#   accumulate, issue 15 item 6), RENDERS (folder holding SCENE/render, default OUT_DIR), REUSE_RENDER=1 (keep an
+#   existing render folder).
 #
 # Ground truth: the issue and the paper's Figure 8 measure against full-resolution rendering of the same payload
 # (render-gbuffer's `color` with `--jitter none`: one sample at every pixel centre, the samples the regular
@@ -42,6 +51,16 @@ METHODS="${METHODS:-spatial temporal herzog herzog-favor-spatial drobot taau spa
 REFERENCE_SPP="${REFERENCE_SPP:-0}"
 RENDER_ARGS="${RENDER_ARGS:---payload direct,shadow,ssao,gi}"
 UPSAMPLE_ARGS="${UPSAMPLE_ARGS:-}"
+VARIANTS="${VARIANTS:-}"
+PAIRS="${PAIRS:-herzog:spatial,herzog:temporal,herzog:taau}"
+WARMUP="${WARMUP:-$(( FACTOR * FACTOR ))}"
+NOISE_AVERAGED_SPP="${NOISE_AVERAGED_SPP:-0}"
+RENDERS="${RENDERS:-}"
+REUSE_RENDER="${REUSE_RENDER:-0}"
+if [[ "$REFERENCE_SPP" -gt 0 && "$NOISE_AVERAGED_SPP" -gt 0 ]]; then
+  echo "upsample-st.sh: REFERENCE_SPP and NOISE_AVERAGED_SPP both need render-gbuffer's reference output: set one" >&2
+  exit 1
+fi
 
 case "$BUILD" in /*) ;; *) BUILD="$PWD/$BUILD" ;; esac
 render="$BUILD/apps/render-gbuffer/render-gbuffer"
@@ -78,6 +97,16 @@ method_args() {
   done
 }
 for m in $METHODS; do method_args "$m" > /dev/null || exit 2; done
+# Every run: "NAME ARGUMENTS" (METHODS through the method table, then the VARIANTS lines as given).
+runs=()
+for m in $METHODS; do runs+=("$m $(method_args "$m")"); done
+raster=0
+while read -r n m args; do
+  [[ -z "$n" ]] && continue
+  runs+=("$n --method $m $args")
+  [[ "$n" == *-raster ]] && raster=1
+done <<< "$VARIANTS"
+IFS=, read -r -a pairs <<< "$PAIRS"
 
 scenes=("$@")
 if [[ ${#scenes[@]} -eq 0 ]]; then
@@ -112,40 +141,71 @@ summary="$OUT/summary.md"
 } > "$summary"
 
 outputs="gbuffer,shade,color"
-[[ "$REFERENCE_SPP" -gt 0 ]] && outputs+=",reference"
+reference_args=(--reference-spp 1)
+if [[ "$REFERENCE_SPP" -gt 0 ]]; then
+  outputs+=",reference"
+  reference_args=(--reference-spp "$REFERENCE_SPP")
+elif [[ "$NOISE_AVERAGED_SPP" -gt 0 ]]; then
+  outputs+=",reference"
+  reference_args=(--reference-spp "$NOISE_AVERAGED_SPP" --reference-jitter none)
+fi
+scene_names=""
+seq_names=""
+for run in "${runs[@]}"; do read -r n _ <<< "$run"; seq_names+="${seq_names:+,}$n"; done
 for scene in "${scenes[@]}"; do
   name="$(basename "${scene%.*}")"
+  scene_names+="${scene_names:+,}$name"
   dir="$OUT/$name"
+  render_dir="${RENDERS:-$OUT}/$name/render"
   mkdir -p "$dir"
-  echo "== $name: rendering ($SIZE, factor $FACTOR, frames $FRAMES)" >&2
-  # shellcheck disable=SC2086
-  "$render" "$scene" --out "$dir/render" --size "$SIZE" --fps "$FPS" --frames "$FRAMES" --factor "$FACTOR" \
-    --outputs "$outputs" --jitter none --reference-spp "$(( REFERENCE_SPP > 0 ? REFERENCE_SPP : 1 ))" $RENDER_ARGS
-
-  tests=()
-  names=""
-  for m in $METHODS; do
-    args="$(method_args "$m")"
-    echo "== $name: upsample-st $args" >&2
+  if [[ "$REUSE_RENDER" == 1 && -d "$render_dir" ]]; then
+    echo "== $name: reusing $render_dir" >&2
+  else
+    echo "== $name: rendering ($SIZE, factor $FACTOR, frames $FRAMES)" >&2
     # shellcheck disable=SC2086
-    "$upsample" --gbuffer "$dir/render/gbuffer.####.exr" --input "$dir/render/shade.####.exr" \
-      --out "$dir/$m/up-$m.####.exr" $args $UPSAMPLE_ARGS
-    tests+=("$dir/$m/up-$m.####.exr")
-    names+="${names:+,}$m"
-  done
-
-  echo "== $name: compare against the full-resolution payload" >&2
-  "$compare" --reference "$dir/render/color.####.exr" "${tests[@]}" --names "$names" \
-    --gbuffer "$dir/render/gbuffer.####.exr" --csv "$dir/metrics.csv" --json "$dir/metrics.json" \
-    --plot "$dir/psnr.png" | tee "$dir/compare.txt"
-  if [[ "$REFERENCE_SPP" -gt 0 ]]; then
-    echo "== $name: compare against the $REFERENCE_SPP-spp reference" >&2
-    "$compare" --reference "$dir/render/reference.####.exr" "${tests[@]}" --names "$names" \
-      --csv "$dir/metrics-supersampled.csv" | tee "$dir/compare-supersampled.txt"
+    "$render" "$scene" --out "$render_dir" --size "$SIZE" --fps "$FPS" --frames "$FRAMES" --factor "$FACTOR" \
+      --outputs "$outputs" --jitter none "${reference_args[@]}" $RENDER_ARGS
+  fi
+  if [[ "$raster" == 1 && ! ( "$REUSE_RENDER" == 1 && -d "$render_dir-raster" ) ]]; then
+    echo "== $name: rendering the payload in the raster pattern order" >&2
+    # shellcheck disable=SC2086
+    "$render" "$scene" --out "$render_dir-raster" --size "$SIZE" --fps "$FPS" --frames "$FRAMES" --factor "$FACTOR" \
+      --outputs shade --shade-jitter regular-raster $RENDER_ARGS
   fi
 
-  shade_low="$(csv_mean "$dir/render/timings.csv" shadeLow)"
-  shade_full="$(csv_mean "$dir/render/timings.csv" shadeFull)"
+  tests=()
+  for run in "${runs[@]}"; do
+    read -r m args <<< "$run"
+    input="$render_dir/shade.####.exr"
+    [[ "$m" == *-raster ]] && input="$render_dir-raster/shade.####.exr"
+    echo "== $name: $m = upsample-st $args" >&2
+    # shellcheck disable=SC2086
+    "$upsample" --gbuffer "$render_dir/gbuffer.####.exr" --input "$input" \
+      --out "$dir/$m/up-$m.####.exr" $args $UPSAMPLE_ARGS
+    tests+=("$dir/$m/up-$m.####.exr")
+  done
+
+  # Means over frames with 95 % intervals, the warm-up (the first FACTOR^2 frames) apart, and every paired
+  # difference (compare's JSON, docs/compare.md "Intervals").
+  echo "== $name: compare against the full-resolution payload" >&2
+  "$compare" --reference "$render_dir/color.####.exr" "${tests[@]}" --names "$seq_names" \
+    --gbuffer "$render_dir/gbuffer.####.exr" --csv "$dir/metrics.csv" --json "$dir/metrics.json" \
+    --warmup "$WARMUP" --plot "$dir/psnr.png" | tee "$dir/compare.txt"
+  if [[ "$REFERENCE_SPP" -gt 0 ]]; then
+    echo "== $name: compare against the $REFERENCE_SPP-spp reference" >&2
+    "$compare" --reference "$render_dir/reference.####.exr" "${tests[@]}" --names "$seq_names" \
+      --csv "$dir/metrics-supersampled.csv" | tee "$dir/compare-supersampled.txt"
+  fi
+  if [[ "$NOISE_AVERAGED_SPP" -gt 0 ]]; then
+    echo "== $name: compare against the noise-averaged payload ($NOISE_AVERAGED_SPP samples at the pixel centres)" >&2
+    mkdir -p "$OUT/noise-averaged/$name"
+    "$compare" --reference "$render_dir/reference.####.exr" "${tests[@]}" --names "$seq_names" \
+      --csv "$OUT/noise-averaged/$name/metrics.csv" --json "$OUT/noise-averaged/$name/metrics.json" \
+      --warmup "$WARMUP" --plot "$OUT/noise-averaged/$name/psnr.png" | tee "$dir/compare-noise-averaged.txt"
+  fi
+
+  shade_low="$(csv_mean "$render_dir/timings.csv" shadeLow)"
+  shade_full="$(csv_mean "$render_dir/timings.csv" shadeFull)"
   {
     echo "## $name"
     echo
@@ -175,6 +235,27 @@ for scene in "${scenes[@]}"; do
     echo
   } >> "$summary"
 done
+
+pair_args=""
+for p in "${pairs[@]}"; do
+  a="${p%%:*}" b="${p#*:}"
+  [[ ",$seq_names," == *",$a,"* && ",$seq_names," == *",$b,"* ]] && pair_args+="${pair_args:+,}$p"
+done
+{
+  echo "## Mean PSNR (RGB, dB) [95% interval] (steady state: after the first $WARMUP frames) / mean flicker"
+  echo
+  echo "Against the full-resolution payload (that frame's SSAO pattern and VPL set):"
+  echo
+  python3 "$here/pipelines/phlm_tables.py" scenes-by-row "$OUT" "$scene_names" "$seq_names" "$pair_args"
+  echo
+  if [[ "$NOISE_AVERAGED_SPP" -gt 0 ]]; then
+    echo "Against the noise-averaged payload ($NOISE_AVERAGED_SPP samples at every pixel centre, each with its own SSAO"
+    echo "pattern and VPL set):"
+    echo
+    python3 "$here/pipelines/phlm_tables.py" scenes-by-row "$OUT/noise-averaged" "$scene_names" "$seq_names" "$pair_args"
+    echo
+  fi
+} >> "$summary"
 
 echo
 cat "$summary"

@@ -18,9 +18,9 @@ namespace {
 struct TextOptions {
   explicit TextOptions(const RenderOptions& r, const SceneLoadOptions& l, const ReplayOptions& p)
       : size(size_string(r)), payload(payload_terms_string(r.payload)), outputs(r.outputs.to_string()),
-        jitter(to_string(r.color_jitter)), shade_jitter(to_string(r.shade_jitter)), shade_mip_bias(shade_mip_bias_string(r)),
+        jitter(to_string(r.color_jitter)), shade_jitter(to_string(r.shade_jitter)), reference_jitter(to_string(r.reference_jitter)), shade_mip_bias(shade_mip_bias_string(r)),
         camera_path(camera_path_name(l.camera.path)), compression(compression_name(p.compression)), mipmaps_off(!r.mipmaps) {}
-  std::string scene, size, payload, outputs, jitter, shade_jitter, shade_mip_bias, camera_path, compression, frames;
+  std::string scene, size, payload, outputs, jitter, shade_jitter, reference_jitter, shade_mip_bias, camera_path, compression, frames;
   bool mipmaps_off;
 };
 
@@ -36,8 +36,11 @@ Status apply(const TextOptions& t, RenderOptions& r, SceneLoadOptions& l, Replay
   if (!color) return color.error();
   auto shade = parse_jitter_mode(t.shade_jitter);
   if (!shade) return shade.error();
+  auto reference = parse_jitter_mode(t.reference_jitter);
+  if (!reference) return reference.error();
   r.color_jitter = *color;
   r.shade_jitter = *shade;
+  r.reference_jitter = *reference;
   auto compression = parse_replay_compression(t.compression);
   if (!compression) return compression.error();
   p.compression = *compression;
@@ -99,9 +102,11 @@ int main(int argc, char** argv) {
   app.add_option("--camera-period", l.camera.path_period_s, "Seconds per orbit turn or dolly back-and-forth");
   app.add_option("--payload", t.payload, "Payload terms: any of direct,shadow,ssao,gi");
   app.add_option("--factor", r.factor, "Low-resolution factor k: shade is width/k x height/k");
-  app.add_option("--jitter", t.jitter, "Colour jitter: regular|halton|random|none");
-  app.add_option("--shade-jitter", t.shade_jitter, "Shade jitter: regular (k x k pattern)|halton|random|none");
+  app.add_option("--jitter", t.jitter, "Colour jitter: regular|regular-raster|halton|random|none");
+  app.add_option("--shade-jitter", t.shade_jitter, "Shade jitter: regular (k x k pattern, dispersed order)|regular-raster (raster order)|halton|random|none");
   app.add_option("--reference-spp", r.reference_spp, "Reference samples per pixel");
+  app.add_option("--reference-jitter", t.reference_jitter,
+                 "Reference sample positions: halton (supersampled) | none (pixel centres: the colour with its SSAO/VPL noise averaged)");
   app.add_option("--outputs", t.outputs, "Outputs: any of gbuffer,shade,reference,color");
   app.add_option("--pcf", pl.pcf_kernel, "Shadow PCF kernel N (N x N shadow-map texels)");
   app.add_option("--shadow-map-size", pl.shadow_map_size, "Shadow map texels per side");

@@ -12,6 +12,7 @@
 #include <functional>
 #include <limits>
 #include <optional>
+#include <vector>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -250,7 +251,8 @@ TEST(RenderJitter, RegularPatternCoversEveryFullResPixelOnce) {
     ASSERT_EQ(low.width(), o.width / k);
     ASSERT_EQ(low.metadata().jitter_index.value_or(-1), frame);
     const glm::vec2 j = *low.metadata().jitter;
-    const int sx = frame % k, sy = frame / k;
+    const glm::ivec2 sub = regular_subpixel(k, frame);  // the pattern's dispersed order (conventions "Jitter")
+    const int sx = sub.x, sy = sub.y;
     EXPECT_FLOAT_EQ(j.x, (sx + 0.5f) / k - 0.5f);
     EXPECT_FLOAT_EQ(j.y, (sy + 0.5f) / k - 0.5f);
     for (int y = 0; y < low.height(); ++y)
@@ -282,7 +284,8 @@ static double mean_sample_difference(std::optional<float> shade_mip_bias) {
   double sum = 0;
   std::size_t n = 0;
   const bool ok = render_pattern(scene, o, [&](int frame, const Image& low, const Image& full) {
-    const int sx = frame % k, sy = frame / k;
+    const glm::ivec2 sub = regular_subpixel(k, frame);  // the pattern's dispersed order (conventions "Jitter")
+    const int sx = sub.x, sy = sub.y;
     for (int y = 0; y < low.height(); ++y)
       for (int x = 0; x < low.width(); ++x)
         for (const char* c : {"R", "G", "B"}) {
@@ -306,9 +309,43 @@ TEST(RenderJitter, LowResolutionPayloadReadsTexturesAtTheFullResolutionMipLevel)
   EXPECT_GT(unbiased, 5.0 * biased) << "biased " << biased;
 }
 
+TEST(RenderJitter, DispersedOrderIsBayer) {
+  // The 4x4 Bayer matrix [[0 8 2 10] [12 4 14 6] [3 11 1 9] [15 7 13 5]] (rows y): index i is the cell holding i.
+  const int bayer4[4][4] = {{0, 8, 2, 10}, {12, 4, 14, 6}, {3, 11, 1, 9}, {15, 7, 13, 5}};
+  for (int y = 0; y < 4; ++y)
+    for (int x = 0; x < 4; ++x) EXPECT_EQ(regular_subpixel(4, bayer4[y][x]), glm::ivec2(x, y)) << x << "," << y;
+  // 2x2: (0,0) (1,1) (1,0) (0,1). k = 3, ranked on the top-left 3x3 of the 4x4 matrix (0 8 2 / 12 4 14 / 3 11 1):
+  EXPECT_EQ(regular_subpixel(2, 1), glm::ivec2(1, 1));
+  EXPECT_EQ(regular_subpixel(2, 3), glm::ivec2(0, 1));
+  const glm::ivec2 k3[9] = {{0, 0}, {2, 2}, {2, 0}, {0, 2}, {1, 1}, {1, 0}, {1, 2}, {0, 1}, {2, 1}};
+  for (int i = 0; i < 9; ++i) EXPECT_EQ(regular_subpixel(3, i), k3[i]) << i;
+  // Every k is a permutation of the k x k cells; each run of 4 frames of k = 4 has one sample per 2x2 quadrant.
+  for (int k = 1; k <= 8; ++k) {
+    std::vector<int> seen(std::size_t(k * k), 0);
+    for (int i = 0; i < k * k; ++i) {
+      const glm::ivec2 s = regular_subpixel(k, i);
+      ASSERT_TRUE(s.x >= 0 && s.x < k && s.y >= 0 && s.y < k) << k << " " << i;
+      ++seen[std::size_t(s.y * k + s.x)];
+      EXPECT_EQ(regular_subpixel(k, i, true), glm::ivec2(i % k, i / k));
+    }
+    for (int c : seen) EXPECT_EQ(c, 1) << "k = " << k;
+  }
+  for (int run = 0; run < 4; ++run) {
+    int quadrants = 0;
+    for (int i = 4 * run; i < 4 * run + 4; ++i) {
+      const glm::ivec2 s = regular_subpixel(4, i);
+      quadrants |= 1 << ((s.y / 2) * 2 + s.x / 2);
+    }
+    EXPECT_EQ(quadrants, 0xf) << "frames " << 4 * run << "-" << 4 * run + 3;
+  }
+  EXPECT_EQ(frame_jitter(JitterMode::RegularRaster, 7, 4, 0), glm::vec2(0.375f, -0.125f));
+  EXPECT_EQ(frame_jitter(JitterMode::Regular, 7, 4, 0), glm::vec2(-0.125f, 0.375f));
+}
+
 TEST(RenderJitter, PatternsAndProjection) {
   EXPECT_EQ(regular_jitter(4, 0), glm::vec2(-0.375f, -0.375f));
-  EXPECT_EQ(regular_jitter(4, 7), glm::vec2(0.375f, -0.125f));
+  EXPECT_EQ(regular_jitter(4, 7), glm::vec2(-0.125f, 0.375f));       // dispersed order: index 7 is (1, 3)
+  EXPECT_EQ(regular_jitter(4, 7, true), glm::vec2(0.375f, -0.125f));  // raster order: (3, 1)
   EXPECT_EQ(regular_jitter_index(17, 4), 1);
   EXPECT_EQ(regular_jitter_index(-1, 4), 15);
   EXPECT_FLOAT_EQ(radical_inverse(1, 2), 0.5f);

@@ -2,6 +2,7 @@
 // camera motion, NaN input, camera cuts, input errors. Tolerances are stated next to each assertion.
 #include "synthetic.h"
 
+#include "temporal/core/jitter.h"
 #include "temporal/upsample/methods.h"
 #include "temporal/upsample/upsample.h"
 
@@ -13,6 +14,7 @@
 #include <cstdio>
 #include <functional>
 #include <limits>
+#include <tuple>
 
 namespace up = temporal::upsample;
 using temporal::Image;
@@ -187,6 +189,54 @@ TEST(Upsample, HerzogFallbackIsSpatialUpsampling) {
   }
 }
 
+TEST(Upsample, HerzogAblationFixedWfZeroIsSpatial) {
+  // `--fixed-wf 0`: w_f = 0 everywhere, so the kernel is spatial's (gamma w_f = 0, the fallback) and eq. 7 gives
+  // the history no weight: every frame equals `spatial` (the same check as a = 0 above, through the ablation).
+  SyntheticScene scene;
+  scene.object = true;
+  scene.object_velocity = {2.0f, 1.0f};
+  up::Upsampler spatial(options_for("spatial")), fixed0(options_for("herzog", {"--fixed-wf", "0"}));
+  for (int t = 0; t < 6; ++t) {
+    SyntheticFrame f = make_frame(scene, t);
+    auto s = spatial.process(f.gbuffer, f.low, kRGB, false);
+    auto h = fixed0.process(f.gbuffer, f.low, kRGB, false);
+    ASSERT_TRUE(s && h);
+    for (const auto& c : kRGB)
+      for (std::size_t i = 0; i < (*s)->pixel_count(); ++i)
+        ASSERT_NEAR((*s)->plane(c)[i], (*h)->plane(c)[i], 1e-6) << c << " " << i << " frame " << t;
+  }
+  EXPECT_FALSE(up::make_options("herzog", {"--fixed-wf", "-0.5"}).has_value());
+  EXPECT_FALSE(up::make_options("herzog", {"--gradient-filter", "box"}).has_value());
+}
+
+TEST(Upsample, HerzogAblationGradientFilter) {
+  // A uniform, static payload converges exactly (any weighted mean of one value is that value), so the three
+  // previous relative gradients are 0. Halving the payload at frame T gives g_t = (h~ - h_r) / max(|h~|, |h_r|)
+  // = (L/2 - L) / L = -0.5 everywhere; the uniform field passes the spatial low-pass unchanged. Section 3.5.1's
+  // filter gives |0.4 x -0.5| = 0.2, the ablation (`--gradient-filter none`) |g_t| = 0.5, and w_f (eq. 8,
+  // a = 1) (1 - 0.2)^2 = 0.64 and 0.25.
+  SyntheticScene scene;
+  scene.amplitude = 0.0f;
+  const int T = 2 * scene.k * scene.k;
+  auto halve = [&](int t, SyntheticFrame& f, bool&) {
+    if (t != T) return;
+    for (const auto& c : kRGB)
+      for (std::size_t i = 0; i < f.low.pixel_count(); ++i) f.low.plane(c)[i] *= 0.5f;
+  };
+  for (const auto& [filter, gradient, wf] :
+       {std::tuple<std::string, float, float>{"temporal", 0.2f, 0.64f}, {"none", 0.5f, 0.25f}}) {
+    up::Options o = options_for("herzog", {"--gradient-filter", filter});
+    o.debug_layers = true;
+    const SeqRun r = run_seq(scene, o, T + 1, halve);
+    const float* g = r.output.plane("debug.gradient");
+    const float* w = r.output.plane("debug.wf");
+    ASSERT_TRUE(g && w);
+    const std::size_t centre = std::size_t(scene.height / 2) * std::size_t(scene.width) + std::size_t(scene.width / 2);
+    EXPECT_NEAR(g[centre], gradient, 1e-4) << filter;
+    EXPECT_NEAR(w[centre], wf, 1e-4) << filter;
+  }
+}
+
 TEST(Upsample, TaauStaticSceneConverges) {
   // A static scene: every pixel is shaded once per k^2 frames and nothing is rectified away, so the accumulated
   // history approaches the full-resolution payload, well below the spatial method's error.
@@ -286,8 +336,21 @@ TEST(Upsample, NoGhostTrailBehindMovingObject) {
   const SeqRun sp = run_seq(scene, options_for("spatial"), frames);
   const auto region = region_for(sp.frame);
   auto in_region = [&](std::size_t i) { return region[i] != 0; };
-  const Err es = error(sp.output, sp.frame.reference, in_region);
+  Err es = error(sp.output, sp.frame.reference, in_region);
   ASSERT_GT(es.n, 300u);
+  // A method that keeps history fills a disoccluded pixel with that frame's spatial estimate and keeps it (the
+  // background is static) until the pattern shades the pixel again, up to k^2 frames later: its error there is
+  // spatial's error at the frame of the disocclusion, so the bound takes spatial's worst error in the region over
+  // the last k^2 frames, not only at the last one (which depends on where the last frame's samples fell).
+  {
+    up::Upsampler u(options_for("spatial"));
+    for (int t = 0; t < frames; ++t) {
+      const SyntheticFrame f = make_frame(scene, t);
+      auto out = u.process(f.gbuffer, f.low, kRGB, false);
+      ASSERT_TRUE(out.has_value());
+      if (t >= frames - scene.k * scene.k) es.max = std::max(es.max, error(**out, f.reference, in_region).max);
+    }
+  }
   for (const char* variant : {"temporal", "herzog", "drobot-refresh", "herzog-lagged"}) {
     const up::MethodVariant* v = up::find_variant(variant);
     ASSERT_NE(v, nullptr) << variant;
@@ -486,7 +549,8 @@ float checker_albedo(int X, int Y, int c) { return ((X + Y + c) & 1) ? 0.8f : 0.
 // (k x + sx, k y + sy)) and the reference by it.
 void texture_frame(SyntheticFrame& f, int k) {
   const int W = f.gbuffer.width(), H = f.gbuffer.height();
-  const int i = *f.low.metadata().jitter_index, sx = i % k, sy = i / k;
+  const glm::ivec2 sub = temporal::regular_subpixel(k, *f.low.metadata().jitter_index);  // conventions "Jitter"
+  const int sx = sub.x, sy = sub.y;
   const char* names[3] = {"R", "G", "B"};
   for (int c = 0; c < 3; ++c) {
     float* a = f.gbuffer.add_channel(std::string("albedo.") + names[c]);

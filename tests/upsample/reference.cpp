@@ -1,6 +1,7 @@
 #include "reference.h"
 
 #include "temporal/core/color.h"
+#include "temporal/core/jitter.h"
 #include "temporal/core/reproject.h"
 #include "temporal/upsample/drobot.h"
 #include "temporal/upsample/history.h"
@@ -118,8 +119,9 @@ Image PlainUpsampler::process(const Image& g, const Image& low, const std::vecto
   f.lh = low.height();
   f.k = *low.metadata().jitter_factor;
   const int index = *low.metadata().jitter_index;
-  f.sx = index % f.k;
-  f.sy = index / f.k;
+  const glm::ivec2 sub = regular_subpixel(f.k, index);  // docs/conventions.md "Jitter": the dispersed order
+  f.sx = sub.x;
+  f.sy = sub.y;
   f.C = int(channels.size());
   f.z = g.plane("depth.Z");
   f.nx = g.plane("N.X");

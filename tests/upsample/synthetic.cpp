@@ -1,5 +1,7 @@
 #include "synthetic.h"
 
+#include "temporal/core/jitter.h"
+
 #include <cmath>
 
 namespace temporal::test {
@@ -69,7 +71,10 @@ SyntheticFrame make_frame(const SyntheticScene& s, int frame) {
   if (frame == 0) gm.camera_cut = true;
   f.reference.metadata() = gm;
 
-  const int index = frame % (k * k), sx = index % k, sy = index / k;
+  // The regular pattern in its dispersed order (docs/conventions.md "Jitter"), as render-gbuffer renders it.
+  const int index = frame % (k * k);
+  const glm::ivec2 sub = regular_subpixel(k, index);
+  const int sx = sub.x, sy = sub.y;
   f.low = Image(W / k, H / k);
   float* low[3] = {f.low.add_channel("R"), f.low.add_channel("G"), f.low.add_channel("B")};
   for (int y = 0; y < H / k; ++y)

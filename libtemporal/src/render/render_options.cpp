@@ -122,6 +122,9 @@ Status validate(const RenderOptions& options) {
     return Error::usage("--factor " + std::to_string(options.factor) + " must divide the width and height (" +
                         std::to_string(options.width) + "x" + std::to_string(options.height) + ")");
   if (options.reference_spp < 1) return Error::usage("--reference-spp must be at least 1");
+  if (options.reference_jitter != JitterMode::Halton && options.reference_jitter != JitterMode::None)
+    return Error::usage(std::string("--reference-jitter ") + to_string(options.reference_jitter) +
+                        " is not a reference pattern: use halton (supersampled) or none (pixel centres, noise averaged)");
   if (options.shade_mip_bias && !(std::abs(*options.shade_mip_bias) <= 16.0f))
     return Error::usage("--shade-mip-bias must be a number between -16 and 16 (or 'auto')");
   if (p.pcf_kernel < 1 || p.pcf_kernel > 32) return Error::usage("--pcf must be between 1 and 32");

@@ -707,12 +707,15 @@ Expected<RenderedFrame> Renderer::render(const FrameInput& in) {
     result.color->metadata().compute_ms = result.timings_ms[kPassColor];
   }
   if (out.reference) {
-    // Reference: reference_spp full-resolution samples at Halton (2,3) sub-pixel positions, each with its
-    // own SSAO pattern and VPL set, accumulated in float targets and averaged.
+    // Reference: reference_spp full-resolution samples at Halton (2,3) sub-pixel positions (or all at the pixel
+    // centres with reference_jitter = None), each with its own SSAO pattern and VPL set, accumulated in float
+    // targets and averaged.
     const auto t0 = Clock::now();
+    const bool centred = o.reference_jitter == JitterMode::None;
     for (int s = 0; s < o.reference_spp; ++s) {
       const auto i = std::uint32_t(s + 1);
-      const glm::vec2 jitter(radical_inverse(i, 2) - 0.5f, radical_inverse(i, 3) - 0.5f);
+      const glm::vec2 jitter =
+          centred ? glm::vec2(0.0f) : glm::vec2(radical_inverse(i, 2) - 0.5f, radical_inverse(i, 3) - 0.5f);
       const Impl::View view = im.make_view(in, w, h, jitter);
       if (s > 0 && im.rsm.fbo) im.select_vpls(instant, s);
       im.draw_gbuffer(im.gbuffer_full, view);

@@ -30,6 +30,7 @@
 #include "temporal/upsample/history.h"
 #include "temporal/core/parallel.h"
 
+#include <algorithm>
 #include <atomic>
 #include <cmath>
 #include <limits>
@@ -209,6 +210,9 @@ struct HerzogOptions {
   float gradient_mip_level = 2.5f;           // spatial low-pass: trilinear mip level, in full-resolution levels
   float max_history_weight = 0.0f;           // bound of h_w; 0 = 2 k^2
   bool lagged_wf = false;                    // eq. 7 with the previous frame's w_f: one fused pass
+  // Ablations (issue 16): which part of the gradient-driven adaptation carries the gain.
+  float fixed_wf = -1.0f;                    // >= 0: w_f is this constant everywhere (no eq. 8)
+  std::string gradient_filter = "temporal";  // none: |g_t| instead of |(0.4, 0.3, 0.2, 0.1) . (g_t..g_t-3)|
 
   float sensitivity() const { return favor_spatial ? kFavorSpatialA : a; }
   ParamList params() {
@@ -238,9 +242,19 @@ struct HerzogOptions {
                        "eq. 7 with the previous frame's w_f (motion-compensated): one pass instead of three, w_f "
                        "reacts one frame later",
                        &lagged_wf),
+        Param::real("--fixed-wf",
+                    "ablation: w_f is this constant in [0, 1] everywhere instead of eq. 8 (the kernel and eq. 7 "
+                    "stop adapting to the gradient; a miss still restarts the history); -1 = off (eq. 8)",
+                    &fixed_wf, -1.0, 1.0),
+        Param::choice("--gradient-filter",
+                      "temporal filter of the gradient (section 3.5.1): temporal = |(0.4, 0.3, 0.2, 0.1) . (g_t, "
+                      "g_t-1, g_t-2, g_t-3)|; none = |g_t| (ablation)",
+                      &gradient_filter, {"temporal", "none"}),
     };
   }
   Status check() const {
+    if (fixed_wf < 0.0f && fixed_wf != -1.0f)
+      return Error::usage("--fixed-wf " + std::to_string(fixed_wf) + " must be in [0, 1], or -1 for eq. 8");
     if (gradient_scale & (gradient_scale - 1))
       return Error::usage("--gradient-scale " + std::to_string(gradient_scale) + " is not a power of 2 (1, 2, 4, 8)");
     return Status::ok();
@@ -780,6 +794,11 @@ void HerzogFrame::pass_b_row(ChunkScratch& ts, int gy) {
   float* cur3[3] = {s.dhist[cur][0].data() + grow, s.dhist[cur][1].data() + grow, s.dhist[cur][2].data() + grow};
   temporal_filter_row(gy, W, H, gs, GW, GH, history, f.mx, f.my, s.dcur.data() + grow, s.dcount.data() + grow,
                       prev3, cur3, s.pyramid[0].data() + grow, ts.bseg);
+  if (ho.gradient_filter == "none") {  // ablation: this frame's gradient alone, |g_t| (the history still shifts)
+    float* __restrict gf = s.pyramid[0].data() + grow;
+    const float* __restrict g0 = cur3[0];
+    for (int gx = 0; gx < GW; ++gx) gf[gx] = std::abs(g0[gx]);
+  }
 }
 
 // Pyramid level j, row y: 2x2 box of level j - 1 (clamp-to-edge).
@@ -830,6 +849,7 @@ void HerzogFrame::low_pass_row(ChunkScratch& ts, int gy) {
       wfo[gx] = temporal_weight(g0[gx], a_);  // eq. 8
     }
   }
+  if (ho.fixed_wf >= 0.0f) std::fill(wfo, wfo + gw, ho.fixed_wf);  // ablation: no adaptation, w_f constant
 }
 
 // ---------------- pass C: eq. 7 for one full row ----------------

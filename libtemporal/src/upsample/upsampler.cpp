@@ -2,6 +2,7 @@
 // geometry, saved and resumed), shader splitting (seed 000 section 4, demodulation) and the antialiasing downsample.
 #include "method.h"
 
+#include "temporal/core/jitter.h"
 #include "temporal/core/parallel.h"
 
 #include <algorithm>
@@ -117,8 +118,9 @@ Status Upsampler::Impl::validate(const Image& gbuffer, const Image& low, std::sp
     const int i = *lm.jitter_index;
     if (i < 0 || i >= k * k)
       return Error::input(lname, "temporal:jitterIndex " + std::to_string(i) + " is out of range 0.." + std::to_string(k * k - 1));
-    sx = i % k;
-    sy = i / k;
+    const glm::ivec2 s = regular_subpixel(k, i);  // the pattern's order (docs/conventions.md, "Jitter")
+    sx = s.x;
+    sy = s.y;
   } else {
     return Error::input(lname, "no temporal:jitter or temporal:jitterIndex in the header (docs/conventions.md, Jitter)");
   }

@@ -9,6 +9,7 @@
 
 #include <glm/mat4x4.hpp>
 #include <glm/vec2.hpp>
+#include <glm/ext/vector_int2.hpp>
 
 #include <cstdint>
 #include <string>
@@ -16,7 +17,8 @@
 namespace temporal {
 
 enum class JitterMode {
-  Regular,  // the k x k grid of seed 000, Figure 2: index i = frame mod k*k, raster order
+  Regular,        // the k x k grid of seed 000, Figure 2: index i = frame mod k*k, dispersed (Bayer) order
+  RegularRaster,  // the same grid in raster order (the order before issue 15; for before/after measurements)
   Halton,   // Halton (2, 3), index frame + 1, period 1024 frames
   Random,   // uniform in [-0.5, 0.5)^2 from a hash of (seed, frame): white-noise jitter (seed 003's input)
   None,     // pixel centres
@@ -26,9 +28,15 @@ enum class JitterMode {
 Expected<JitterMode> parse_jitter_mode(const std::string& name);
 const char* to_string(JitterMode mode);
 
-// The regular pattern of docs/conventions.md: index i in 0..k*k-1 is sub-pixel (i mod k, i div k) and
-// jitter ((sx + 0.5) / k - 0.5, (sy + 0.5) / k - 0.5). k = 1 gives (0, 0).
-glm::vec2 regular_jitter(int k, int index);
+// The regular pattern of docs/conventions.md: index i in 0..k*k-1 is sub-pixel (sx, sy) in 0..k-1, in the
+// dispersed order (the i-th cell of the k x k grid ranked by the Bayer matrix of the next power of two; for
+// k = 4: (0,0) (2,2) (2,0) (0,2) (1,1) (3,3) (3,1) (1,3) (1,0) (3,2) ...), or in raster order (i mod k, i div k)
+// with `raster`. Seed 000 Figure 2 leaves the order open; the dispersed one spreads every run of consecutive
+// frames over the pixel, so a history that holds only a few frames still sees samples all around each pixel.
+// An index outside 0..k*k-1 is taken mod k*k. k = 1 gives (0, 0).
+glm::ivec2 regular_subpixel(int k, int index, bool raster = false);
+// The jitter of that sub-pixel: ((sx + 0.5) / k - 0.5, (sy + 0.5) / k - 0.5).
+glm::vec2 regular_jitter(int k, int index, bool raster = false);
 
 // The radical inverse of `index` in `base` (index >= 0), in [0, 1).
 float radical_inverse(std::uint32_t index, std::uint32_t base);

@@ -88,6 +88,10 @@ struct RenderOptions {
   JitterMode shade_jitter = JitterMode::Regular;
   JitterMode color_jitter = JitterMode::Random;
   int reference_spp = 16;              // reference samples per pixel (Halton (2,3) sub-pixel positions)
+  // Where the reference's samples lie in each pixel: Halton (a supersampled, antialiased reference) or None (every
+  // sample at the pixel centre: only the per-sample SSAO pattern and VPL set vary, so the reference is the
+  // 1-spp colour with its noise averaged - the target of methods that accumulate over frames; issue 15 item 6).
+  JitterMode reference_jitter = JitterMode::Halton;
   bool mipmaps = true;                 // false: textures sampled without mipmaps (seed 003, section 7.2)
   // Texture LOD bias of the low-resolution payload's G-buffer. Unset: -log2(factor), which makes the
   // low-resolution pass pick the mip level the full-resolution pass picks, so that each jittered low-res
