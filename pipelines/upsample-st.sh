@@ -96,10 +96,12 @@ method_args() {
     extra=" ${suffix#*$'\t'}$extra"
   done
 }
-for m in $METHODS; do method_args "$m" > /dev/null || exit 2; done
 # Every run: "NAME ARGUMENTS" (METHODS through the method table, then the VARIANTS lines as given).
 runs=()
-for m in $METHODS; do runs+=("$m $(method_args "$m")"); done
+for m in $METHODS; do
+  args="$(method_args "$m")" || exit 2
+  runs+=("$m $args")
+done
 raster=0
 while read -r n m args; do
   [[ -z "$n" ]] && continue

@@ -405,9 +405,7 @@ Status Run::reference_frame(std::size_t fi, int frame) {
     fr.motion_x = gbuf_ ? gbuf_->plane("motion.X") : nullptr;
     fr.motion_y = gbuf_ ? gbuf_->plane("motion.Y") : nullptr;
     if (gbuf_geometry_ && have_prev_geometry_) {
-      const float* warped = gbuf_warped_ ? gbuf_->plane("prevDepth.Z") : nullptr;
-      fr.z = warped ? warped : gbuf_->plane("depth.Z");
-      if (warped) fr.test.depth_tolerance = reproject::kWarpedDepthTolerance;
+      reproject::expect_depth(fr, gbuf_->plane("depth.Z"), gbuf_warped_ ? gbuf_->plane("prevDepth.Z") : nullptr);
       fr.id = gbuf_->uint_plane("id");
       fr.prev_z = prev_z_.data();
       fr.prev_id = prev_id_.data();

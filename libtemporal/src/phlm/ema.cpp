@@ -59,14 +59,12 @@ Status EmaFilter::process(const FilterInput& in, Image& output, FilterStats* sta
   frames.height = h;
   frames.motion_x = in.motion_x;
   frames.motion_y = in.motion_y;
-  // The expected previous depth: the warped depth when the G-buffer has it (seed 000 section 3.2), else the
-  // current depth (temporal/core/reproject.h).
-  const bool warped = use_depth && in.prev_depth;
-  frames.z = use_depth ? (warped ? in.prev_depth : in.depth) : nullptr;
   frames.prev_z = use_depth ? prev_depth : nullptr;
   frames.id = use_id ? in.id : nullptr;
   frames.prev_id = use_id ? prev_id : nullptr;
-  frames.test = {warped ? params_.warped_depth_tolerance : tol, use_id};
+  frames.test = {tol, use_id};
+  // The expected previous depth: the warped depth when the G-buffer has it, else the current depth.
+  if (use_depth) reproject::expect_depth(frames, in.depth, in.prev_depth, params_.warped_depth_tolerance);
   std::atomic<std::size_t> rejects{0};
   parallel_rows(h, [&](int y0, int y1) {
     thread_local reproject::HistoryRow taps;

@@ -307,12 +307,11 @@ std::size_t accumulate_cache_row(DrobotState& s, const FrameContext& f, bool his
     fr.height = f.lh;
     fr.motion_x = s.cmx.data();
     fr.motion_y = s.cmy.data();
-    const bool warped = !s.czw.empty();  // the warped depth of seed 000 section 3.2 when the G-buffer has it
-    fr.z = warped ? s.czw.data() : s.cz.data();
     fr.prev_z = s.hb_z[prv].data();
     fr.id = s.cid.empty() ? nullptr : s.cid.data();
     fr.prev_id = s.hb_id[prv].empty() ? nullptr : s.hb_id[prv].data();
-    fr.test = f.options->surface_test(warped);
+    fr.test = f.options->surface_test();
+    reproject::expect_depth(fr, s.cz.data(), s.czw.empty() ? nullptr : s.czw.data(), f.options->warped_depth_tolerance);
     reproject::reproject_row(fr, y, h);
     if (o.cache_point) {  // Figure 7.5's point filtering: the surviving tap with the largest weight
       for (int x = 0; x < lw; ++x) {

@@ -94,11 +94,11 @@ inline void history_row(const FrameContext& f, const PreviousGeometry& prev, int
   fr.height = f.H;
   fr.motion_x = f.mx;
   fr.motion_y = f.my;
-  fr.z = f.prev_z ? f.prev_z : f.z;
   fr.prev_z = prev.z.data();
   fr.id = f.id;
   fr.prev_id = prev.id.empty() ? nullptr : prev.id.data();
-  fr.test = f.options->surface_test(f.prev_z != nullptr);
+  fr.test = f.options->surface_test();
+  reproject::expect_depth(fr, f.z, f.prev_z, f.options->warped_depth_tolerance);
   reproject::reproject_row(fr, Y, h);
 }
 

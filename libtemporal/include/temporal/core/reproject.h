@@ -192,6 +192,15 @@ struct Frames {
   SurfaceTest test;
 };
 
+// Sets what the disocclusion test compares the previous depth with (seed 000 section 3.2): the warped depth
+// (G-buffer layer prevDepth.Z, the depth the surface point had in the previous frame) at `warped_tolerance` when
+// the caller has it, else the current depth at the tolerance already in `frames.test`. The one place that rule lives.
+inline void expect_depth(Frames& frames, const float* depth, const float* warped_depth,
+                         float warped_tolerance = kWarpedDepthTolerance) {
+  frames.z = warped_depth ? warped_depth : depth;
+  if (warped_depth) frames.test.depth_tolerance = warped_tolerance;
+}
+
 // Fills `h` for row y with the rules above. Allocates only when the width grows.
 void reproject_row(const Frames& frames, int y, HistoryRow& h);
 

@@ -101,10 +101,9 @@ struct Options {
 
   MethodOptionSet per_method;  // each method's own parameters
 
-  // The disocclusion test of the history fetch; `warped`: its expected depth is prevDepth.Z.
-  reproject::SurfaceTest surface_test(bool warped = false) const {
-    return {warped ? warped_depth_tolerance : depth_tolerance, !no_ids};
-  }
+  // The disocclusion test of the history fetch (with prevDepth.Z, reproject::expect_depth sets the warped
+  // tolerance).
+  reproject::SurfaceTest surface_test() const { return {depth_tolerance, !no_ids}; }
 };
 
 // Every parameter of the stage, pointing at the fields of `options`: the shared ones, then each method's (help
