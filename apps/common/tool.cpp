@@ -1,6 +1,6 @@
 #include "tool.h"
 
-#include "temporal/core/atomic_file.h"
+#include "temporal/io/atomic_file.h"
 #include "temporal/core/parallel.h"
 
 #include <signal.h>

@@ -5,7 +5,7 @@
 
 #include "temporal/core/error.h"
 #include "temporal/core/params.h"
-#include "temporal/core/runner.h"
+#include "temporal/io/runner.h"
 
 #include <CLI/CLI.hpp>
 
@@ -58,7 +58,7 @@ class Tool {
   };
   void add_sequence_options(SequenceOptions& options, const SequenceFlags& flags);
 
-  // Hooks that draw the progress line, print warnings and --verbose lines (temporal/core/runner.h).
+  // Hooks that draw the progress line, print warnings and --verbose lines (temporal/io/runner.h).
   RunHooks hooks();
   // `temporal:tool` / `temporal:parameters` of the outputs.
   RunIdentity identity() const { return {signature(), command_line_}; }

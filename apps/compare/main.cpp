@@ -1,6 +1,6 @@
 // compare: per-frame PSNR, SSIM, flicker and (with --flip) FLIP of test sequences against a reference, as CSV,
 // JSON, error-map EXRs, charts, pictures and an HTML report, with pass/fail thresholds for pipelines. The run
-// lives in libtemporal (temporal/report/compare_run.h; the metrics in temporal/metrics/comparison.h);
+// lives in libtemporal (temporal/report/compare_run.h; the metrics in temporal/compare/comparison.h);
 // docs/compare.md defines them. This file binds options.
 #include "tool.h"
 

@@ -4,6 +4,8 @@
 // live in libtemporal (temporal/morph/methods.h, morph_stage.h); docs/morph-120hz.md describes them.
 #include "tool.h"
 
+#include "temporal/io/color_config.h"
+#include "temporal/io/exr.h"
 #include "temporal/morph/methods.h"
 #include "temporal/morph/morph_stage.h"
 
@@ -43,7 +45,7 @@ int main(int argc, char** argv) {
       "Print the methods (name, tab, summary; one per line) and exit");
 
   return tool.run(argc, argv, [&]() -> Status {
-    auto stage = make_morph_stage(options);
+    auto stage = make_morph_stage(options, MorphStageIO{&read_exr_rgb, &load_display_gamma});
     if (!stage) return stage.error();
     auto summary = run_sequence(seq, **stage, tool.identity(), tool.hooks());
     if (!summary) return summary.error();

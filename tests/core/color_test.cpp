@@ -1,4 +1,4 @@
-#include "temporal/core/color.h"
+#include "temporal/io/color_config.h"
 #include "temporal/core/image.h"
 
 #include "test_support.h"

@@ -1,5 +1,5 @@
 // Every layer and metadata attribute of docs/conventions.md survives a write and a read bit for bit.
-#include "temporal/core/exr.h"
+#include "temporal/io/exr.h"
 
 #include "test_support.h"
 

@@ -1,4 +1,4 @@
-#include "temporal/core/exr.h"
+#include "temporal/io/exr.h"
 
 #include "test_support.h"
 

@@ -1,10 +1,10 @@
 // Bad input loses nothing and is never accepted silently (issue 11): non-EXR files, truncated multi-part files,
 // absurd headers, outputs that would replace inputs, frames of another size, temporary files of killed runs,
 // unbounded patterns and frame numbers, non-finite parameters.
-#include "temporal/core/atomic_file.h"
-#include "temporal/core/exr.h"
+#include "temporal/io/atomic_file.h"
+#include "temporal/io/exr.h"
 #include "temporal/core/params.h"
-#include "temporal/core/runner.h"
+#include "temporal/io/runner.h"
 #include "temporal/core/sequence.h"
 
 #include "test_support.h"

@@ -1,6 +1,6 @@
 // The built `compare` tool, run as a pipeline would: DISPLAY unset (compare must provide its own Xvfb), CSV
 // rows, JSON keys, PNG files, exit codes for thresholds and bad input, and every option of --help accepted.
-#include "temporal/core/exr.h"
+#include "temporal/io/exr.h"
 #include "temporal/core/image.h"
 
 #include "test_support.h"

@@ -1,7 +1,7 @@
 // The comparison engine on EXR sequences: values against idiff and hand computations, identical sequences,
 // masks, error maps, outputs without NaN, and every kind of bad input.
-#include "temporal/metrics/comparison.h"
-#include "temporal/core/exr.h"
+#include "temporal/compare/comparison.h"
+#include "temporal/io/exr.h"
 #include "temporal/core/image.h"
 #include "temporal/metrics/flip.h"
 

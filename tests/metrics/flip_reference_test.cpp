@@ -2,7 +2,7 @@
 // ../shared/flip-reference/expected.json holds its mean FLIP for three test images against one reference, LDR
 // (8-bit sRGB PNGs) and HDR (half-float EXRs, ACES, automatic exposures) at 67.0206 and 40 pixels per degree,
 // and its error maps of the phlm frame as magma-coloured PNGs (README there). Skipped when the folder is absent.
-#include "temporal/core/exr.h"
+#include "temporal/io/exr.h"
 #include "temporal/core/image.h"
 #include "temporal/metrics/flip.h"
 

@@ -1,5 +1,5 @@
 // The morph-120hz command line: frame numbering and timing of the output, metadata, bad input exit codes.
-#include "temporal/core/exr.h"
+#include "temporal/io/exr.h"
 #include "temporal/morph/methods.h"
 
 #include "synthetic.h"

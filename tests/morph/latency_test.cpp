@@ -2,9 +2,12 @@
 // blend needs rendered frame n+1 before it can show slot 1 of frame n, so its output frame t is displayed
 // factor = 3 output frames late and must be judged against the native 120 Hz frame t + 3. A synthetic edge
 // moving one pixel per 120 Hz frame gives every value by hand.
-#include "temporal/core/exr.h"
-#include "temporal/metrics/comparison.h"
+#include "temporal/io/exr.h"
+#include "temporal/compare/comparison.h"
+#include "temporal/io/color_config.h"
+#include "temporal/io/exr.h"
 #include "temporal/morph/morph_stage.h"
+#include "temporal/io/runner.h"
 
 #include "synthetic.h"
 #include "test_support.h"
@@ -14,6 +17,9 @@
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
+
+// The tool's file and colour services (morph-120hz passes the same).
+static const temporal::MorphStageIO kMorphIO{&temporal::read_exr_rgb, &temporal::load_display_gamma};
 
 namespace temporal {
 namespace {
@@ -41,7 +47,7 @@ class LatencyScoring : public ::testing::Test {
     for (int t = 0; t <= last_native; ++t) write_edge(path("native/c." + num(t) + ".exr"), 8 + t, 120.0);
     MorphStageOptions o;
     o.morph.method = method;
-    auto stage = make_morph_stage(o);
+    auto stage = make_morph_stage(o, kMorphIO);
     ASSERT_TRUE(stage) << stage.error().message;
     SequenceOptions seq;
     seq.input = path("in/c.####.exr");

@@ -1,6 +1,8 @@
 // The method registry of morph-120hz (temporal/morph/methods.h) and the parameters bound from it
 // (temporal/morph/morph_stage.h).
 #include "temporal/morph/methods.h"
+#include "temporal/io/color_config.h"
+#include "temporal/io/exr.h"
 #include "temporal/morph/morph_stage.h"
 
 #include "synthetic.h"
@@ -8,6 +10,9 @@
 #include <gtest/gtest.h>
 
 #include <set>
+
+// The tool's file and colour services (morph-120hz passes the same).
+static const temporal::MorphStageIO kMorphIO{&temporal::read_exr_rgb, &temporal::load_display_gamma};
 
 namespace temporal {
 namespace {
@@ -128,30 +133,30 @@ TEST(MorphStageParams, EyeTrackingPixelsPerDegree) {
 TEST(MorphStage, InvalidOptionsAreRefusedBeforeAnyFrameIsRead) {
   MorphStageOptions o;
   o.morph.method = "nope";
-  EXPECT_FALSE(make_morph_stage(o));
+  EXPECT_FALSE(make_morph_stage(o, kMorphIO));
   o.morph.method = "didyk";
   o.morph.grid.cell = 6;
-  auto s = make_morph_stage(o);
+  auto s = make_morph_stage(o, kMorphIO);
   ASSERT_FALSE(s);
   EXPECT_EQ(s.error().kind, ErrorKind::Usage);
   EXPECT_NE(s.error().message.find("power of two"), std::string::npos);
   o.morph.grid.cell = 8;
   o.display = "no_such_display";
-  EXPECT_FALSE(make_morph_stage(o));
+  EXPECT_FALSE(make_morph_stage(o, kMorphIO));
   o.display.clear();
-  auto ok = make_morph_stage(o);
+  auto ok = make_morph_stage(o, kMorphIO);
   ASSERT_TRUE(ok);
   EXPECT_EQ((*ok)->inputs().outputs_per_frame, 3);
   EXPECT_TRUE((*ok)->inputs().gbuffer_required);
   o.morph.method = "blend";
-  ok = make_morph_stage(o);
+  ok = make_morph_stage(o, kMorphIO);
   ASSERT_TRUE(ok);
   EXPECT_FALSE((*ok)->inputs().gbuffer_required);
   EXPECT_EQ((*ok)->inputs().lookahead, 1);
   EXPECT_FALSE((*ok)->inputs().lookahead_past_range);
   o.perceive = true;
   o.hold.window = 4;
-  ok = make_morph_stage(o);
+  ok = make_morph_stage(o, kMorphIO);
   ASSERT_TRUE(ok);
   EXPECT_EQ((*ok)->inputs().lookahead, 3);
   EXPECT_TRUE((*ok)->inputs().lookahead_past_range);

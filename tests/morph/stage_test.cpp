@@ -1,7 +1,9 @@
-// morph-120hz's stage on the sequence runner (temporal/morph/morph_stage.h, temporal/core/runner.h): output
+// morph-120hz's stage on the sequence runner (temporal/morph/morph_stage.h, temporal/io/runner.h): output
 // numbering and timing, blend's next frame, --perceive's window past the selected frames, the NaN policy.
 // Frames are constant images, so every expected value is computed by hand.
-#include "temporal/core/exr.h"
+#include "temporal/io/color_config.h"
+#include "temporal/io/exr.h"
+#include "temporal/io/runner.h"
 #include "temporal/morph/morph_stage.h"
 
 #include "synthetic.h"
@@ -11,6 +13,9 @@
 
 #include <cmath>
 #include <limits>
+
+// The tool's file and colour services (morph-120hz passes the same).
+static const temporal::MorphStageIO kMorphIO{&temporal::read_exr_rgb, &temporal::load_display_gamma};
 
 namespace temporal {
 namespace {
@@ -38,7 +43,7 @@ class MorphStageRun : public ::testing::Test {
   }
   Expected<RunSummary> run(const MorphStageOptions& o, const std::string& input, const std::string& frames,
                            const std::string& gbuffer = {}) {
-    auto stage = make_morph_stage(o);
+    auto stage = make_morph_stage(o, kMorphIO);
     if (!stage) return stage.error();
     SequenceOptions seq;
     seq.input = path(input + ".###.exr");
@@ -160,7 +165,7 @@ TEST_F(MorphStageRun, PerceiveWithALagReferenceReportsTheLagApartFromTheBlur) {
   }
   MorphStageOptions o;
   o.perceive = true;
-  auto stage = make_morph_stage(o);
+  auto stage = make_morph_stage(o, kMorphIO);
   ASSERT_TRUE(stage);
   SequenceOptions seq;
   seq.input = path("native.###.exr");
@@ -213,13 +218,13 @@ TEST_F(MorphStageRun, ClearErrors) {
   // --lag-reference without --perceive would do nothing: refused.
   MorphStageOptions lag;
   lag.lag_reference = "native.####.exr";
-  auto refused = make_morph_stage(lag);
+  auto refused = make_morph_stage(lag, kMorphIO);
   ASSERT_FALSE(refused);
   EXPECT_EQ(refused.error().kind, ErrorKind::Usage);
   EXPECT_NE(refused.error().message.find("--perceive"), std::string::npos) << refused.error().message;
 
   // Several outputs per input frame need a placeholder in --out, even for a single input file.
-  auto stage = make_morph_stage(MorphStageOptions{});
+  auto stage = make_morph_stage(MorphStageOptions{}, kMorphIO);
   ASSERT_TRUE(stage);
   SequenceOptions seq;
   seq.input = path("nofps.000.exr");

@@ -1,6 +1,6 @@
 // filter-phlm's command line: every method on a tiny synthetic sequence, --state-out / --state-in resume,
 // errors and exit codes.
-#include "temporal/core/exr.h"
+#include "temporal/io/exr.h"
 
 #include "test_support.h"
 

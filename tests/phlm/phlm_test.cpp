@@ -1,5 +1,5 @@
 // PHLM (seed 003) on synthetic sequences: the numerically hard cases of issue 5, each with a numeric assertion.
-#include "temporal/core/exr.h"
+#include "temporal/io/exr.h"
 #include "temporal/phlm/phlm.h"
 
 #include "test_support.h"

@@ -1,7 +1,7 @@
 // The pictures stage with hand-computed values: colour maps (matplotlib's published entries, FLIP's indexing, and
 // NVIDIA's own FLIP map picture), display encoding through the OCIO config, heat maps and colour bars, G-buffer
 // pictures, picture operations, crops, grids, temporal profiles, labels, files and the H.264 video.
-#include "temporal/core/exr.h"
+#include "temporal/io/exr.h"
 #include "temporal/core/image.h"
 #include "temporal/metrics/flip.h"
 #include "temporal/pictures/colormap.h"

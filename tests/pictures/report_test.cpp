@@ -2,9 +2,9 @@
 // plot defect of issue 13 (formats by extension, axis ranges, titles, names, what the speed chart plots, the
 // progress line), `compare --png` and `compare --report` as files, and the report rendered by headless Chromium
 // (screenshot not blank, every picture loaded, tables, charts, contact sheet, FLIP maps and the video present).
-#include "temporal/core/exr.h"
+#include "temporal/io/exr.h"
 #include "temporal/core/image.h"
-#include "temporal/metrics/comparison.h"
+#include "temporal/compare/comparison.h"
 #include "temporal/pictures/html.h"
 #include "temporal/pictures/picture.h"
 #include "temporal/plot/plot.h"

@@ -1,7 +1,7 @@
 // render-gbuffer's command line: bad input, the layers of each --outputs choice, headers, determinism.
 #include "test_support.h"
 
-#include "temporal/core/exr.h"
+#include "temporal/io/exr.h"
 
 #include <gtest/gtest.h>
 

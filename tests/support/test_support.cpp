@@ -2,7 +2,7 @@
 
 #include <cstdlib>
 
-#include "temporal/core/exr.h"
+#include "temporal/io/exr.h"
 
 #include <sys/wait.h>
 

@@ -2,7 +2,7 @@
 // exit codes for bad input.
 #include "synthetic.h"
 
-#include "temporal/core/exr.h"
+#include "temporal/io/exr.h"
 #include "temporal/upsample/methods.h"
 #include "temporal/upsample/upsample.h"
 

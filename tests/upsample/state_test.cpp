@@ -4,7 +4,7 @@
 // message that says what differs.
 #include "synthetic.h"
 
-#include "temporal/core/exr.h"
+#include "temporal/io/exr.h"
 #include "temporal/upsample/methods.h"
 #include "temporal/upsample/upsample.h"
 

@@ -2,9 +2,10 @@
 #include "temporal/morph/morph_stage.h"
 
 #include "method_common.h"
-#include "temporal/core/color.h"
-#include "temporal/core/exr.h"
 #include "temporal/core/sequence.h"
+
+#include <chrono>
+#include <functional>
 #include "temporal/morph/methods.h"
 
 #include <algorithm>
@@ -149,8 +150,9 @@ class UpsampleStage final : public FrameStage {
 // input frame, integrating the window of displayed frames that starts at it.
 class PerceiveStage final : public FrameStage {
  public:
-  PerceiveStage(const HoldBlurOptions& hold, std::optional<SequencePattern> lag_reference, const LagSearchOptions& lag)
-      : hold_(hold), lag_reference_(std::move(lag_reference)), lag_(lag) {
+  PerceiveStage(const HoldBlurOptions& hold, std::optional<SequencePattern> lag_reference, const LagSearchOptions& lag,
+                std::function<Expected<Image>(const std::string&)> read_rgb)
+      : hold_(hold), lag_reference_(std::move(lag_reference)), lag_(lag), read_rgb_(std::move(read_rgb)) {
     inputs_.input_layers = {"rgb"};
     inputs_.gbuffer_layers = {{"motion", true}};
     inputs_.gbuffer_required = true;
@@ -198,7 +200,7 @@ class PerceiveStage final : public FrameStage {
       latency = int(v);
     }
     const std::string path = lag_reference_->path(f.frame);
-    auto ref = read_exr(path, ExrSelection{{"rgb"}});
+    auto ref = read_rgb_(path);
     if (!ref)
       return Error::input(path, "no perceived reference image for frame " + std::to_string(f.frame) +
                                     ": run --perceive on the native sequence through frame " + std::to_string(f.frame) +
@@ -233,6 +235,7 @@ class PerceiveStage final : public FrameStage {
   HoldBlurOptions hold_;
   std::optional<SequencePattern> lag_reference_;
   LagSearchOptions lag_;
+  std::function<Expected<Image>(const std::string&)> read_rgb_;
   StageInputs inputs_;
   std::vector<Image> scratch_;  // finite copies of the window (only of frames with NaN/Inf)
   Image gbuffer_, result_;
@@ -279,7 +282,7 @@ ParamList morph_stage_params(MorphStageOptions& o) {
   return params;
 }
 
-Expected<std::unique_ptr<FrameStage>> make_morph_stage(const MorphStageOptions& options) {
+Expected<std::unique_ptr<FrameStage>> make_morph_stage(const MorphStageOptions& options, const MorphStageIO& io) {
   if (options.perceive) {
     if (options.hold.window < 1) return Error::usage("--window must be at least 1");
     std::optional<SequencePattern> lag_reference;
@@ -287,8 +290,10 @@ Expected<std::unique_ptr<FrameStage>> make_morph_stage(const MorphStageOptions& 
       auto p = SequencePattern::parse(options.lag_reference);
       if (!p) return p.error();
       lag_reference = *p;
+      if (!io.read_rgb) return Error::usage("--lag-reference needs an image reader (MorphStageIO::read_rgb)");
     }
-    return std::unique_ptr<FrameStage>(std::make_unique<PerceiveStage>(options.hold, lag_reference, options.lag));
+    return std::unique_ptr<FrameStage>(
+        std::make_unique<PerceiveStage>(options.hold, lag_reference, options.lag, io.read_rgb));
   }
   if (!options.lag_reference.empty())  // an option that would do nothing is an error, not silence
     return Error::usage("--lag-reference measures the lag of a --perceive run: add --perceive, or drop it");
@@ -296,9 +301,8 @@ Expected<std::unique_ptr<FrameStage>> make_morph_stage(const MorphStageOptions& 
   if (!info) return info.error();
   MorphStageOptions resolved = options;
   if (!options.display.empty()) {
-    auto config = ColorConfig::load(options.ocio);
-    if (!config) return config.error();
-    auto gamma = config->display_gamma(options.display);
+    if (!io.display_gamma) return Error::usage("--display needs colour management (MorphStageIO::display_gamma)");
+    auto gamma = io.display_gamma(options.display, options.ocio);
     if (!gamma) return gamma.error();
     resolved.morph.gamma = *gamma;
   }

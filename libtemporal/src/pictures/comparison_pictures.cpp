@@ -6,7 +6,7 @@
 // metrics, CSV and JSON are still written and compare exits 4 (docs/compare.md).
 #include "temporal/pictures/comparison_pictures.h"
 
-#include "temporal/core/exr.h"
+#include "temporal/io/exr.h"
 #include "temporal/pictures/colormap.h"
 #include "temporal/pictures/sheet.h"
 #include "temporal/pictures/text.h"

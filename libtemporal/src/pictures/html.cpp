@@ -1,7 +1,7 @@
 // The HTML report page (temporal/pictures/html.h).
 #include "temporal/pictures/html.h"
 
-#include "temporal/core/atomic_file.h"
+#include "temporal/io/atomic_file.h"
 #include "temporal/metrics/statistics.h"
 
 #include <cmath>

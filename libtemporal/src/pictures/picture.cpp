@@ -1,7 +1,7 @@
 // 8-bit RGB pictures and their files (temporal/pictures/picture.h), written through OpenImageIO.
 #include "temporal/pictures/picture.h"
 
-#include "temporal/core/atomic_file.h"
+#include "temporal/io/atomic_file.h"
 
 #include <OpenImageIO/imageio.h>
 

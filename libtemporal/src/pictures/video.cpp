@@ -3,7 +3,7 @@
 // raising SIGPIPE in the calling tool. ffmpeg's messages go to a temporary file read when it fails.
 #include "temporal/pictures/video.h"
 
-#include "temporal/core/atomic_file.h"
+#include "temporal/io/atomic_file.h"
 #include "temporal/core/executable.h"
 
 #include <fcntl.h>

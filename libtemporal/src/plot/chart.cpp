@@ -3,7 +3,7 @@
 // through libharu (vtkPDFExporter).
 #include "temporal/plot/plot.h"
 
-#include "temporal/core/atomic_file.h"
+#include "temporal/io/atomic_file.h"
 
 #include <vtkAxis.h>
 #include <vtkBrush.h>

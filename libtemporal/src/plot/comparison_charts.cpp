@@ -1,5 +1,5 @@
 // The charts of `compare --plot` (temporal/plot/plot.h): per-frame metric curves and speed against error.
-#include "temporal/metrics/comparison.h"
+#include "temporal/compare/comparison.h"
 #include "temporal/plot/plot.h"
 
 #include <algorithm>
@@ -31,7 +31,7 @@ std::vector<std::pair<std::string, Chart>> comparison_charts(const ComparisonRep
   }
   std::vector<std::pair<std::string, Chart>> charts;
 
-  // One chart per measured metric, from its registry entry (temporal/metrics/comparison.h).
+  // One chart per measured metric, from its registry entry (temporal/compare/comparison.h).
   for (const auto& name : report.metrics) {
     const MetricDefinition* d = find_metric(name);
     if (!d) continue;

@@ -1,7 +1,7 @@
 // One compare run and its outputs (temporal/report/compare_run.h).
 #include "temporal/report/compare_run.h"
 
-#include "temporal/core/runner.h"
+#include "temporal/io/runner.h"
 #include "temporal/pictures/html.h"
 #include "temporal/plot/plot.h"
 

@@ -2,7 +2,7 @@
 // and the helpers its state files use. Each method's source file defines one MethodEntry; registry.cpp lists them.
 #pragma once
 
-#include "temporal/core/runner.h"
+#include "temporal/core/stage.h"
 #include "upsample_internal.h"
 #include "temporal/upsample/methods.h"
 

@@ -81,7 +81,7 @@ Status Upsampler::Impl::validate(const Image& gbuffer, const Image& low, std::sp
   const Options& o = options;
   const std::string& gname = names.gbuffer;
   const std::string& lname = names.input;
-  // The runner's checks and messages (temporal/core/runner.h), for callers of the library too.
+  // The runner's checks and messages (temporal/io/runner.h), for callers of the library too.
   std::vector<LayerNeed> needs = entry->layers(o);
   if (o.demodulate) needs.push_back({"albedo", true, "needed by --demodulate"});
   if (Status s = check_gbuffer_layers(gbuffer, needs, gname); !s) return s;

@@ -4,8 +4,8 @@
 //  * `compare`'s time per 1080p frame (the tool as a process, one frame and ten frames; the library with I/O;
 //    the metric kernels alone), next to `idiff` on the same pair.
 // External tools that are not in PATH are skipped with a message. Numbers are reported in docs/compare.md.
-#include "temporal/metrics/comparison.h"
-#include "temporal/core/exr.h"
+#include "temporal/compare/comparison.h"
+#include "temporal/io/exr.h"
 #include "temporal/core/image.h"
 #include "temporal/metrics/metrics.h"
 #include "temporal/metrics/flicker.h"

@@ -16,7 +16,7 @@
 // The first test is the baseline of the relative columns (give the unfiltered input first), and the subject of the
 // convention fit: per frame, its shift against its temporal:jitter (see the end of main).
 // Prints a Markdown table; exit 1 on bad usage, 2 on unreadable input.
-#include "temporal/core/exr.h"
+#include "temporal/io/exr.h"
 #include "temporal/core/reproject.h"
 #include "temporal/core/sequence.h"
 

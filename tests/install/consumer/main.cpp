@@ -1,6 +1,6 @@
 // The worked example of docs/library.md: write a short noisy sequence, load it back frame by frame, filter it
 // with PHLM (seed 003) and measure PSNR against the clean image before and after.
-#include "temporal/core/exr.h"
+#include "temporal/io/exr.h"
 #include "temporal/core/image.h"
 #include "temporal/core/sequence.h"
 #include "temporal/metrics/metrics.h"

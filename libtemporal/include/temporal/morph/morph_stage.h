@@ -1,4 +1,4 @@
-// morph-120hz as a stage of the sequence runner (temporal/core/runner.h): the per-frame policy of the tool, in
+// morph-120hz as a stage of the sequence runner (temporal/io/runner.h): the per-frame policy of the tool, in
 // the library. The runner owns the loop (patterns, frame list, G-buffer checks, non-finite counting, header
 // stamping, atomic writes); the stage adds what is particular to frame-rate conversion:
 //  - input frame n becomes output frames n*factor + k, k = 0..factor-1, with temporal:fps = fps*factor and
@@ -17,10 +17,11 @@
 
 #include "temporal/core/error.h"
 #include "temporal/core/params.h"
-#include "temporal/core/runner.h"
+#include "temporal/core/stage.h"
 #include "temporal/morph/hold_blur.h"
 #include "temporal/morph/morph.h"
 
+#include <functional>
 #include <memory>
 #include <string>
 
@@ -39,7 +40,7 @@ struct ViewingOptions {
 // Pixels per degree for an image `image_width` pixels wide under `viewing`; 0 when the limit is off.
 float tracking_pixels_per_degree(const ViewingOptions& viewing, int image_width);
 
-// Everything morph-120hz does beyond the sequence options (temporal/core/runner.h). The defaults here are the
+// Everything morph-120hz does beyond the sequence options (temporal/io/runner.h). The defaults here are the
 // tool's defaults (the command line binds to these fields through morph_stage_params()).
 struct MorphStageOptions {
   MorphOptions morph;    // the method and its parameters
@@ -61,8 +62,18 @@ struct MorphStageOptions {
 // perceive and its window, then each registered method's own parameters (a flag listed by several methods once).
 ParamList morph_stage_params(MorphStageOptions& options);
 
+// The file and colour-management services the stage needs for two options, given by the caller so that the
+// morph stage links no image or colour library (the tool passes the io stage's read_exr and ColorConfig):
+//  - read_rgb: the R,G,B of one image file (the --lag-reference frames);
+//  - display_gamma: the power-law exponent of a display colour space in an OpenColorIO config (--display).
+struct MorphStageIO {
+  std::function<Expected<Image>(const std::string& path)> read_rgb;
+  std::function<Expected<float>(const std::string& display, const std::string& ocio_config)> display_gamma;
+};
+
 // The stage for these options. Errors (before any frame is read): Usage for invalid options (unknown method,
-// factor < 2, a grid that is not a power of two), the colour config's errors for `display`.
-Expected<std::unique_ptr<FrameStage>> make_morph_stage(const MorphStageOptions& options);
+// factor < 2, a grid that is not a power of two), the colour config's errors for `display`; Usage when an
+// option needs a service that `io` lacks.
+Expected<std::unique_ptr<FrameStage>> make_morph_stage(const MorphStageOptions& options, const MorphStageIO& io = {});
 
 }  // namespace temporal

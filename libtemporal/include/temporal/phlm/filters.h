@@ -1,11 +1,11 @@
 // The methods of `filter-phlm` as units: one registry line per method (src/phlm/registry.cpp), each with its
 // parameters, the G-buffer layers it reads and a factory; adding a method is one source file, one registry line and
 // its section in docs/filter-phlm.md. The tool binds every method's parameters to its command line from here, and
-// runs the chosen method through the sequence runner (temporal/core/runner.h).
+// runs the chosen method through the sequence runner (temporal/io/runner.h).
 #pragma once
 
 #include "temporal/core/params.h"
-#include "temporal/core/runner.h"
+#include "temporal/core/stage.h"
 #include "temporal/phlm/ema.h"
 #include "temporal/phlm/frame_filter.h"
 #include "temporal/phlm/fxaa.h"
@@ -48,7 +48,7 @@ const FilterMethod* find_filter_method(std::string_view name);
 // "phlm | taa | ema | fxaa" (for help texts).
 std::string filter_method_names();
 
-// The runner stage of filter-phlm (temporal/core/runner.h): selects the layer's channels of each frame, feeds the
+// The runner stage of filter-phlm (temporal/io/runner.h): selects the layer's channels of each frame, feeds the
 // method with the frame's motion (and depth and ids), times it and saves / resumes its state. Usage error for an
 // unknown method or invalid parameters.
 Expected<std::unique_ptr<FrameStage>> make_filter_stage(const FilterOptions& options);

@@ -6,8 +6,8 @@
 #pragma once
 
 #include "temporal/core/error.h"
-#include "temporal/core/runner.h"
-#include "temporal/metrics/comparison.h"
+#include "temporal/io/runner.h"
+#include "temporal/compare/comparison.h"
 #include "temporal/pictures/display.h"
 #include "temporal/pictures/html.h"
 #include "temporal/pictures/profile.h"

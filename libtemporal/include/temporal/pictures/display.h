@@ -4,7 +4,7 @@
 // code values. NaN / Inf pixels are shown in kNonFiniteColor (magenta).
 #pragma once
 
-#include "temporal/core/color.h"
+#include "temporal/io/color_config.h"
 #include "temporal/core/error.h"
 #include "temporal/core/image.h"
 #include "temporal/pictures/picture.h"

@@ -10,7 +10,7 @@
 #pragma once
 
 #include "temporal/core/error.h"
-#include "temporal/metrics/comparison.h"
+#include "temporal/compare/comparison.h"
 #include "temporal/pictures/sheet.h"
 
 #include <string>

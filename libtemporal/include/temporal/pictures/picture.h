@@ -1,5 +1,5 @@
 // Pictures: 8-bit RGB rasters for people to look at (display-encoded frames, heat maps, contact sheets, video
-// frames) and their PNG / JPEG files. Data stays in EXR (temporal/core/exr.h); a Picture is what a screen shows,
+// frames) and their PNG / JPEG files. Data stays in EXR (temporal/io/exr.h); a Picture is what a screen shows,
 // already display-encoded (temporal/pictures/display.h), so nothing here knows about colour spaces.
 //
 // Pixel (x, y) is x to the right, y down from the top-left corner, as everywhere in the suite

@@ -7,7 +7,7 @@
 #pragma once
 
 #include "temporal/core/error.h"
-#include "temporal/metrics/comparison.h"
+#include "temporal/compare/comparison.h"
 
 #include <optional>
 #include <string>
@@ -97,7 +97,7 @@ class VirtualDisplay {
 };
 
 // The charts of `--plot F.EXT` (EXT = png, svg or pdf): the file name and the chart. One per measured metric, as
-// its registry entry names it (temporal/metrics/comparison.h): F.EXT per-frame PSNR (RGB); F-psnr-y.EXT,
+// its registry entry names it (temporal/compare/comparison.h): F.EXT per-frame PSNR (RGB); F-psnr-y.EXT,
 // F-ssim.EXT, F-flicker.EXT (only when there are two frames or more), F-flip.EXT with --flip; F-speed.EXT: mean
 // PSNR against the mean compute time of each test whose headers time the method itself
 // (ComputeKind::Method: never a render's or a simulation's time), when there is one. Titles are the metric's,

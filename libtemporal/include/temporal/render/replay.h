@@ -5,7 +5,7 @@
 #pragma once
 
 #include "temporal/core/error.h"
-#include "temporal/core/exr.h"
+#include "temporal/io/exr.h"
 #include "temporal/core/sequence.h"
 #include "temporal/render/render.h"
 #include "temporal/scene/scene.h"

@@ -1,5 +1,5 @@
 // One `compare` run, everything it writes, in one call (the tool only binds options and prints): the comparison
-// (temporal/metrics/comparison.h) with its pictures made while the frames stream (temporal/pictures), then the
+// (temporal/compare/comparison.h) with its pictures made while the frames stream (temporal/pictures), then the
 // CSV, the JSON, the charts (temporal/plot, on a virtual display when needed) and the HTML report page.
 //
 // Outputs that fail do not stop the others: each failure is kept in CompareRun::output_errors (the tool exits 4
@@ -8,7 +8,7 @@
 #pragma once
 
 #include "temporal/core/error.h"
-#include "temporal/metrics/comparison.h"
+#include "temporal/compare/comparison.h"
 #include "temporal/pictures/comparison_pictures.h"
 
 #include <string>

@@ -1,10 +1,10 @@
-// The upsampling stage as the sequence runner runs it (temporal/core/runner.h): upsample-st is this stage plus
+// The upsampling stage as the sequence runner runs it (temporal/io/runner.h): upsample-st is this stage plus
 // its command line. The runner reads each frame (the `--layer` payload and the G-buffer layers of the method),
 // handles the frame list, resets and state files; the stage selects the channels, upsamples and fills the
 // output header.
 #pragma once
 
-#include "temporal/core/runner.h"
+#include "temporal/core/stage.h"
 #include "temporal/upsample/upsample.h"
 
 #include <optional>

@@ -1,7 +1,7 @@
-// CSV, JSON and chart descriptions of a comparison (temporal/metrics/comparison.h). Formats in docs/compare.md.
-#include "temporal/metrics/comparison.h"
+// CSV, JSON and chart descriptions of a comparison (temporal/compare/comparison.h). Formats in docs/compare.md.
+#include "temporal/compare/comparison.h"
 
-#include "temporal/core/atomic_file.h"
+#include "temporal/io/atomic_file.h"
 
 #include <nlohmann/json.hpp>
 

@@ -1,5 +1,5 @@
-// Atomic outputs (temporal/core/atomic_file.h).
-#include "temporal/core/atomic_file.h"
+// Atomic outputs (temporal/io/atomic_file.h).
+#include "temporal/io/atomic_file.h"
 
 #include <signal.h>
 #include <unistd.h>

@@ -1,18 +1,18 @@
-// Frame-by-frame comparison of test sequences against a reference (temporal/metrics/comparison.h).
+// Frame-by-frame comparison of test sequences against a reference (temporal/compare/comparison.h).
 //
 // Streaming: each frame's reference, G-buffer and test files are read, measured and dropped; what survives a
 // frame is the luminance of the reference and of each test (for flicker) and the metric rows. Only the layers
 // that are compared (plus `motion` and the mask) are read from the multi-part files. The engine prepares what
 // several metrics share (validity, luminance, the motion-compensated change of luminance, the error-map image);
 // the metrics themselves are the registry's (registry.cpp).
-#include "temporal/metrics/comparison.h"
+#include "temporal/compare/comparison.h"
 
-#include "temporal/core/exr.h"
+#include "temporal/io/exr.h"
 #include "temporal/metrics/flicker.h"
 #include "temporal/core/image.h"
 #include "temporal/metrics/metrics.h"
 #include "temporal/core/reproject.h"
-#include "temporal/core/runner.h"
+#include "temporal/io/runner.h"
 
 #include <algorithm>
 #include <chrono>

@@ -1,8 +1,8 @@
-// The entries of compare's metric registry (temporal/metrics/comparison.h), one function per metric source
+// The entries of compare's metric registry (temporal/compare/comparison.h), one function per metric source
 // file. Private to the metrics stage.
 #pragma once
 
-#include "temporal/metrics/comparison.h"
+#include "temporal/compare/comparison.h"
 
 namespace temporal {
 

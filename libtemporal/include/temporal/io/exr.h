@@ -47,6 +47,10 @@ Expected<Image> read_exr(const std::string& path, const ExrSelection& selection 
 
 // Writes atomically: a temporary file beside `path` is written and then renamed over it, so an
 // interrupted run never leaves a truncated EXR. Creates missing parent folders.
+// The R, G, B channels of `path` (read_exr with the selection {"rgb"}): the reader handed to stages that read
+// one extra image per frame without linking this stage (MorphStageIO::read_rgb).
+Expected<Image> read_exr_rgb(const std::string& path);
+
 Status write_exr(const std::string& path, const Image& image, const ExrWriteOptions& options = {});
 
 // Parses `none|zip|piz|dwaa`.

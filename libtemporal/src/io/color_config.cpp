@@ -1,5 +1,5 @@
 // Colour management through OpenColorIO 2.1 (no built-in config before 2.2: one is built here in code).
-#include "temporal/core/color.h"
+#include "temporal/io/color_config.h"
 
 #include "temporal/core/image.h"
 #include "temporal/core/parallel.h"
@@ -162,6 +162,12 @@ Status ColorConfig::convert(Image& image, std::span<const std::string> rgb_chann
   }, 16);
   if (!failure.empty()) return Error::internal("OpenColorIO: " + failure);
   return {};
+}
+
+Expected<float> load_display_gamma(const std::string& space, const std::string& config_path) {
+  auto config = ColorConfig::load(config_path);
+  if (!config) return config.error();
+  return config->display_gamma(space);
 }
 
 }  // namespace temporal

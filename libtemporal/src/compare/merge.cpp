@@ -1,8 +1,8 @@
-// Per-shard comparisons merged into one (temporal/metrics/comparison.h, read_comparison_csv and
+// Per-shard comparisons merged into one (temporal/compare/comparison.h, read_comparison_csv and
 // merge_comparisons): a long sequence compared as several frame ranges on different machines gives exactly the
 // single run's per-frame values (each shard primes its first frame's flicker from the frame before it, and the
 // CSV stores every value so that it reads back as the same double), hence exactly its means and intervals.
-#include "temporal/metrics/comparison.h"
+#include "temporal/compare/comparison.h"
 
 #include <algorithm>
 #include <charconv>

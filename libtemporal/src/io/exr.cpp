@@ -1,7 +1,7 @@
 // OpenEXR I/O through OpenImageIO: multi-part files (one part per layer), planar images, atomic writes.
-#include "temporal/core/exr.h"
+#include "temporal/io/exr.h"
 
-#include "temporal/core/atomic_file.h"
+#include "temporal/io/atomic_file.h"
 
 #include <OpenEXR/openexr.h>
 #include <OpenImageIO/imageio.h>
@@ -465,7 +465,7 @@ Status write_exr(const std::string& path, const Image& image, const ExrWriteOpti
     specs.push_back(std::move(spec));
   }
 
-  // Hidden temporary file beside the target (temporal/core/atomic_file.h), renamed over it when complete.
+  // Hidden temporary file beside the target (temporal/io/atomic_file.h), renamed over it when complete.
   TemporaryFile file(path);
   const std::string& tmp = file.path();
 
@@ -515,5 +515,7 @@ Status write_exr(const std::string& path, const Image& image, const ExrWriteOpti
                                    " (is the disk full or the folder read-only?)");
   return file.commit();
 }
+
+Expected<Image> read_exr_rgb(const std::string& path) { return read_exr(path, ExrSelection{{"rgb"}}); }
 
 }  // namespace temporal

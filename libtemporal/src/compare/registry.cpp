@@ -1,4 +1,4 @@
-// compare's metric registry (temporal/metrics/comparison.h): the table every output iterates. A new metric is
+// compare's metric registry (temporal/compare/comparison.h): the table every output iterates. A new metric is
 // its source file (declared in registry.h) and one line here; the order is the order of the CSV columns of the
 // later metrics, the JSON keys, the charts and the summary table.
 #include "registry.h"

@@ -14,7 +14,7 @@
 
 #include "temporal/core/error.h"
 #include "temporal/core/metadata.h"
-#include "temporal/core/runner.h"
+#include "temporal/io/runner.h"
 #include "temporal/core/sequence.h"
 #include "temporal/metrics/flip.h"
 #include "temporal/metrics/statistics.h"
@@ -257,7 +257,7 @@ struct ComparedFrame {
 };
 
 // Observers of a running comparison (the library never prints; the tool decides what to show): the runner's
-// hooks (temporal/core/runner.h), frame_done after each frame, warnings (e.g. NaN pixels found), --verbose lines;
+// hooks (temporal/io/runner.h), frame_done after each frame, warnings (e.g. NaN pixels found), --verbose lines;
 // and `frame`, called with the images of each frame once every test is measured (an error stops the run).
 struct ComparisonHooks : RunHooks {
   ComparisonHooks() = default;
