@@ -22,6 +22,8 @@ find_package(CLI11 CONFIG REQUIRED)
 # export every gl* symbol, and an executable that loads libGL first silently breaks OSMesa.
 pkg_check_modules(OSMESA REQUIRED IMPORTED_TARGET osmesa)
 find_package(TinyGLTF CONFIG REQUIRED)
+# stb_image (libstb, the library tinygltf decodes glTF images with) decodes USD textures too.
+pkg_check_modules(STB REQUIRED IMPORTED_TARGET stb)
 
 find_package(MPI REQUIRED COMPONENTS C)
 set(TEMPORAL_VTK_COMPONENTS CommonCore CommonDataModel ChartsCore ViewsContext2D RenderingContext2D
