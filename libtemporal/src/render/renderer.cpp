@@ -1,5 +1,5 @@
-// render-gbuffer's frame loop in OpenGL (OSMesa's llvmpipe or an EGL device, gl_api.h): light maps, G-buffers, deferred payload
-// shading, read-back into planar images. docs/render-gbuffer.md explains every choice made here.
+// render-gbuffer's frame loop in OpenGL (OSMesa's llvmpipe or an EGL device, gl_api.h): light maps, G-buffers,
+// deferred payload shading, read-back into planar images. docs/render-gbuffer.md explains every choice made here.
 #include "temporal/render/render.h"
 
 #include "gl_api.h"

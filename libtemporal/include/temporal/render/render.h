@@ -190,8 +190,8 @@ struct RenderedFrame {
 
 class Renderer {
  public:
-  // Creates the OpenGL context (RenderOptions::gl; LP_NUM_THREADS must already be set for llvmpipe), compiles the shaders and uploads the
-  // scene's geometry and textures. Usage errors for bad sizes/factors; Internal when OpenGL fails.
+  // Creates the OpenGL context (RenderOptions::gl; LP_NUM_THREADS must already be set for llvmpipe), compiles
+  // the shaders and uploads the scene's geometry and textures. Usage errors for bad sizes/factors; Internal when OpenGL fails.
   static Expected<Renderer> create(const RenderOptions& options, const SceneGeometry& scene);
 
   // Renders one frame. The FrameState's instances must refer to the SceneGeometry given to create().
