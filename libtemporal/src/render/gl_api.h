@@ -118,7 +118,7 @@ class GlContext {
   // What made the context: kind "osmesa" or "egl", the EGL device index (-1 for OSMesa), and GL_VENDOR,
   // GL_RENDERER, GL_VERSION as the driver reports them.
   const GlInfo& info() const { return info_; }
-  // "llvmpipe (LLVM 15.0.6, 256 bits), OpenGL 4.5 (Core Profile) Mesa 22.3.6"
+  // "llvmpipe (LLVM 15.0.6, 256 bits), OpenGL 4.5 (Core Profile) Mesa 22.3.6 (egl device 0)"
   std::string description() const;
   // Makes this context current on the calling thread again.
   virtual void make_current() = 0;
