@@ -123,7 +123,7 @@ def load(path):
     """The registry of the tool at PATH."""
     tool = os.path.basename(path)
     if not (os.path.isfile(path) and os.access(path, os.X_OK)):
-        raise SystemExit(f"methods.py: {path} is not built")
+        raise SystemExit(f"methods.py: {path} is not built: build the tools first (docs/pipelines.md, \"Running it\")")
     listing = _ask(path, "--list-methods")
     list_entries, suffixes = _from_list(listing) if listing is not None else ([], [])
     text = _ask(path, "--list-methods-json")
