@@ -35,8 +35,9 @@
 # the per-frame SSAO / VPL noise, which no upsampler is asked to remove; it is optional.
 #
 # Costs: shading ms are render-gbuffer's `shadeLow` (payload at 1/FACTOR resolution) and `shadeFull` (the same
-# payload at full resolution) from timings.csv, upsampling ms are upsample-st's `temporal:computeMs` (mean
-# over frames, as printed by compare). Both are measured on this machine (llvmpipe for the shading).
+# payload at full resolution) from timings.csv, upsampling ms are upsample-st's `temporal:computeMs` (compare's
+# mean over frames, from its JSON). Both are measured on this machine (llvmpipe for the shading). The tables are
+# pipelines/tables.py's; herzog's margins are compare's paired differences.
 # shellcheck source=pipelines/lib.sh
 source "$(dirname "${BASH_SOURCE[0]}")/lib.sh"
 
