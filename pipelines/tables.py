@@ -7,9 +7,9 @@ this module only picks and formats them. The few numbers compare does not comput
 Tables:
   tables.py scenes OUT_DIR SCENE[,SCENE...] SEQ[,SEQ...] [A:B,A:B...]
       per scene (OUT_DIR/SCENE/metrics.json): mean PSNR (RGB) over frames with its 95% interval and the
-      steady-state mean (after compare's --warmup frames), mean flicker; the mean over the scenes; then the paired
-      differences A - B (PSNR, and flicker) with their 95% intervals for each PAIR "A:B" (names as given to compare
-      --names)
+      steady-state mean (after compare's --warmup frames), mean flicker; the mean of those over the scenes (not
+      compare's: one compare run sees one scene); then the paired differences A - B (PSNR, and flicker) with
+      their 95% intervals for each PAIR "A:B" (names as given to compare --names)
   tables.py scenes-by-row OUT_DIR ...
       the same, with the paired differences one row per pair and one column per scene, PSNR only (ablations)
   tables.py upsample-st SCENE_DIR SHADE_LOW_MS SHADE_FULL_MS [SS_JSON SS_LABEL]
@@ -17,8 +17,8 @@ Tables:
       compute_ms), total, full-resolution shade ms, speed-up, PSNR, and the PSNR against the supersampled reference
       of SS_JSON; then herzog's margins over spatial and temporal (compare's paired differences)
   tables.py tuning TUNING.csv
-      one table per method of the sweep (rows: setting; columns: tuning sequences, mean PSNR, mean flicker), the
-      chosen setting (highest mean PSNR over the sequences) stated under it
+      one table per method of the sweep (rows: setting; columns: tuning sequences, the mean of compare's means
+      over the sequences, PSNR and flicker), the chosen setting (highest mean PSNR over the sequences) under it
   tables.py tuning-rows METRICS_JSON SEQUENCE RUN...
       rows "method,setting,sequence,psnr_rgb_db,flicker" of TUNING.csv: RUN i ("METHOD SETTING ...") is compare's
       sequence named i
@@ -30,11 +30,12 @@ Tables:
   tables.py paired-rows JSON SCENE SCORE METRIC
       rows "scene,score,metric,a,b,frames,mean_difference_db,ci_low,ci_high" of compare's paired differences
   tables.py morph-summary SUMMARY.csv
-      the Markdown rows of morph-120hz.sh's summary table
+      morph-120hz.sh's summary table (Markdown) from its summary.csv
 Numbers compare does not compute (see that section):
   tables.py csv-mean CSV COLUMN [DIGITS]          mean of a column (render-gbuffer's timings.csv)
-  tables.py csv-row-sum-mean CSV FIRST_COLUMN [DIGITS]  mean over rows of the sum of the columns from FIRST_COLUMN
-  tables.py mean [DIGITS] / median [DIGITS]       of the numbers on stdin (one per line)
+  tables.py pass-ms-mean TIMINGS.csv [DIGITS]     mean over frames of the sum of render-gbuffer's pass columns
+  tables.py mean [DIGITS]                         of the numbers on stdin (one per line; the lagMs headers)
+  tables.py median-ms                             of the runs timed as "START END" lines on stdin (seconds)
   tables.py per-frame TOTAL COUNT [MINUS]         (TOTAL - MINUS) / COUNT, %.2f
   tables.py regions FACTOR M.csv S.csv C.csv L.csv METHOD...   morph-120hz-regions.sh's split of the error
 Fields compare does not write (an older compare without intervals) are shown as "n/a".
