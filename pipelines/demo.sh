@@ -12,7 +12,7 @@
 # shellcheck source=pipelines/lib.sh
 source "$(dirname "${BASH_SOURCE[0]}")/lib.sh"
 
-use_build "${1:-build/release}"
+use_build "${1:-}"
 REPORT="${2:-report/demo}"
 case "$REPORT" in /*) ;; *) REPORT="$PWD/$REPORT" ;; esac
 SCENE="${SCENE:-$ROOT/assets/scenes/walkers.glb}"

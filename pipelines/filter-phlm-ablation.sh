@@ -17,7 +17,7 @@
 #   FRAMES, FPS, RENDER_ARGS, WARMUP (the renders must match them).
 # shellcheck source=pipelines/lib.sh
 source "$(dirname "${BASH_SOURCE[0]}")/lib.sh"
-use_build "${1:-build/release}"
+use_build "${1:-}"
 OUT="${2:-report/filter-phlm-ablation}"
 shift $(( $# > 2 ? 2 : $# ))
 export RENDERS="${RENDERS:-report/filter-phlm}"

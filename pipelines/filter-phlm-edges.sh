@@ -22,7 +22,7 @@
 # shellcheck source=pipelines/lib.sh
 source "$(dirname "${BASH_SOURCE[0]}")/lib.sh"
 
-use_build "${1:-build/release}"
+use_build "${1:-}"
 OUT="${2:-report/filter-phlm-edges}"
 SIZE="${SIZE:-512x288}"
 FRAMES="${FRAMES:-0-47}"

@@ -34,7 +34,7 @@
 # shellcheck source=pipelines/lib.sh
 source "$(dirname "${BASH_SOURCE[0]}")/lib.sh"
 
-use_build "${1:-build/release}"
+use_build "${1:-}"
 OUT="${2:-report/filter-phlm-tune}"
 SIZE="${SIZE:-512x288}"
 FPS="${FPS:-40}"
@@ -85,7 +85,7 @@ while read -r name scene frames opts; do
   i=0
   rm -rf "$dir/runs"
   for run in "${runs[@]}"; do
-    read -r method label args <<< "$run"
+    read -r method _ args <<< "$run"  # the setting label is for tuning.csv
     out="$dir/runs/$i/$method.####.exr"
     # shellcheck disable=SC2086
     "$filter" --input "$dir/render/color.####.exr" --gbuffer "$dir/render/gbuffer.####.exr" --out "$out" \

@@ -31,7 +31,7 @@
 # shellcheck source=pipelines/lib.sh
 source "$(dirname "${BASH_SOURCE[0]}")/lib.sh"
 
-use_build "${1:-build/release}"
+use_build "${1:-}"
 OUT="${2:-report/filter-phlm}"
 shift $(( $# > 2 ? 2 : $# ))
 SIZE="${SIZE:-512x288}"

@@ -2,7 +2,7 @@
 # pipelines/lib.sh: the preamble every script of pipelines/ sources (docs/pipelines.md, "lib.sh"):
 #
 #   source "$(dirname "${BASH_SOURCE[0]}")/lib.sh"
-#   use_build "${1:-build/release}"              # BUILD: absolute build folder
+#   use_build "${1:-}"                          # BUILD: absolute build folder
 #   require_tools render-gbuffer filter-phlm compare
 #   filter="$(tool_path filter-phlm)"
 #   METHODS="${METHODS:-$(methods_of filter-phlm)}"
@@ -14,7 +14,6 @@ set -euo pipefail
 
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 PIPELINE="$(basename "${BASH_SOURCE[1]:-$0}")"
-BUILD=""
 # The one table formatter (pipelines/tables.py) and the registry helper, for the sourcing scripts.
 # shellcheck disable=SC2034
 TABLES="$ROOT/pipelines/tables.py"
@@ -28,10 +27,11 @@ die() {
   exit "${2:-2}"
 }
 
-# use_build DIR: the build folder holding apps/<tool>/<tool>. A relative DIR is taken from the current folder
+# use_build DIR: sets BUILD, the build folder holding apps/<tool>/<tool>: DIR (the script's BUILD_DIR argument),
+# else the BUILD environment variable, else build/release. A relative folder is taken from the current folder
 # when it exists there, else from the repository root (so a script works from any folder).
 use_build() {
-  BUILD="$1"
+  BUILD="${1:-${BUILD:-build/release}}"
   case "$BUILD" in
     /*) ;;
     *) if [[ -d "$PWD/$BUILD" ]]; then BUILD="$PWD/$BUILD"; else BUILD="$ROOT/$BUILD"; fi ;;

@@ -16,7 +16,7 @@
 # Environment: morph-120hz.sh's SIZE, FRAMES, REPEAT (default 1 here: the timings are not the point).
 # shellcheck source=pipelines/lib.sh
 source "$(dirname "${BASH_SOURCE[0]}")/lib.sh"
-use_build "${1:-build/release}"
+use_build "${1:-}"
 OUT="${2:-report/morph-120hz-ablation}"
 shift $(( $# > 2 ? 2 : $# ))
 export METHODS="didyk repeat warp"

@@ -25,7 +25,7 @@
 # shellcheck source=pipelines/lib.sh
 source "$(dirname "${BASH_SOURCE[0]}")/lib.sh"
 D=${1:?usage: morph-120hz-regions.sh SCENE_DIR [BUILD_DIR]}
-use_build "${2:-build/release}"
+use_build "${2:-}"
 require_tools compare
 COMPARE="$(tool_path compare)"
 FACTOR=3

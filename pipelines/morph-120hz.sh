@@ -24,7 +24,7 @@
 # shellcheck source=pipelines/lib.sh
 source "$(dirname "${BASH_SOURCE[0]}")/lib.sh"
 
-use_build "${1:-build/release}"
+use_build "${1:-}"
 OUT=${2:-report/morph-120hz}
 shift $(( $# >= 2 ? 2 : $# ))
 SIZE=${SIZE:-256x256}
@@ -140,7 +140,6 @@ for scene in "${SCENES[@]}"; do
     tests+=("$D/$m/color.####.exr")
   done
 
-  ffmpeg_ms=""
   if (( have_ffmpeg )); then
     echo "== $name: ffmpeg minterpolate" >&2
     # ffmpeg reads single-part EXR (not DWA): take the colour part as half/ZIP, interpolate, write float EXR.

@@ -21,7 +21,7 @@
 #   lines "NAME herzog OPTIONS").
 # shellcheck source=pipelines/lib.sh
 source "$(dirname "${BASH_SOURCE[0]}")/lib.sh"
-use_build "${1:-build/release}"
+use_build "${1:-}"
 OUT="${2:-report/upsample-st-ablation}"
 shift $(( $# > 2 ? 2 : $# ))
 export METHODS="${METHODS:-spatial temporal herzog}"

@@ -41,7 +41,7 @@
 # shellcheck source=pipelines/lib.sh
 source "$(dirname "${BASH_SOURCE[0]}")/lib.sh"
 
-use_build "${1:-build/release}"
+use_build "${1:-}"
 OUT="${2:-report/upsample-st}"
 shift $(( $# > 2 ? 2 : $# ))
 SIZE="${SIZE:-640x512}"
