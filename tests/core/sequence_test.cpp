@@ -25,6 +25,29 @@ TEST(FrameRange, Parses) {
   EXPECT_EQ(FrameRange::parse("x").error().kind, ErrorKind::Usage);
 }
 
+// oiiotool's frame lists: x N every Nth frame, y N all but every Nth (a 40 -> 120 Hz study's rendered and
+// in-between frames).
+TEST(FrameRange, EveryNthAndAllButEveryNth) {
+  auto x = FrameRange::parse("0-10x3");
+  ASSERT_TRUE(x);
+  EXPECT_EQ(x->frames(), (std::vector<int>{0, 3, 6, 9}));
+  EXPECT_EQ(x->count(), 4);
+  auto y = FrameRange::parse("0-10y3");
+  ASSERT_TRUE(y);
+  EXPECT_EQ(y->frames(), (std::vector<int>{1, 2, 4, 5, 7, 8, 10}));
+  EXPECT_EQ(y->count(), 7);
+  EXPECT_TRUE(y->contains(5));
+  EXPECT_FALSE(y->contains(6));
+  EXPECT_FALSE(y->contains(11));
+  auto x1 = FrameRange::parse("4-6x1");
+  ASSERT_TRUE(x1);
+  EXPECT_EQ(x1->frames(), (std::vector<int>{4, 5, 6}));
+  EXPECT_EQ(FrameRange::parse("0-10x0").error().kind, ErrorKind::Usage);
+  EXPECT_FALSE(FrameRange::parse("0-10y1"));  // selects no frame
+  EXPECT_FALSE(FrameRange::parse("0-10x"));
+  EXPECT_FALSE(FrameRange::parse("0-10z3"));
+}
+
 TEST(SequencePattern, HashesAndPrintf) {
   auto hashes = SequencePattern::parse("dir/gbuffer.####.exr");
   ASSERT_TRUE(hashes);

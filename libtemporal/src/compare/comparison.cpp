@@ -95,16 +95,32 @@ class Run {
     // A range that starts after the first frame on disk (a shard of a longer sequence) first reads the frame
     // before it, without reporting it: the first compared frame then gets the flicker value a single run over the
     // whole sequence gives it, and per-shard results merge exactly (docs/compare.md, "Shards").
-    std::vector<int> order = report_.frames;
+    std::vector<int> order;
     // The latency of each test, from its first compared frame's header (docs/conventions.md, "Latency").
     if (setup_.latency_aware)
       for (auto& t : tests_)
         if (auto st = read_latency(t); !st) return st.error();
-    const bool prime = setup_.frames && previous_frame_exists(report_.frames.front() - 1);
-    if (prime) order.insert(order.begin(), report_.frames.front() - 1);
+    // The same for every gap of a stepped list (--frames 0-47y3): the frame before each selected frame whose
+    // predecessor is not selected is read for its history and not reported, so that each compared frame's flicker
+    // is its change from the frame before it, whichever frames are listed. Without that frame on disk the compared
+    // frame has no flicker value (as after a cut).
+    std::vector<bool> primes;
+    for (std::size_t i = 0; i < report_.frames.size(); ++i) {
+      const int f = report_.frames[i];
+      const bool gap_before = i == 0 ? bool(setup_.frames) : report_.frames[i - 1] != f - 1;
+      if (gap_before && previous_frame_exists(f - 1)) {
+        order.push_back(f - 1);
+        primes.push_back(true);
+      }
+      order.push_back(f);
+      primes.push_back(false);
+    }
+    std::size_t reported = 0;
     for (std::size_t fi = 0; fi < order.size(); ++fi) {
       const int frame = order[fi];
-      priming_ = prime && fi == 0;
+      priming_ = primes[fi];
+      // No history across a gap that no primed frame fills.
+      if (fi > 0 && order[fi - 1] != frame - 1) ref_has_prev_ = false;
       shown_.erase(shown_.begin(), shown_.lower_bound(frame));  // frames before this one are never shown again
       if (auto st = reference_frame(fi, frame); !st) return st.error();
       for (auto& t : tests_) {
@@ -114,13 +130,13 @@ class Run {
       if (ref_invalid_ && !priming_)
         warn(ref_path_, std::to_string(ref_invalid_) + " pixels hold NaN or Inf; they are excluded from every metric");
       if (hooks_.frame && !priming_)  // the observer sees the compared frames only, indexed among them
-        if (auto st = observe(fi - (prime ? 1 : 0), frame); !st) return st.error();
+        if (auto st = observe(reported, frame); !st) return st.error();
       for (std::size_t i = 0; i < n_; ++i)
         if (!ref_valid_[i]) ref_y_[i] = std::numeric_limits<float>::quiet_NaN();
       std::swap(ref_y_, ref_prev_y_);
       ref_has_prev_ = true;
-      if (hooks_.frame_done && !priming_)
-        hooks_.frame_done(frame, int(fi + (prime ? 0 : 1)), int(report_.frames.size()));
+      if (!priming_) ++reported;
+      if (hooks_.frame_done && !priming_) hooks_.frame_done(frame, int(reported), int(report_.frames.size()));
     }
     priming_ = false;
     for (auto& t : tests_) {

@@ -43,8 +43,35 @@ Expected<FrameRange> FrameRange::parse(std::string_view text) {
   return checked;
 }
 
+std::vector<int> FrameRange::frames() const {
+  std::vector<int> out;
+  for (int f = first; f <= last && f >= first; ++f)  // f >= first: no wrap at INT_MAX
+    if (contains(f)) out.push_back(f);
+  return out;
+}
+
+int FrameRange::count() const {
+  const long long all = (long long)last - first + 1;
+  const long long on_step = (all + step - 1) / step;
+  return int(complement ? all - on_step : on_step);
+}
+
 Expected<FrameRange> FrameRange::parse_unchecked(std::string_view text) {
   text = trim(text);
+  // oiiotool's "A-BxN" (every Nth) and "A-ByN" (all but every Nth).
+  if (const auto mark = text.find_first_of("xy"); mark != std::string_view::npos) {
+    int step = 0;
+    if (!parse_int(text.substr(mark + 1), step) || step < 1)
+      return Error::usage("--frames '" + std::string(text) + "': after x or y comes the period N >= 1 (e.g. 0-47x3: every "
+                          "third frame; 0-47y3: all but every third)");
+    auto r = parse_unchecked(text.substr(0, mark));
+    if (!r) return r;
+    r->step = step;
+    r->complement = text[mark] == 'y';
+    if (r->count() == 0)
+      return Error::usage("--frames " + std::string(text) + " selects no frame");
+    return r;
+  }
   // A leading '-' belongs to a negative first frame, so look for the separator after the first character.
   const auto dash = text.find('-', 1);
   FrameRange r;
@@ -141,14 +168,11 @@ Expected<std::vector<int>> resolve_frames(const SequencePattern& pattern, const 
   if (!pattern.has_placeholder()) {
     if (!fs::exists(pattern.pattern()))
       return Error::input(pattern.pattern(), "no such file (for a sequence, put #### or %04d where the frame number goes)");
-    if (range) {
-      for (int f = range->first; f <= range->last; ++f) frames.push_back(f);
-      return frames;
-    }
+    if (range) return range->frames();
     return std::vector<int>{0};
   }
   if (range) {
-    for (int f = range->first; f <= range->last; ++f) {
+    for (int f : range->frames()) {
       if (!fs::exists(pattern.path(f)))
         return Error::input(pattern.path(f), "missing: frame " + std::to_string(f) + " of --frames " +
                                                  std::to_string(range->first) + "-" + std::to_string(range->last) +

@@ -11,6 +11,8 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cmath>
+#include <numeric>
 #include <cctype>
 #include <cstdio>
 #include <cstring>
@@ -94,7 +96,26 @@ void write_metadata(ImageSpec& spec, const FrameMetadata& md) {
   if (md.near_clip) spec.attribute("clipNear", *md.near_clip);
   if (md.far_clip) spec.attribute("clipFar", *md.far_clip);
   if (md.frame) spec.attribute("temporal:frame", *md.frame);
-  if (md.fps) spec.attribute("temporal:fps", float(*md.fps));
+  if (md.fps) {
+    spec.attribute("temporal:fps", float(*md.fps));
+    // OpenEXR's standard framesPerSecond (a rational) too, for tools that read only the standard attributes
+    // (ffmpeg, Nuke, oiiotool): fps as a fraction with denominator 1000 (or 1001 for the NTSC rates), reduced.
+    const double fps = *md.fps;
+    if (std::isfinite(fps) && fps > 0.0 && fps < 1e6) {
+      const double ntsc_num = fps * 1001.0;  // 29.97 = 30000/1001: an integer multiple of 1000 over 1001
+      const bool ntsc = std::abs(fps - std::round(fps)) > 1e-6 &&
+                        std::abs(ntsc_num / 1000.0 - std::round(ntsc_num / 1000.0)) < 1e-6;
+      const long long den = ntsc ? 1001 : 1000;
+      const long long whole = std::llround(fps * double(den));
+      const long long g = std::gcd(whole, den);
+      const int rational[2] = {int(whole / g), int(den / g)};
+      spec.attribute("FramesPerSecond", OIIO::TypeRational, rational);
+    }
+  }
+  // Every file holds scene-linear Rec.709 (docs/conventions.md): say so with OpenEXR's standard chromaticities
+  // (red, green, blue primaries and the D65 white point, CIE xy), so other tools need not assume it.
+  static const float kRec709[8] = {0.64f, 0.33f, 0.30f, 0.60f, 0.15f, 0.06f, 0.3127f, 0.3290f};
+  spec.attribute("chromaticities", TypeDesc(TypeDesc::FLOAT, 8), kRec709);
   if (md.time) spec.attribute("temporal:time", float(*md.time));
   if (md.jitter) spec.attribute("temporal:jitter", TypeDesc(TypeDesc::FLOAT, TypeDesc::VEC2), glm::value_ptr(*md.jitter));
   if (md.jitter_factor) spec.attribute("temporal:jitterFactor", *md.jitter_factor);
@@ -359,6 +380,30 @@ Expected<Image> read_exr(const std::string& path, const ExrSelection& selection)
       return Error::input(path, "part " + std::to_string(s) + " is " + std::to_string(spec.width) + "x" +
                                     std::to_string(spec.height) + " but part 0 is " + std::to_string(first.width) +
                                     "x" + std::to_string(first.height) + "; the tools need equal-size parts");
+    // The tools index pixels from the display window's corner: a shifted or cropped data window would be read
+    // as if it started there (an image shifted by (10, 7) scored inf dB against its original).
+    if (spec.x != spec.full_x || spec.y != spec.full_y || spec.width != spec.full_width ||
+        spec.height != spec.full_height)
+      return Error::input(path, "part " + std::to_string(s) + " has the data window (" + std::to_string(spec.x) + "," +
+                                    std::to_string(spec.y) + ")-(" + std::to_string(spec.x + spec.width - 1) + "," +
+                                    std::to_string(spec.y + spec.height - 1) + ") inside the display window (" +
+                                    std::to_string(spec.full_x) + "," + std::to_string(spec.full_y) + ")-(" +
+                                    std::to_string(spec.full_x + spec.full_width - 1) + "," +
+                                    std::to_string(spec.full_y + spec.full_height - 1) +
+                                    "); the tools need the two equal: pad or crop it with `oiiotool IN --croptofull -o OUT`");
+    // Integer channels are ids (`id`, `prev.id`, `history.id`, ...); any other one stored as an integer (colour as
+    // uint32) would reach code that reads it as float: refuse it by name.
+    for (int k = 0; k < spec.nchannels; ++k) {
+      const std::string& name = spec.channelnames[k];
+      const auto base = spec.channelformat(k).basetype;
+      const bool integer = base == TypeDesc::UINT32 || base == TypeDesc::INT32 || base == TypeDesc::UINT16 ||
+                           base == TypeDesc::INT16 || base == TypeDesc::UINT8 || base == TypeDesc::INT8;
+      const bool id = name == "id" || (name.size() > 3 && name.compare(name.size() - 3, 3, ".id") == 0);
+      if (integer && !id && selected(selection, name))
+        return Error::input(path, "channel '" + name + "' is stored as " + spec.channelformat(k).c_str() +
+                                      "; only id channels are integers here, colour and data are half or float: "
+                                      "convert it with `oiiotool IN -d half -o OUT`");
+    }
     // Contiguous runs of selected channels with one pixel type are read in one call each.
     const int nch = spec.nchannels;
     int c = 0;

@@ -78,7 +78,10 @@ Expected<Plan> make_plan(const SequenceOptions& o, const StageInputs& needs) {
     auto g = SequencePattern::parse(o.gbuffer);
     if (!g) return g.error();
     // Every G-buffer file of the range must exist before any work is done.
-    if (auto f = resolve_frames(*g, FrameRange{plan.frames.front(), plan.frames.back()}); !f) return f.error();
+    for (int f : plan.frames)
+      if (!std::filesystem::exists(g->path(f)))
+        return Error::input(g->path(f), "missing: the G-buffer of frame " + std::to_string(f) + " (--gbuffer) does not "
+                                        "exist; render it or narrow --frames");
     plan.gbuffer = *g;
   }
   if (!o.state_out.empty()) {

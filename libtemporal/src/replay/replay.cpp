@@ -137,7 +137,11 @@ Status replay(const Scene& scene, const RenderOptions& render, const ReplayOptio
 
   std::optional<FrameState> previous;
   if (range.first > 0) previous = scene.evaluate(double(range.first - 1) / options.fps);
-  for (int frame = range.first; frame <= range.last; ++frame) {
+  int previous_frame = range.first - 1;
+  for (int frame : range.frames()) {
+    // A stepped list (--frames 0-47x3) skips frames: the motion of frame N is always from the scene at N - 1.
+    if (frame != previous_frame + 1 && frame > 0) previous = scene.evaluate(double(frame - 1) / options.fps);
+    previous_frame = frame;
     FrameState current = scene.evaluate(double(frame) / options.fps);
     FrameInput in;
     in.frame = frame;

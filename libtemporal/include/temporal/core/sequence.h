@@ -10,15 +10,29 @@
 
 namespace temporal {
 
+// A frame range in oiiotool's syntax: "A-B" (every frame), "A" (one frame), "A-BxN" (A, A+N, A+2N, ... up to B:
+// every Nth frame) and "A-ByN" (every frame but those of A-BxN: all but every Nth). A 40 -> 120 Hz study scores
+// its in-between output frames with "0-47y3" (frames 1, 2, 4, 5, ...) and its rendered ones with "0-47x3".
 struct FrameRange {
   int first = 0;
   int last = 0;  // inclusive
-  // Parses "A-B" or "A" (one frame); "A-" is refused (the end must be given), so are negative frames and frames
-  // above 99,999,999 (usage errors).
+  int step = 1;  // x or y: the period N (1: every frame)
+  bool complement = false;  // y: every frame but every Nth
+  // Parses the forms above; "A-" is refused (the end must be given), so are negative frames, frames above
+  // 99,999,999, and N < 1 (usage errors).
   static Expected<FrameRange> parse(std::string_view text);
   // The same without the bounds (for frame lists that may name any frame).
   static Expected<FrameRange> parse_unchecked(std::string_view text);
-  int count() const { return last - first + 1; }
+  // Whether frame f is one of the range.
+  bool contains(int f) const {
+    if (f < first || f > last) return false;
+    const bool on_step = (f - first) % step == 0;
+    return complement ? !on_step : on_step;
+  }
+  // The frames of the range, ascending.
+  std::vector<int> frames() const;
+  // How many frames frames() returns.
+  int count() const;
 };
 
 class SequencePattern {

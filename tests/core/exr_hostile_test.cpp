@@ -1,0 +1,96 @@
+// EXR files the tools must refuse by name rather than misread (issue 26 items 6 and 8): a data window that differs
+// from the display window (it would be read as if it started at the corner), and colour stored as uint32 (code
+// that reads colour as float would find no plane).
+#include "temporal/io/exr.h"
+
+#include "test_support.h"
+
+#include <OpenImageIO/imageio.h>
+
+#include <tuple>
+#include <vector>
+
+namespace temporal {
+namespace {
+
+namespace fs = std::filesystem;
+
+// A one-part RGB file written by OpenImageIO directly, with the given data window origin and pixel type.
+void write_raw(const fs::path& path, int x, int y, OIIO::TypeDesc type) {
+  OIIO::ImageSpec spec(8, 4, 3, type);
+  spec.x = x;
+  spec.y = y;
+  spec.full_x = 0;
+  spec.full_y = 0;
+  spec.full_width = 8 + x;
+  spec.full_height = 4 + y;
+  spec.channelnames = {"R", "G", "B"};
+  auto out = OIIO::ImageOutput::create(path.string());
+  ASSERT_TRUE(out);
+  ASSERT_TRUE(out->open(path.string(), spec));
+  std::vector<float> pixels(8 * 4 * 3, 0.25f);
+  std::vector<std::uint32_t> ints(8 * 4 * 3, 7u);
+  ASSERT_TRUE(type == OIIO::TypeFloat ? out->write_image(OIIO::TypeFloat, pixels.data())
+                                      : out->write_image(OIIO::TypeUInt, ints.data()));
+  ASSERT_TRUE(out->close());
+}
+
+TEST(ExrHostile, ShiftedDataWindowIsRefusedByName) {
+  const fs::path dir = test::scratch_dir("exr_hostile_window");
+  write_raw(dir / "shifted.exr", 10, 7, OIIO::TypeFloat);
+  auto r = read_exr((dir / "shifted.exr").string());
+  ASSERT_FALSE(r);
+  EXPECT_EQ(r.error().kind, ErrorKind::Input);
+  EXPECT_NE(r.error().message.find("data window (10,7)"), std::string::npos) << r.error().message;
+  EXPECT_NE(r.error().message.find("--croptofull"), std::string::npos) << r.error().message;
+  write_raw(dir / "aligned.exr", 0, 0, OIIO::TypeFloat);  // the control: the same file unshifted reads
+  auto ok = read_exr((dir / "aligned.exr").string());
+  ASSERT_TRUE(ok) << ok.error().message;
+  EXPECT_FLOAT_EQ(ok->plane("G")[5], 0.25f);
+}
+
+TEST(ExrHostile, ColourStoredAsIntegersIsRefusedButIdsAreRead) {
+  const fs::path dir = test::scratch_dir("exr_hostile_uint");
+  write_raw(dir / "uint.exr", 0, 0, OIIO::TypeUInt);
+  auto r = read_exr((dir / "uint.exr").string());
+  ASSERT_FALSE(r);
+  EXPECT_EQ(r.error().kind, ErrorKind::Input);
+  EXPECT_NE(r.error().message.find("channel 'R'"), std::string::npos) << r.error().message;
+  Image ids(8, 4);
+  std::uint32_t* id = ids.add_uint_channel("id");
+  for (int i = 0; i < 32; ++i) id[i] = std::uint32_t(i * 1000003);
+  ASSERT_TRUE(write_exr((dir / "ids.exr").string(), ids));
+  auto back = read_exr((dir / "ids.exr").string());
+  ASSERT_TRUE(back) << back.error().message;
+  ASSERT_NE(back->uint_plane("id"), nullptr);
+  EXPECT_EQ(back->uint_plane("id")[31], 31u * 1000003u);
+}
+
+// Beside temporal:fps, the standard attributes other tools read (issue 25 item 8): framesPerSecond as a reduced
+// rational, and the Rec.709 / D65 chromaticities of the working space.
+TEST(ExrStandardAttributes, FramesPerSecondAndChromaticities) {
+  const fs::path dir = test::scratch_dir("exr_standard_attributes");
+  for (const auto& [fps, num, den] : {std::tuple{40.0, 40, 1}, std::tuple{120.0, 120, 1}, std::tuple{23.976, 2997, 125},
+                                      std::tuple{30000.0 / 1001.0, 30000, 1001}}) {
+    Image img = test::make_image(4, 4, {"R", "G", "B"}, 0.5f);
+    img.metadata().fps = fps;
+    const std::string path = (dir / "a.exr").string();
+    ASSERT_TRUE(write_exr(path, img));
+    auto in = OIIO::ImageInput::open(path);
+    ASSERT_TRUE(in);
+    const OIIO::ParamValue* r = in->spec().find_attribute("FramesPerSecond", OIIO::TypeRational);
+    ASSERT_NE(r, nullptr) << fps;
+    const int* v = static_cast<const int*>(r->data());
+    EXPECT_EQ(v[0], num) << fps;
+    EXPECT_EQ(v[1], den) << fps;
+    const OIIO::ParamValue* c = in->spec().find_attribute("chromaticities");
+    ASSERT_NE(c, nullptr);
+    ASSERT_EQ(c->type().basevalues(), 8u);
+    const float* xy = static_cast<const float*>(c->data());
+    EXPECT_FLOAT_EQ(xy[0], 0.64f);
+    EXPECT_FLOAT_EQ(xy[7], 0.3290f);
+  }
+}
+
+}  // namespace
+}  // namespace temporal
