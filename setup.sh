@@ -11,7 +11,7 @@ PACKAGES=(
   libopenimageio-dev openimageio-tools libopenexr-dev
   libopencolorio-dev opencolorio-tools
   libtinygltf-dev libstb-dev nlohmann-json3-dev libglm-dev
-  libosmesa6-dev
+  libosmesa6-dev libegl-dev libegl-mesa0
   libvtk9-dev xvfb xauth
   libtbb-dev libcli11-dev libfmt-dev
   libgtest-dev libgmock-dev libbenchmark-dev

@@ -22,6 +22,9 @@ find_package(CLI11 CONFIG REQUIRED)
 # export every gl* symbol, and an executable that loads libGL first silently breaks OSMesa.
 pkg_check_modules(OSMESA REQUIRED IMPORTED_TARGET osmesa)
 find_package(TinyGLTF CONFIG REQUIRED)
+# The gpu stage's compute kernels: EGL only (glvnd's libEGL); every GL entry point is loaded through
+# eglGetProcAddress, so no libGL / libOpenGL is linked (see libtemporal/src/gpu/context.cpp).
+pkg_check_modules(EGL REQUIRED IMPORTED_TARGET egl)
 
 find_package(MPI REQUIRED COMPONENTS C)
 set(TEMPORAL_VTK_COMPONENTS CommonCore CommonDataModel ChartsCore ViewsContext2D RenderingContext2D
