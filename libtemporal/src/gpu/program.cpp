@@ -83,6 +83,10 @@ void Program::set(const char* name, const float* v, int count) const {
   context_->gl().Uniform1fv(context_->gl().GetUniformLocation(program_, name), count, v);
 }
 
+void Program::set_int2(const char* name, int x, int y) const {
+  context_->gl().Uniform2i(context_->gl().GetUniformLocation(program_, name), x, y);
+}
+
 Status Program::dispatch(int width, int height) const {
   // Every image kernel reads its size from u_size (gpu::glsl::prelude); the dispatch sets it so that the size
   // and the grid cannot disagree.
