@@ -6,18 +6,23 @@
 // Time per iteration is the kernels' time (gpu::TimedKernel::last_timing: GL_TIME_ELAPSED on hardware, wall clock
 // after glFinish on llvmpipe; the `gpu_clock` counter says which: 1 = GPU queries), not the uploads and downloads
 // around them. Counters: bytes_moved (per frame), bound_ms (bytes_moved / the copy kernel's bandwidth), x_bound.
-// Each benchmark is also registered at a quarter size per axis (/480/270) for quick runs on llvmpipe:
-//   gpu_benchmark --benchmark_filter=/480/270
+// Each benchmark is also registered at a quarter size per axis (ema/taa /480/270, spatial/temporal /320/256,
+// blend/warp /256/256) for quick runs on llvmpipe:
+//   gpu_benchmark --benchmark_filter='/(480|320|256)/'
 // Without an EGL device every benchmark is skipped with the reason.
 #include "temporal/gpu/buffer.h"
 #include "temporal/gpu/glsl.h"
 #include "temporal/gpu/program.h"
 #include "temporal/gpu/timer.h"
+#include "temporal/morph/gpu_methods.h"
 #include "temporal/phlm/gpu_filters.h"
+#include "upsample_context.h"
+#include "gpu_methods.h"  // libtemporal/src/upsample (internal): the MethodState factories
 
 #include <benchmark/benchmark.h>
 
 #include <algorithm>
+#include <cmath>
 #include <map>
 #include <random>
 #include <utility>
@@ -176,9 +181,113 @@ void BM_Taa(benchmark::State& state) {
   run_filter(state, [](std::shared_ptr<gpu::Context> c) { return make_taa_filter_gpu(std::move(c)); });
 }
 
-BENCHMARK(BM_Copy)->Args({1920, 1080})->Args({480, 270})->UseManualTime()->Unit(benchmark::kMillisecond);
+// Upsampling: the method state on frames of the synthetic sequence (two warm-up frames: the first has no history).
+void run_upsample(benchmark::State& state, decltype(&upsample::make_spatial_state_gpu) make) {
+  std::string why;
+  auto ctx = context(&why);
+  if (!ctx) return state.SkipWithError(("no EGL device: " + why).c_str());
+  test::SyntheticScene scene;
+  scene.width = int(state.range(0));
+  scene.height = int(state.range(1));
+  scene.k = 4;
+  scene.camera_velocity = {0.6f, -0.4f};
+  scene.object = true;
+  scene.object_velocity = {1.5f, 0.7f};
+  scene.object_size = scene.width / 4;
+  std::vector<test::SyntheticFrame> frames;
+  for (int t = 0; t < 4; ++t) frames.push_back(test::make_frame(scene, t));
+  upsample::Options options;
+  const upsample::Geometry g = test::geometry_of(frames[0]);
+  auto method = make(ctx, options, g);
+  if (!method) return state.SkipWithError(method.error().message.c_str());
+  const auto* timed = dynamic_cast<const gpu::TimedKernel*>(method->get());
+  upsample::FrameContext f;
+  upsample::FrameStats stats;
+  int t = 0;
+  for (; t < 2; ++t) {
+    test::build_context(f, options, frames[std::size_t(t)], false, false);
+    (*method)->run(f, t > 0, stats);
+  }
+  for (auto _ : state) {
+    test::build_context(f, options, frames[std::size_t(t++ % 4)], false, false);
+    (*method)->run(f, true, stats);
+    if (!(*method)->run_status()) return state.SkipWithError((*method)->run_status().error().message.c_str());
+    state.SetIterationTime(timed->last_timing().kernel_ms * 1e-3);
+  }
+  const gpu::KernelTiming k = timed->last_timing();
+  const double rate = copy_bytes_per_ms(ctx, g.W, g.H);
+  state.counters["bytes_moved"] = k.bytes_moved;
+  state.counters["bound_ms"] = rate > 0.0 ? k.bytes_moved / rate : 0.0;
+  state.counters["x_bound"] = rate > 0.0 ? k.kernel_ms / (k.bytes_moved / rate) : 0.0;
+  state.counters["gpu_clock"] = k.clock == gpu::Clock::GpuQuery ? 1.0 : 0.0;
+  state.SetLabel(ctx->description());
+}
+void BM_Spatial(benchmark::State& state) { run_upsample(state, upsample::make_spatial_state_gpu); }
+void BM_Temporal(benchmark::State& state) { run_upsample(state, upsample::make_temporal_state_gpu); }
+
+// Morphing: one rendered frame into `factor` = 3 slots; a texture moving right, a square moving the other way
+// nearer the camera.
+void run_morph(benchmark::State& state, decltype(&make_blend_method_gpu) make) {
+  std::string why;
+  auto ctx = context(&why);
+  if (!ctx) return state.SkipWithError(("no EGL device: " + why).c_str());
+  const int w = int(state.range(0)), h = int(state.range(1));
+  Image color(w, h), next(w, h), gbuffer(w, h);
+  const char* rgb[3] = {"R", "G", "B"};
+  for (int c = 0; c < 3; ++c) {
+    float* p = color.add_channel(rgb[c]);
+    float* q = next.add_channel(rgb[c]);
+    for (int y = 0; y < h; ++y)
+      for (int x = 0; x < w; ++x) {
+        p[std::size_t(y) * w + x] = 0.35f + 0.15f * std::sin(0.45f * float(x) + 0.7f * float(c)) * std::cos(0.6f * float(y));
+        q[std::size_t(y) * w + x] = 0.35f + 0.15f * std::sin(0.45f * float(x + 7) + 0.7f * float(c)) * std::cos(0.6f * float(y));
+      }
+  }
+  float* mx = gbuffer.add_channel("motion.X");
+  float* my = gbuffer.add_channel("motion.Y");
+  float* d = gbuffer.add_channel("depth.Z");
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      const std::size_t i = std::size_t(y) * w + x;
+      const bool square = x > w / 4 && x < w / 2 && y > h / 4 && y < h / 2;
+      mx[i] = square ? 5.3f : -1.6f;
+      my[i] = square ? -2.7f : 0.9f;
+      d[i] = square ? 4.0f : 20.0f;
+    }
+  MorphOptions options;
+  options.factor = 3;
+  auto method = make(ctx, options);
+  if (!method) return state.SkipWithError(method.error().message.c_str());
+  const auto* timed = dynamic_cast<const gpu::TimedKernel*>(method->get());
+  std::vector<Image> out(3, Image(w, h));
+  for (auto& o : out)
+    for (const char* c : rgb) o.add_channel(c);
+  MorphTimings t;
+  (*method)->run(color, &gbuffer, &next, out, t);  // warm-up (allocates the buffers)
+  for (auto _ : state) {
+    (*method)->run(color, &gbuffer, &next, out, t);
+    if (!(*method)->run_status()) return state.SkipWithError((*method)->run_status().error().message.c_str());
+    state.SetIterationTime(timed->last_timing().kernel_ms * 1e-3);
+  }
+  const gpu::KernelTiming k = timed->last_timing();
+  const double rate = copy_bytes_per_ms(ctx, w, h);
+  state.counters["bytes_moved"] = k.bytes_moved;
+  state.counters["bound_ms"] = rate > 0.0 ? k.bytes_moved / rate : 0.0;
+  state.counters["x_bound"] = rate > 0.0 ? k.kernel_ms / (k.bytes_moved / rate) : 0.0;
+  state.counters["gpu_clock"] = k.clock == gpu::Clock::GpuQuery ? 1.0 : 0.0;
+  state.SetLabel(ctx->description());
+}
+void BM_Blend(benchmark::State& state) { run_morph(state, make_blend_method_gpu); }
+void BM_Warp(benchmark::State& state) { run_morph(state, make_warp_method_gpu); }
+
+BENCHMARK(BM_Copy)->Args({1920, 1080})->Args({1280, 1024})->Args({1024, 1024})->Args({480, 270})->Args({320, 256})
+    ->Args({256, 256})->UseManualTime()->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_Ema)->Args({1920, 1080})->Args({480, 270})->UseManualTime()->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_Taa)->Args({1920, 1080})->Args({480, 270})->UseManualTime()->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_Spatial)->Args({1280, 1024})->Args({320, 256})->UseManualTime()->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_Temporal)->Args({1280, 1024})->Args({320, 256})->UseManualTime()->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_Blend)->Args({1024, 1024})->Args({256, 256})->UseManualTime()->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_Warp)->Args({1024, 1024})->Args({256, 256})->UseManualTime()->Unit(benchmark::kMillisecond);
 
 }  // namespace
 
