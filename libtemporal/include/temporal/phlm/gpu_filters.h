@@ -8,6 +8,7 @@
 #include "temporal/gpu/context.h"
 #include "temporal/phlm/ema.h"
 #include "temporal/phlm/frame_filter.h"
+#include "temporal/phlm/fxaa.h"
 #include "temporal/phlm/taa.h"
 
 #include <memory>
@@ -21,5 +22,9 @@ Expected<std::unique_ptr<FrameFilter>> make_ema_filter_gpu(std::shared_ptr<gpu::
 // invalid parameters, as TaaFilter::process reports them.
 Expected<std::unique_ptr<FrameFilter>> make_taa_filter_gpu(std::shared_ptr<gpu::Context> context,
                                                           TaaParams params = {});
+
+// FXAA (temporal/phlm/fxaa.h) on `context` (created on the default device when null); spatial, no state.
+Expected<std::unique_ptr<FrameFilter>> make_fxaa_filter_gpu(std::shared_ptr<gpu::Context> context,
+                                                           FxaaParams params = {});
 
 }  // namespace temporal
