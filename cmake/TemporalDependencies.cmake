@@ -21,10 +21,13 @@ find_package(CLI11 CONFIG REQUIRED)
 # The renderer (OSMesa) and the plots (VTK, which links libGL) live in separate targets: both libraries
 # export every gl* symbol, and an executable that loads libGL first silently breaks OSMesa.
 pkg_check_modules(OSMESA REQUIRED IMPORTED_TARGET osmesa)
-find_package(TinyGLTF CONFIG REQUIRED)
-# The gpu stage's compute kernels: EGL only (glvnd's libEGL); every GL entry point is loaded through
-# eglGetProcAddress, so no libGL / libOpenGL is linked (see libtemporal/src/gpu/context.cpp).
+# The renderer's second context and the gpu stage's compute kernels: EGL's device platform through glvnd's libEGL
+# (libegl-dev; Mesa's software device comes from libegl-mesa0, a GPU's from its driver). Only libEGL is linked: GL
+# entry points come from eglGetProcAddress.
 pkg_check_modules(EGL REQUIRED IMPORTED_TARGET egl)
+find_package(TinyGLTF CONFIG REQUIRED)
+# stb_image (libstb, the library tinygltf decodes glTF images with) decodes USD textures too.
+pkg_check_modules(STB REQUIRED IMPORTED_TARGET stb)
 
 find_package(MPI REQUIRED COMPONENTS C)
 set(TEMPORAL_VTK_COMPONENTS CommonCore CommonDataModel ChartsCore ViewsContext2D RenderingContext2D

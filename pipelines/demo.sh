@@ -9,33 +9,32 @@
 # Usage: pipelines/demo.sh [BUILD_DIR] [REPORT_DIR]      (defaults: build/release report/demo)
 # Environment: SCENE (default assets/scenes/walkers.glb), SIZE (default 320x256), FRAMES (default 0-31),
 #   MORPH_FRAMES (40 Hz frames for morph-120hz, default 8), HTML_REPORT=0 to skip the HTML report.
-set -euo pipefail
+# shellcheck source=pipelines/lib.sh
+source "$(dirname "${BASH_SOURCE[0]}")/lib.sh"
 
-here="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
-BUILD="${1:-build/release}"
+use_build "${1:-}"
 REPORT="${2:-report/demo}"
-case "$BUILD" in /*) ;; *) BUILD="$PWD/$BUILD" ;; esac
 case "$REPORT" in /*) ;; *) REPORT="$PWD/$REPORT" ;; esac
-SCENE="${SCENE:-$here/assets/scenes/walkers.glb}"
+SCENE="${SCENE:-$ROOT/assets/scenes/walkers.glb}"
 export SIZE="${SIZE:-320x256}"
 export FRAMES="${FRAMES:-0-31}"
 
 if [[ ! -f "$SCENE" ]]; then
-  echo "demo.sh: $SCENE: no such scene; pass SCENE=path/to/scene.glb" >&2
-  exit 2
+  die "$SCENE: no such scene; pass SCENE=path/to/scene.glb"
 fi
+require_tools render-gbuffer upsample-st filter-phlm morph-120hz compare
 mkdir -p "$REPORT"
 start=$(date +%s)
 step() { printf '\ndemo.sh: == %s ==\n' "$*" >&2; }
 
 step "upsample-st (seed 000 / 002) on $(basename "$SCENE"), $SIZE, frames $FRAMES"
-bash "$here/pipelines/upsample-st.sh" "$BUILD" "$REPORT/upsample-st" "$SCENE"
+bash "$ROOT/pipelines/upsample-st.sh" "$BUILD" "$REPORT/upsample-st" "$SCENE"
 
 step "filter-phlm (seed 003)"
-bash "$here/pipelines/filter-phlm.sh" "$BUILD" "$REPORT/filter-phlm" "$SCENE"
+bash "$ROOT/pipelines/filter-phlm.sh" "$BUILD" "$REPORT/filter-phlm" "$SCENE"
 
 step "morph-120hz (seed 004)"
-FRAMES="${MORPH_FRAMES:-8}" bash "$here/pipelines/morph-120hz.sh" "$BUILD" "$REPORT/morph-120hz" "$SCENE"
+FRAMES="${MORPH_FRAMES:-8}" bash "$ROOT/pipelines/morph-120hz.sh" "$BUILD" "$REPORT/morph-120hz" "$SCENE"
 
 html=""
 scene_name="$(basename "${SCENE%.*}")"
@@ -45,15 +44,16 @@ if [[ "${HTML_REPORT:-1}" != 0 ]]; then
   d="$REPORT/filter-phlm/$scene_name"
   tests=("$d/render/color.####.exr")
   names="input"
-  for m in ${METHODS:-phlm taa ema fxaa}; do
+  # The methods filter-phlm.sh ran: its METHODS, by default every method of filter-phlm's registry.
+  for m in ${METHODS:-$(methods_of filter-phlm)}; do
     tests+=("$d/$m/$m.####.exr")
     names+=",$m"
   done
-  "$BUILD/apps/compare/compare" --reference "$d/render/reference.####.exr" "${tests[@]}" --names "$names" \
+  "$(tool_path compare)" --reference "$d/render/reference.####.exr" "${tests[@]}" --names "$names" \
     --gbuffer "$d/render/gbuffer.####.exr" --flip ldr \
     --title "$scene_name, filter-phlm (seed 003), $SIZE, 1 spp against 16 spp" --report "$REPORT/report" > /dev/null
   html="$REPORT/report/index.html"
-  echo "demo.sh: HTML report written in $(( $(date +%s) - report_start )) s" >&2
+  say "HTML report written in $(( $(date +%s) - report_start )) s"
 fi
 
 {
@@ -78,5 +78,5 @@ fi
 } > "$REPORT/README.md"
 step "done: $REPORT/README.md"
 cat "$REPORT/README.md"
-[[ -n "$html" ]] && echo "demo.sh: HTML report: $html" >&2
-echo "demo.sh: finished in $(( $(date +%s) - start )) s" >&2
+[[ -n "$html" ]] && say "HTML report: $html"
+say "finished in $(( $(date +%s) - start )) s"

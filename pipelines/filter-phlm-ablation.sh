@@ -15,9 +15,9 @@
 #        [SCENE.glb ...]
 # Environment: RENDERS (folder of the Table 2 renders, default report/filter-phlm), and filter-phlm.sh's SIZE,
 #   FRAMES, FPS, RENDER_ARGS, WARMUP (the renders must match them).
-set -euo pipefail
-here="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
-BUILD="${1:-build/release}"
+# shellcheck source=pipelines/lib.sh
+source "$(dirname "${BASH_SOURCE[0]}")/lib.sh"
+use_build "${1:-}"
 OUT="${2:-report/filter-phlm-ablation}"
 shift $(( $# > 2 ? 2 : $# ))
 export RENDERS="${RENDERS:-report/filter-phlm}"
@@ -30,4 +30,4 @@ phlm-eq1 phlm --feature-alpha eq1
 phlm-mean-no-box phlm --no-feature --no-box-test
 phlm-catmull-rom phlm --model-fetch catmull-rom"
 export PAIRS="phlm-no-feature:phlm,phlm-nearest:phlm,phlm-no-box:phlm,phlm-eq1:phlm,phlm-mean-no-box:phlm,phlm-catmull-rom:phlm,phlm:input"
-exec bash "$here/pipelines/filter-phlm.sh" "$BUILD" "$OUT" "$@"
+exec bash "$ROOT/pipelines/filter-phlm.sh" "$BUILD" "$OUT" "$@"

@@ -19,37 +19,30 @@
 # Usage: pipelines/filter-phlm-edges.sh [BUILD_DIR=build/release] [OUT_DIR=report/filter-phlm-edges]
 # Environment: SIZE (512x288), FRAMES (0-47), FPS (40), WARMUP (10), CASES, REUSE_RENDER=1, SHARED_ASSETS (the
 #   third-party assets folder, default ../shared/assets beside the repository; a worktree sets it to its path).
-set -euo pipefail
+# shellcheck source=pipelines/lib.sh
+source "$(dirname "${BASH_SOURCE[0]}")/lib.sh"
 
-here="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
-BUILD="${1:-build/release}"
+use_build "${1:-}"
 OUT="${2:-report/filter-phlm-edges}"
 SIZE="${SIZE:-512x288}"
 FRAMES="${FRAMES:-0-47}"
 FPS="${FPS:-40}"
 WARMUP="${WARMUP:-10}"
 REUSE_RENDER="${REUSE_RENDER:-0}"
-shared="${SHARED_ASSETS:-$here/../shared/assets}/gltf"
-CASES="${CASES:-fence $here/assets/scenes/fence.glb
+shared="${SHARED_ASSETS:-$ROOT/../shared/assets}/gltf"
+CASES="${CASES:-fence $ROOT/assets/scenes/fence.glb
 helmet-orbit $shared/FlightHelmet/FlightHelmet.gltf --camera-path orbit
 helmet-static $shared/FlightHelmet/FlightHelmet.gltf --camera-path fixed
 ivy-orbit $shared/SponzaIvy/sponza_ivy.gltf --camera-path orbit}"
 
-case "$BUILD" in
-  /*) ;;
-  *) if [[ -d "$PWD/$BUILD" ]]; then BUILD="$PWD/$BUILD"; else BUILD="$here/$BUILD"; fi ;;
-esac
-render="$BUILD/apps/render-gbuffer/render-gbuffer"
-filter="$BUILD/apps/filter-phlm/filter-phlm"
-compare="$BUILD/apps/compare/compare"
-split="$BUILD/tests/benchmarks/phlm/phlm_edge_split"
-for t in "$render" "$filter" "$compare" "$split"; do
-  if [[ ! -x "$t" ]]; then
-    echo "filter-phlm-edges.sh: $t is missing: build the project first (cmake --build --preset release)" >&2
-    exit 2
-  fi
-done
+require_tools render-gbuffer filter-phlm compare tests/benchmarks/phlm/phlm_edge_split
+render="$(tool_path render-gbuffer)"
+filter="$(tool_path filter-phlm)"
+compare="$(tool_path compare)"
+split="$(tool_path tests/benchmarks/phlm/phlm_edge_split)"
 
+# The runs, "NAME METHOD options": this study's fetch and velocity variants (an experiment's choice, not a
+# method list).
 runs=("phlm phlm"
   "phlm-catmull-rom phlm --model-fetch catmull-rom"
   "phlm-nearest phlm --model-fetch nearest"

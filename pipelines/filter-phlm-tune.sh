@@ -31,10 +31,10 @@
 #   filtered sequences; by default they are deleted after compare has measured them), APPEND=1 (add the runs to an
 #   existing OUT_DIR/tuning.csv, e.g. to extend a grid; the tables sort the settings). An empty list (TAA_ALPHAS="")
 #   skips that method.
-set -euo pipefail
+# shellcheck source=pipelines/lib.sh
+source "$(dirname "${BASH_SOURCE[0]}")/lib.sh"
 
-here="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
-BUILD="${1:-build/release}"
+use_build "${1:-}"
 OUT="${2:-report/filter-phlm-tune}"
 SIZE="${SIZE:-512x288}"
 FPS="${FPS:-40}"
@@ -51,19 +51,10 @@ walkers-late walkers.glb 100-131 --seed 103
 fan-dolly fan.glb 100-131 --camera-path dolly --seed 104
 morph_test-orbit morph_test.glb 100-131 --camera-path orbit --seed 105}"
 
-case "$BUILD" in
-  /*) ;;
-  *) if [[ -d "$PWD/$BUILD" ]]; then BUILD="$PWD/$BUILD"; else BUILD="$here/$BUILD"; fi ;;
-esac
-render="$BUILD/apps/render-gbuffer/render-gbuffer"
-filter="$BUILD/apps/filter-phlm/filter-phlm"
-compare="$BUILD/apps/compare/compare"
-for t in "$render" "$filter" "$compare"; do
-  if [[ ! -x "$t" ]]; then
-    echo "filter-phlm-tune.sh: $t is missing: build the project first (cmake --preset release && cmake --build --preset release)" >&2
-    exit 2
-  fi
-done
+require_tools render-gbuffer filter-phlm compare
+render="$(tool_path render-gbuffer)"
+filter="$(tool_path filter-phlm)"
+compare="$(tool_path compare)"
 mkdir -p "$OUT"
 
 # The runs: "method label filter-options" per line.
@@ -86,7 +77,7 @@ while read -r name scene frames opts; do
   else
     echo "== $name: rendering $scene $opts ($SIZE, frames $frames)" >&2
     # shellcheck disable=SC2086
-    "$render" "$here/assets/scenes/$scene" --out "$dir/render" --size "$SIZE" --fps "$FPS" --frames "$frames" \
+    "$render" "$ROOT/assets/scenes/$scene" --out "$dir/render" --size "$SIZE" --fps "$FPS" --frames "$frames" \
       --outputs gbuffer,color,reference --jitter random --reference-spp 16 --payload direct,shadow,ssao $opts
   fi
   tests=()
@@ -94,7 +85,7 @@ while read -r name scene frames opts; do
   i=0
   rm -rf "$dir/runs"
   for run in "${runs[@]}"; do
-    read -r method label args <<< "$run"
+    read -r method _ args <<< "$run"  # the setting label is for tuning.csv
     out="$dir/runs/$i/$method.####.exr"
     # shellcheck disable=SC2086
     "$filter" --input "$dir/render/color.####.exr" --gbuffer "$dir/render/gbuffer.####.exr" --out "$out" \
@@ -106,23 +97,10 @@ while read -r name scene frames opts; do
   echo "== $name: compare (${#tests[@]} runs)" >&2
   "$compare" --reference "$dir/render/reference.####.exr" "${tests[@]}" --names "$names" \
     --gbuffer "$dir/render/gbuffer.####.exr" --json "$dir/metrics.json" > /dev/null
-  python3 - "$dir/metrics.json" "$name" "$csv" "${runs[@]}" <<'PY'
-import json, sys
-path, seq, csv = sys.argv[1], sys.argv[2], sys.argv[3]
-runs = sys.argv[4:]
-data = json.load(open(path))
-by_name = {s["name"]: s for s in data["sequences"]}
-with open(csv, "a") as f:
-    for i, run in enumerate(runs):
-        method, label = run.split()[:2]
-        s = by_name[str(i)]
-        psnr = s["psnr_rgb"]["mean"]
-        flicker = s["flicker"]["mean"]
-        f.write(f"{method},{label},{seq},{psnr},{flicker}\n")
-PY
+  python3 "$TABLES" tuning-rows "$dir/metrics.json" "$name" "${runs[@]}" >> "$csv"
   [[ "$KEEP_OUTPUTS" == 1 ]] || rm -rf "$dir/runs"
 done <<< "$TUNE_SET"
 
-python3 "$here/pipelines/phlm_tables.py" tuning "$csv" > "$OUT/tuning.md"
+python3 "$TABLES" tuning "$csv" > "$OUT/tuning.md"
 cat "$OUT/tuning.md"
-echo "filter-phlm-tune.sh: $OUT/tuning.md, $OUT/tuning.csv" >&2
+say "$OUT/tuning.md, $OUT/tuning.csv"

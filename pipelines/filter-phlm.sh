@@ -10,8 +10,9 @@
 #   BUILD_DIR  where the tools were built (default build/release)
 #   OUT_DIR    report folder (default report/filter-phlm)
 #   SCENE      scenes to run (default: the built-in fence, tower, fan and walkers scenes of assets/scenes)
-# Environment: SIZE (default 512x288), FRAMES (default 0-47), FPS (default 40), METHODS (default
-#   "phlm taa ema fxaa"), VARIANTS (more runs, one per line "NAME METHOD filter-phlm options", e.g. the previous TAA
+# Environment: SIZE (default 512x288), FRAMES (default 0-47), FPS (default 40), METHODS (default: every method
+#   of filter-phlm's registry, as `filter-phlm --list-methods` prints them; a named variant's name works too),
+#   VARIANTS (more runs, one per line "NAME METHOD filter-phlm options", e.g. the previous TAA
 #   "taa-0.1 taa --taa-alpha 0.1" (the engine-typical blend) and "taa-2014 taa --taa-velocity centre --taa-clip
 #   minmax --taa-alpha 0.04" by default; "" for none),
 #   RENDER_ARGS (extra render-gbuffer options; default "--payload direct,shadow,ssao": the gi payload's 2000 VPLs
@@ -27,16 +28,15 @@
 # the chosen jitter, and its `reference` is the same payload's R,G,B averaged over --reference-spp samples at
 # Halton (2,3) positions (apps/render-gbuffer, libtemporal/src/render/renderer.cpp), so reference.####.exr's
 # bare R,G,B is the 16-spp version of the colour input and is compared against directly.
-set -euo pipefail
+# shellcheck source=pipelines/lib.sh
+source "$(dirname "${BASH_SOURCE[0]}")/lib.sh"
 
-here="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
-BUILD="${1:-build/release}"
+use_build "${1:-}"
 OUT="${2:-report/filter-phlm}"
 shift $(( $# > 2 ? 2 : $# ))
 SIZE="${SIZE:-512x288}"
 FRAMES="${FRAMES:-0-47}"
 FPS="${FPS:-40}"
-METHODS="${METHODS:-phlm taa ema fxaa}"
 RENDER_ARGS="${RENDER_ARGS:---payload direct,shadow,ssao}"
 REFERENCE_SPP="${REFERENCE_SPP:-16}"
 REUSE_RENDER="${REUSE_RENDER:-0}"
@@ -48,38 +48,31 @@ RENDERS="${RENDERS:-$OUT}"
 WARMUP="${WARMUP:-10}"
 PAIRS="${PAIRS:-phlm:taa,phlm:taa-0.1,phlm:input,taa:input,taa:taa-0.1,phlm:fxaa,phlm:ema,taa-0.1:taa-2014}"
 
-# A relative BUILD_DIR is taken from the current folder, else from the repository root.
-case "$BUILD" in
-  /*) ;;
-  *) if [[ -d "$PWD/$BUILD" ]]; then BUILD="$PWD/$BUILD"; else BUILD="$here/$BUILD"; fi ;;
-esac
-render="$BUILD/apps/render-gbuffer/render-gbuffer"
-filter="$BUILD/apps/filter-phlm/filter-phlm"
-compare="$BUILD/apps/compare/compare"
-for t in "$render" "$filter" "$compare"; do
-  if [[ ! -x "$t" ]]; then
-    echo "filter-phlm.sh: $t is missing: build the project first (cmake --preset release && cmake --build --preset release)" >&2
-    exit 2
-  fi
-done
+require_tools render-gbuffer filter-phlm compare
+render="$(tool_path render-gbuffer)"
+filter="$(tool_path filter-phlm)"
+compare="$(tool_path compare)"
+METHODS="${METHODS:-$(methods_of filter-phlm)}"
 
 scenes=("$@")
 if [[ ${#scenes[@]} -eq 0 ]]; then
   for s in fence tower fan walkers; do
-    [[ -f "$here/assets/scenes/$s.glb" ]] && scenes+=("$here/assets/scenes/$s.glb")
+    [[ -f "$ROOT/assets/scenes/$s.glb" ]] && scenes+=("$ROOT/assets/scenes/$s.glb")
   done
 fi
 if [[ ${#scenes[@]} -eq 0 ]]; then
-  echo "filter-phlm.sh: no scenes given and none in $here/assets/scenes" >&2
-  exit 2
+  die "no scenes given and none in $ROOT/assets/scenes"
 fi
 
 mkdir -p "$OUT"
 summary="$OUT/summary.md"
-# Every run: "NAME METHOD options" (the methods under their own names first, then the variants).
+# Every run: "NAME ARGUMENTS" (the METHODS through the registry under their own names first, then the variants).
 runs=()
-for m in $METHODS; do runs+=("$m $m"); done
-while read -r line; do [[ -n "$line" ]] && runs+=("$line"); done <<< "$VARIANTS"
+for m in $METHODS; do
+  args="$(method_args filter-phlm "$m")" || die "unknown method '$m' in METHODS"
+  runs+=("$m $args")
+done
+while read -r n m args; do [[ -n "$n" ]] && runs+=("$n --method $m $args"); done <<< "$VARIANTS"
 compare_args=()
 compare_help="$("$compare" --help 2>/dev/null || true)"
 if [[ "$compare_help" == *--warmup* ]]; then compare_args+=(--warmup "$WARMUP"); fi
@@ -113,16 +106,16 @@ for scene in "${scenes[@]}"; do
   last_frame="$(ls "$render_dir"/color.*.exr | tail -1)"
   last_frame="${last_frame##*/color.}"
   for run in "${runs[@]}"; do
-    read -r n m args <<< "$run"
+    read -r n args <<< "$run"
     tests+=("$dir/$n/$n.####.exr")
     if [[ "$REUSE_OUTPUTS" == 1 && -f "$dir/$n/$n.$last_frame" ]]; then
       echo "== $name: reusing $dir/$n" >&2
       continue
     fi
-    echo "== $name: $n = filter-phlm --method $m $args" >&2
+    echo "== $name: $n = filter-phlm $args" >&2
     # shellcheck disable=SC2086
     "$filter" --input "$render_dir/color.####.exr" --gbuffer "$render_dir/gbuffer.####.exr" \
-      --out "$dir/$n/$n.####.exr" --method "$m" $args $FILTER_ARGS
+      --out "$dir/$n/$n.####.exr" $args $FILTER_ARGS
   done
 
   echo "== $name: compare" >&2
@@ -143,10 +136,10 @@ done
 {
   echo "## Table 2: mean PSNR (RGB, dB) [95% interval] (steady state) / mean flicker"
   echo
-  python3 "$here/pipelines/phlm_tables.py" scenes "$OUT" "$scene_names" "$seq_names" "$PAIRS"
+  python3 "$TABLES" scenes "$OUT" "$scene_names" "$seq_names" "$PAIRS"
   echo
 } >> "$summary"
 
 echo
 cat "$summary"
-echo "filter-phlm.sh: report in $OUT (summary.md, per scene: metrics.csv, metrics.json, psnr*.png)" >&2
+say "report in $OUT (summary.md, per scene: metrics.csv, metrics.json, psnr*.png)"

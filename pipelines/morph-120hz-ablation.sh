@@ -14,9 +14,9 @@
 # Usage: pipelines/morph-120hz-ablation.sh [BUILD_DIR=build/release] [OUT_DIR=report/morph-120hz-ablation]
 #        [SCENE.glb ...]
 # Environment: morph-120hz.sh's SIZE, FRAMES, REPEAT (default 1 here: the timings are not the point).
-set -euo pipefail
-here="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
-BUILD="${1:-build/release}"
+# shellcheck source=pipelines/lib.sh
+source "$(dirname "${BASH_SOURCE[0]}")/lib.sh"
+use_build "${1:-}"
 OUT="${2:-report/morph-120hz-ablation}"
 shift $(( $# > 2 ? 2 : $# ))
 export METHODS="didyk repeat warp"
@@ -26,4 +26,4 @@ didyk-nocomp didyk --no-compensation
 didyk-grid2 didyk --grid 2"
 export FFMPEG=0
 export REPEAT="${REPEAT:-1}"
-exec bash "$here/pipelines/morph-120hz.sh" "$BUILD" "$OUT" "$@"
+exec bash "$ROOT/pipelines/morph-120hz.sh" "$BUILD" "$OUT" "$@"

@@ -17,22 +17,26 @@
 #
 # Usage: [METHODS="didyk repeat ..."] pipelines/morph-120hz-regions.sh SCENE_DIR [BUILD_DIR]
 #   SCENE_DIR  one scene's folder of pipelines/morph-120hz.sh (r120/, ldr120/, one folder per method)
-#   BUILD_DIR  default build/release (compare)
-#   METHODS    method folders of SCENE_DIR to split (default: didyk repeat blend warp minterpolate, those present;
-#              any other folder of output frames color.####.exr works, e.g. an ablation of didyk)
+#   BUILD_DIR  default build/release (compare; morph-120hz for the default METHODS)
+#   METHODS    method folders of SCENE_DIR to split (default: every method of morph-120hz's registry and
+#              minterpolate, those present; any other folder of output frames color.####.exr works, e.g. an
+#              ablation of didyk)
 # Writes SCENE_DIR/regions.csv and prints it.
-set -euo pipefail
-ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
+# shellcheck source=pipelines/lib.sh
+source "$(dirname "${BASH_SOURCE[0]}")/lib.sh"
 D=${1:?usage: morph-120hz-regions.sh SCENE_DIR [BUILD_DIR]}
-BUILD=${2:-build/release}
-case "$BUILD" in /*) ;; *) BUILD="$ROOT/$BUILD" ;; esac
-COMPARE="$BUILD/apps/compare/compare"
+use_build "${2:-}"
+require_tools compare
+COMPARE="$(tool_path compare)"
 FACTOR=3
-[[ -x "$COMPARE" ]] || { echo "morph-120hz-regions.sh: $COMPARE: not built" >&2; exit 2; }
-command -v oiiotool >/dev/null 2>&1 || { echo "morph-120hz-regions.sh: oiiotool not found" >&2; exit 2; }
+command -v oiiotool >/dev/null 2>&1 || die "oiiotool not found"
+if [[ -z "${METHODS:-}" ]]; then
+  require_tools morph-120hz
+  METHODS="$(methods_of morph-120hz) minterpolate"
+fi
 methods=()
-for m in ${METHODS:-didyk repeat blend warp minterpolate}; do [[ -d "$D/$m" ]] && methods+=("$m"); done
-(( ${#methods[@]} )) || { echo "morph-120hz-regions.sh: no method folder in $D" >&2; exit 2; }
+for m in $METHODS; do [[ -d "$D/$m" ]] && methods+=("$m"); done
+(( ${#methods[@]} )) || die "no method folder in $D"
 last=$(ls "${D}/${methods[0]}"/color.*.exr | wc -l); last=$((last - 1))
 
 # moving(f): 1 where |motion.X| + |motion.Y| of the native 120 Hz frame f exceeds 1e-3 px, else 0.
@@ -69,46 +73,7 @@ for r in M S C L; do
 done
 
 # Per method over the in-between frames: mean PSNR, mean share of each region in the MSE, and the PSNR with a
-# region's error removed.
-python3 - "$D/regions/regionM.csv" "$D/regions/regionS.csv" "$D/regions/regionC.csv" "$D/regions/regionL.csv" "$FACTOR" "${methods[@]}" \
-  > "$D/regions.csv" <<'PY'
-import csv, math, sys
-factor = int(sys.argv[5])
-def rows(path):
-    out = {}
-    for r in csv.DictReader(open(path)):
-        f = int(r["frame"])
-        if f % factor:
-            out[(r["sequence"], f)] = r
-    return out
-M, S, C, L = rows(sys.argv[1]), rows(sys.argv[2]), rows(sys.argv[3]), rows(sys.argv[4])
-def mse_in(r):
-    p = float(r["psnr_rgb_in_db"]) if r["psnr_rgb_in_db"] not in ("", "inf") else math.inf
-    return 0.0 if math.isinf(p) else 10 ** (-p / 10)
-regions = ("M", "D", "S", "C", "L", "U")
-print("method,frames,psnr_db,mse," + ",".join("share_" + r for r in regions) + "," + ",".join("fraction_" + r for r in regions)
-      + "," + ",".join("psnr_without_%s_db" % r for r in regions))
-methods = sys.argv[6:]
-for m in methods:
-    keys = sorted(k for k in M if k[0] == m)
-    acc = {k: 0.0 for k in ["psnr", "mse"] + [p + r for p in "sfw" for r in regions]}
-    psnr = lambda e: 10 * math.log10(1 / e) if e > 0 else math.inf
-    for k in keys:
-        total = float(M[k]["mse_rgb"])
-        fm, fs, fc, fl = (float(x[k]["mask_fraction"]) for x in (M, S, C, L))
-        em, es, ec, el = fm * mse_in(M[k]), fs * mse_in(S[k]), fc * mse_in(C[k]), fl * mse_in(L[k])
-        part = {"M": (em, fm), "D": (max(0.0, total - em - es), 1 - fm - fs), "S": (es, fs), "C": (ec, fc),
-                "L": (el, fl), "U": (max(0.0, es - ec), fs - fc)}
-        acc["psnr"] += psnr(total)
-        acc["mse"] += total
-        for r in regions:
-            e, f = part[r]
-            acc["s" + r] += e / total if total > 0 else 0
-            acc["f" + r] += f
-            acc["w" + r] += psnr(total - e)
-    n = len(keys)
-    v = {k: a / n for k, a in acc.items()}
-    print("%s,%d,%.2f,%.3e," % (m, n, v["psnr"], v["mse"]) + ",".join("%.3f" % v["s" + r] for r in regions) + "," +
-          ",".join("%.3f" % v["f" + r] for r in regions) + "," + ",".join("%.2f" % v["w" + r] for r in regions))
-PY
+# region's error removed (tables.py regions: statistics compare does not compute over masked regions).
+python3 "$TABLES" regions "$FACTOR" "$D/regions/regionM.csv" "$D/regions/regionS.csv" "$D/regions/regionC.csv" \
+  "$D/regions/regionL.csv" "${methods[@]}" > "$D/regions.csv"
 column -s, -t < "$D/regions.csv"

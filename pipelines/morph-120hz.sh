@@ -21,10 +21,10 @@
 #   morph-120hz options", e.g. "didyk-nosnap didyk --no-snap"; pipelines/morph-120hz-ablation.sh sets didyk's
 #   ablations), FFMPEG=0 to skip minterpolate, REPEAT (timed runs of each command, default 3; the median is
 #   reported).
-set -euo pipefail
+# shellcheck source=pipelines/lib.sh
+source "$(dirname "${BASH_SOURCE[0]}")/lib.sh"
 
-ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
-BUILD=${1:-build/release}
+use_build "${1:-}"
 OUT=${2:-report/morph-120hz}
 shift $(( $# >= 2 ? 2 : $# ))
 SIZE=${SIZE:-256x256}
@@ -33,43 +33,33 @@ FACTOR=3
 REPEAT=${REPEAT:-3}
 WINDOW=3  # morph-120hz --perceive's default window
 
-case "$BUILD" in /*) ;; *) BUILD="$ROOT/$BUILD" ;; esac
-RENDER="$BUILD/apps/render-gbuffer/render-gbuffer"
-MORPH="$BUILD/apps/morph-120hz/morph-120hz"
-COMPARE="$BUILD/apps/compare/compare"
-for t in "$RENDER" "$MORPH" "$COMPARE"; do
-  if [[ ! -x "$t" ]]; then
-    echo "morph-120hz.sh: $t: not built; build it first (cmake --build $BUILD)" >&2
-    exit 2
-  fi
-done
-if (( FRAMES < 2 )); then echo "morph-120hz.sh: FRAMES must be at least 2" >&2; exit 1; fi
-# The methods come from the tool's registry (one name and a tab-separated summary per line).
-METHODS=${METHODS:-$("$MORPH" --list-methods | cut -f1 | tr '\n' ' ')}
-# Every run: "NAME METHOD OPTIONS" (the METHODS as they are, then the VARIANTS lines).
+require_tools render-gbuffer morph-120hz compare
+RENDER="$(tool_path render-gbuffer)"
+MORPH="$(tool_path morph-120hz)"
+COMPARE="$(tool_path compare)"
+if (( FRAMES < 2 )); then die "FRAMES must be at least 2" 1; fi
+# The methods come from the tool's registry.
+METHODS=${METHODS:-$(methods_of morph-120hz)}
+# Every run: "NAME ARGUMENTS" (the METHODS through the registry, then the VARIANTS lines).
 RUNS=()
-for m in $METHODS; do RUNS+=("$m $m"); done
-while read -r line; do [[ -n "$line" ]] && RUNS+=("$line"); done <<< "${VARIANTS:-}"
+for m in $METHODS; do
+  args="$(method_args morph-120hz "$m")" || die "unknown method '$m' in METHODS"
+  RUNS+=("$m $args")
+done
+while read -r n m args; do [[ -n "$n" ]] && RUNS+=("$n --method $m $args"); done <<< "${VARIANTS:-}"
 
 if (( $# > 0 )); then SCENES=("$@"); else SCENES=("$ROOT"/assets/scenes/*.glb); fi
 if [[ ! -e "${SCENES[0]}" ]]; then
-  echo "morph-120hz.sh: no scene found (assets/scenes/*.glb is empty); pass SCENE.glb" >&2
-  exit 2
+  die "no scene found (assets/scenes/*.glb is empty); pass SCENE.glb"
 fi
 
 have_ffmpeg=0
-if ! command -v python3 >/dev/null 2>&1; then
-  echo "morph-120hz.sh: python3 not found (it reads compare's JSON intervals)" >&2
-  exit 2
-fi
-if ! command -v oiiotool >/dev/null 2>&1; then
-  echo "morph-120hz.sh: oiiotool not found: install openimageio-tools (it clamps the renders to [0, 1])" >&2
-  exit 2
-fi
+command -v oiiotool >/dev/null 2>&1 ||
+  die "oiiotool not found: install openimageio-tools (it clamps the renders to [0, 1])"
 if [[ "${FFMPEG:-1}" != 0 ]] && command -v ffmpeg >/dev/null 2>&1; then
   have_ffmpeg=1
 else
-  echo "morph-120hz.sh: ffmpeg not found (or FFMPEG=0): skipping the minterpolate baseline" >&2
+  say "ffmpeg not found (or FFMPEG=0): skipping the minterpolate baseline"
 fi
 
 mkdir -p "$OUT"
@@ -87,16 +77,17 @@ PAIRED="$OUT/paired.csv"
 echo "scene,method,latency_frames,psnr_inbetween_db,psnr_inbetween_ci_low,psnr_inbetween_ci_high,psnr_inbetween_latency_db,psnr_inbetween_latency_ci_low,psnr_inbetween_latency_ci_high,psnr_all_db,perceived_psnr_db,perceived_latency_psnr_db,perceived_blur_psnr_db,lag_ms,compute_ms_per_output_frame,command_ms_per_output_frame,render_ms_per_frame" > "$TABLE"
 echo "scene,score,metric,a,b,frames,mean_difference_db,ci_low,ci_high" > "$PAIRED"
 
-# Median wall time in ms of REPEAT runs of a command (its output to /dev/null unless redirected inside).
+# Median wall time in ms of REPEAT runs of a command (its output to /dev/null unless redirected inside). The
+# median is tables.py's (a number compare does not compute: the whole command's wall time).
 median_ms() {
-  local times=() t0 t1
+  local r
   for ((r = 0; r < REPEAT; ++r)); do
+    local t0 t1
     t0=$(date +%s.%N)
-    "$@"
+    "$@" >&2
     t1=$(date +%s.%N)
-    times+=("$(awk -v a="$t0" -v b="$t1" 'BEGIN { printf "%.3f", (b - a) * 1000 }')")
-  done
-  printf '%s\n' "${times[@]}" | sort -g | awk '{ v[NR] = $1 } END { if (NR % 2) print v[(NR + 1) / 2]; else printf "%.3f\n", (v[NR / 2] + v[NR / 2 + 1]) / 2 }'
+    echo "$t0 $t1"
+  done | python3 "$TABLES" median-ms
 }
 
 # Keep the header and the rows of compare's CSV whose frame is an in-between frame (frame % FACTOR != 0).
@@ -105,50 +96,14 @@ inbetween_rows() {
 }
 
 # sequence METRIC -> "mean,ci_low,ci_high" from compare's JSON (empty fields when absent)
-json_interval() {
-  python3 - "$1" "$2" "$3" <<'PY'
-import json, sys
-j = json.load(open(sys.argv[1]))
-def fmt(v):  # compare writes +infinity (an identical frame) as "inf": shown, never dropped
-    return "" if v is None else "%.2f" % v if isinstance(v, (int, float)) else str(v)
-for s in j["sequences"]:
-    if s["name"] == sys.argv[2]:
-        m = s.get(sys.argv[3]) or {}
-        ci = m.get("ci95") or [None, None]
-        print(",".join(fmt(v) for v in (m.get("mean"), ci[0], ci[1])))
-        break
-else:
-    print(",,")
-PY
-}
+json_interval() { python3 "$TABLES" interval "$@"; }
 
 # Paired differences a - b of one metric from compare's JSON, as rows of paired.csv.
-json_paired() {
-  python3 - "$1" "$2" "$3" "$4" <<'PY'
-import json, sys
-j = json.load(open(sys.argv[1]))
-for p in j.get("paired", []):
-    if p["metric"] != sys.argv[4]:
-        continue
-    ci = p.get("ci95") or [None, None]
-    f = lambda v: "" if v is None or isinstance(v, str) else "%.3f" % v
-    print(",".join([sys.argv[2], sys.argv[3], p["metric"], p["a"], p["b"], str(p["frames"]), f(p["mean_difference"]), f(ci[0]), f(ci[1])]))
-PY
-}
+json_paired() { python3 "$TABLES" paired-rows "$@"; }
 
 # `temporal:KEY` of an EXR header (oiiotool's listing), or empty
 header_value() {
   oiiotool --info -v "$1" 2>/dev/null | awk -v key="temporal:$2" '$1 == key":" { v = $2; gsub(/"/, "", v); print v; exit }'
-}
-
-# mean of column NAME over the rows of CSV whose `sequence` is SEQ and whose frame passes FILTER (awk expr on f)
-csv_mean() {
-  local csv=$1 seq=$2 col=$3 filter=$4
-  awk -F, -v seq="$seq" -v col="$col" "
-    NR == 1 { for (i = 1; i <= NF; ++i) idx[\$i] = i; next }
-    { f = \$idx[\"frame\"]; s = \$idx[\"sequence\"]; gsub(/\"/, \"\", s) }
-    s == seq && ($filter) && \$idx[col] != \"\" && \$idx[col] != \"inf\" { sum += \$idx[col]; n++ }
-    END { if (n) printf \"%.2f\", sum / n; else printf \"nan\" }" "$csv"
 }
 
 for scene in "${SCENES[@]}"; do
@@ -169,23 +124,22 @@ for scene in "${SCENES[@]}"; do
     fi
   done
   # Render time of one frame: the sum of the pass columns of timings.csv, averaged over the 120 Hz frames.
-  render_ms=$(awk -F, 'NR > 1 { s = 0; for (i = 3; i <= NF; ++i) s += $i; t += s; n++ } END { if (n) printf "%.2f", t / n; else printf "nan" }' "$D/r120/timings.csv")
+  render_ms=$(python3 "$TABLES" pass-ms-mean "$D/r120/timings.csv")
 
   names=()
   tests=()
   declare -A command_ms=() compute_ms=()
   for run in "${RUNS[@]}"; do
-    read -r m method args <<< "$run"
-    echo "== $name: $m = morph-120hz --method $method $args ($REPEAT timed runs)" >&2
+    read -r m args <<< "$run"
+    echo "== $name: $m = morph-120hz $args ($REPEAT timed runs)" >&2
     # shellcheck disable=SC2086
     wall=$(median_ms "$MORPH" --input "$D/ldr40/color.####.exr" --gbuffer "$D/r40/gbuffer.####.exr" \
-      --out "$D/$m/color.####.exr" --method "$method" $args --factor $FACTOR --fps 40)
-    command_ms[$m]=$(awk -v w="$wall" -v n=$((FACTOR * FRAMES)) 'BEGIN { printf "%.2f", w / n }')
+      --out "$D/$m/color.####.exr" $args --factor $FACTOR --fps 40)
+    command_ms[$m]=$(python3 "$TABLES" per-frame "$wall" $((FACTOR * FRAMES)))
     names+=("$m")
     tests+=("$D/$m/color.####.exr")
   done
 
-  ffmpeg_ms=""
   if (( have_ffmpeg )); then
     echo "== $name: ffmpeg minterpolate" >&2
     # ffmpeg reads single-part EXR (not DWA): take the colour part as half/ZIP, interpolate, write float EXR.
@@ -205,8 +159,8 @@ for scene in "${SCENES[@]}"; do
       -vf "format=yuv444p,$mi,format=gbrpf32le" -f null -)
     without_mi=$(median_ms ffmpeg -loglevel error -y -framerate 40 -start_number 0 -i "$D/ffmpeg-in/c.%04d.exr" \
       -vf "format=yuv444p,fps=120,format=gbrpf32le" -f null -)
-    command_ms[minterpolate]=$(awk -v w="$wall" -v n="$produced" 'BEGIN { printf "%.2f", w / (n > 0 ? n : 1) }')
-    compute_ms[minterpolate]=$(awk -v a="$with_mi" -v b="$without_mi" -v n="$produced" 'BEGIN { printf "%.2f", (a - b) / (n > 0 ? n : 1) }')
+    command_ms[minterpolate]=$(python3 "$TABLES" per-frame "$wall" "$produced")
+    compute_ms[minterpolate]=$(python3 "$TABLES" per-frame "$with_mi" "$produced" "$without_mi")
     # Pad to the full 120 Hz range by holding the last frame, so compare sees a contiguous sequence; declare
     # minterpolate's latency (it interpolates towards the next rendered frame: one rendered frame, FACTOR output
     # frames) and the rate, as morph-120hz's headers do.
@@ -257,16 +211,18 @@ for scene in "${SCENES[@]}"; do
     inb=$(json_interval "$D/inbetween.json" "$m" psnr_rgb)
     inb_lat=$(json_interval "$D/inbetween.json" "$m" psnr_latency)
     all=$(json_interval "$D/compare.json" "$m" psnr_rgb | cut -d, -f1)  # "inf" when a frame is identical
-    latency=$(csv_mean "$D/compare.csv" "$m" latency_frames "1")
+    latency=$(python3 "$TABLES" value "$D/compare.json" "$m" psnr_latency.latency_frames 0)
     # compare's means: a frame of infinite PSNR (an identical image) makes the mean "inf" - shown, never dropped.
     per=$(json_interval "$D/perceived.json" "$m" psnr_rgb | cut -d, -f1)
     per_lat=$(json_interval "$D/perceived.json" "$m" psnr_latency | cut -d, -f1)
     blur=$(json_interval "$D/perceived-blur.json" "$m" psnr_rgb | cut -d, -f1)
     # Mean lag over the compared frames, from the perceived images' headers (temporal:lagMs).
+    # (A number compare does not compute: tables.py's mean of the header values.)
     lag=$(for ((n = FIRSTCMP; n <= LASTCMP; ++n)); do printf -v f "%04d" "$n"; header_value "$D/perceived/$m/p.$f.exr" lagMs; done |
-      awk '{ s += $1; n++ } END { if (n) printf "%.2f", s / n; else printf "nan" }')
-    if [[ "$m" == minterpolate ]]; then ms=${compute_ms[$m]}; else ms=$(csv_mean "$D/compare.csv" "$m" compute_ms "1"); fi
-    echo "$name,$m,${latency%.00},$inb,$inb_lat,$all,$per,$per_lat,$blur,$lag,$ms,${command_ms[$m]},$render_ms" >> "$TABLE"
+      python3 "$TABLES" mean)
+    # compare's mean compute_ms over the compared frames (minterpolate's: the ffmpeg difference above).
+    if [[ "$m" == minterpolate ]]; then ms=${compute_ms[$m]}; else ms=$(python3 "$TABLES" value "$D/compare.json" "$m" compute_ms 2); fi
+    echo "$name,$m,$latency,$inb,$inb_lat,$all,$per,$per_lat,$blur,$lag,$ms,${command_ms[$m]},$render_ms" >> "$TABLE"
   done
   unset command_ms compute_ms
 done
@@ -288,7 +244,5 @@ echo "Table: $TABLE"
   echo "output frame (I/O excluded), command = whole command per output frame (EXR in and out); render ms ="
   echo "render-gbuffer per 120 Hz frame. Paired differences: paired.csv. Plots: <scene>/psnr*.png, <scene>/perceived*.png."
   echo
-  echo "| scene | method | L | in-between | in-between, shown | all | perceived | perceived, shown | blur (lag removed) | lag ms | compute ms | command ms | render ms |"
-  echo "|---|---|---|---|---|---|---|---|---|---|---|---|---|"
-  tail -n +2 "$TABLE" | awk -F, '{ printf "| %s | %s | %s | %s [%s, %s] | %s [%s, %s] | %s | %s | %s | %s | %s | %s | %s | %s |\n", $1, $2, $3, $4, $5, $6, $7, $8, $9, $10, $11, $12, $13, $14, $15, $16, $17 }'
+  python3 "$TABLES" morph-summary "$TABLE"
 } > "$OUT/summary.md"

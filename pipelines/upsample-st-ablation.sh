@@ -19,9 +19,9 @@
 # Environment: upsample-st.sh's SIZE, FRAMES, FPS, FACTOR, RENDER_ARGS, NOISE_AVERAGED_SPP, RENDERS, REUSE_RENDER;
 #   METHODS (default "spatial temporal herzog"; add e.g. drobot taau for the full table), EXTRA_VARIANTS (more
 #   lines "NAME herzog OPTIONS").
-set -euo pipefail
-here="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
-BUILD="${1:-build/release}"
+# shellcheck source=pipelines/lib.sh
+source "$(dirname "${BASH_SOURCE[0]}")/lib.sh"
+use_build "${1:-}"
 OUT="${2:-report/upsample-st-ablation}"
 shift $(( $# > 2 ? 2 : $# ))
 export METHODS="${METHODS:-spatial temporal herzog}"
@@ -39,4 +39,4 @@ while read -r n _; do
   [[ -n "$n" ]] && pairs+=",$n:herzog"
 done <<< "$VARIANTS"
 export PAIRS="$pairs"
-exec bash "$here/pipelines/upsample-st.sh" "$BUILD" "$OUT" "$@"
+exec bash "$ROOT/pipelines/upsample-st.sh" "$BUILD" "$OUT" "$@"

@@ -35,12 +35,13 @@
 # the per-frame SSAO / VPL noise, which no upsampler is asked to remove; it is optional.
 #
 # Costs: shading ms are render-gbuffer's `shadeLow` (payload at 1/FACTOR resolution) and `shadeFull` (the same
-# payload at full resolution) from timings.csv, upsampling ms are upsample-st's `temporal:computeMs` (mean
-# over frames, as printed by compare). Both are measured on this machine (llvmpipe for the shading).
-set -euo pipefail
+# payload at full resolution) from timings.csv, upsampling ms are upsample-st's `temporal:computeMs` (compare's
+# mean over frames, from its JSON). Both are measured on this machine (llvmpipe for the shading). The tables are
+# pipelines/tables.py's; herzog's margins are compare's paired differences.
+# shellcheck source=pipelines/lib.sh
+source "$(dirname "${BASH_SOURCE[0]}")/lib.sh"
 
-here="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
-BUILD="${1:-build/release}"
+use_build "${1:-}"
 OUT="${2:-report/upsample-st}"
 shift $(( $# > 2 ? 2 : $# ))
 SIZE="${SIZE:-640x512}"
@@ -58,48 +59,18 @@ NOISE_AVERAGED_SPP="${NOISE_AVERAGED_SPP:-0}"
 RENDERS="${RENDERS:-}"
 REUSE_RENDER="${REUSE_RENDER:-0}"
 if [[ "$REFERENCE_SPP" -gt 0 && "$NOISE_AVERAGED_SPP" -gt 0 ]]; then
-  echo "upsample-st.sh: REFERENCE_SPP and NOISE_AVERAGED_SPP both need render-gbuffer's reference output: set one" >&2
-  exit 1
+  die "REFERENCE_SPP and NOISE_AVERAGED_SPP both need render-gbuffer's reference output: set one" 1
 fi
 
-case "$BUILD" in /*) ;; *) BUILD="$PWD/$BUILD" ;; esac
-render="$BUILD/apps/render-gbuffer/render-gbuffer"
-upsample="$BUILD/apps/upsample-st/upsample-st"
-compare="$BUILD/apps/compare/compare"
-for t in "$render" "$upsample" "$compare"; do
-  if [[ ! -x "$t" ]]; then
-    echo "upsample-st.sh: $t is missing: build the project first (cmake --preset release && cmake --build --preset release)" >&2
-    exit 2
-  fi
-done
+require_tools render-gbuffer upsample-st compare
+render="$(tool_path render-gbuffer)"
+upsample="$(tool_path upsample-st)"
+compare="$(tool_path compare)"
 
-# The method table: NAME<TAB>ARGUMENTS<TAB>SUMMARY per method and variant, and *SUFFIX<TAB>ARGUMENTS for the name
-# suffixes any method takes.
-catalogue="$("$upsample" --list-methods)"
-# Arguments of a METHODS name: the table's arguments, after stripping (and adding the arguments of) suffixes.
-method_args() {
-  local name="$1" extra=""
-  while true; do
-    local n args summary suffix=""
-    while IFS=$'\t' read -r n args summary; do
-      if [[ "$n" == "$name" ]]; then
-        echo "$args$extra"
-        return 0
-      fi
-      if [[ "$n" == \** && "$name" == *"${n#\*}" ]]; then suffix="${n#\*}"$'\t'"$args"; fi
-    done <<< "$catalogue"
-    if [[ -z "$suffix" ]]; then
-      echo "upsample-st.sh: unknown method '$1' in METHODS (upsample-st --list-methods lists the names)" >&2
-      return 1
-    fi
-    name="${name%"${suffix%%$'\t'*}"}"
-    extra=" ${suffix#*$'\t'}$extra"
-  done
-}
 # Every run: "NAME ARGUMENTS" (METHODS through the method table, then the VARIANTS lines as given).
 runs=()
 for m in $METHODS; do
-  args="$(method_args "$m")" || exit 2
+  args="$(method_args upsample-st "$m")" || die "unknown method '$m' in METHODS (upsample-st --list-methods lists the names)"
   runs+=("$m $args")
 done
 raster=0
@@ -113,21 +84,12 @@ IFS=, read -r -a pairs <<< "$PAIRS"
 scenes=("$@")
 if [[ ${#scenes[@]} -eq 0 ]]; then
   for s in walkers tower fan; do
-    [[ -f "$here/assets/scenes/$s.glb" ]] && scenes+=("$here/assets/scenes/$s.glb")
+    [[ -f "$ROOT/assets/scenes/$s.glb" ]] && scenes+=("$ROOT/assets/scenes/$s.glb")
   done
 fi
 if [[ ${#scenes[@]} -eq 0 ]]; then
-  echo "upsample-st.sh: no scenes given and none in $here/assets/scenes" >&2
-  exit 2
+  die "no scenes given and none in $ROOT/assets/scenes"
 fi
-
-# Mean of a named column of a CSV file (empty cells skipped).
-csv_mean() {
-  awk -F, -v col="$2" '
-    NR == 1 { for (i = 1; i <= NF; i++) if ($i == col) c = i; next }
-    c && $c != "" { s += $c; n++ }
-    END { if (n) printf "%.3f", s / n; else printf "-" }' "$1"
-}
 
 mkdir -p "$OUT"
 summary="$OUT/summary.md"
@@ -196,7 +158,7 @@ for scene in "${scenes[@]}"; do
   if [[ "$REFERENCE_SPP" -gt 0 ]]; then
     echo "== $name: compare against the $REFERENCE_SPP-spp reference" >&2
     "$compare" --reference "$render_dir/reference.####.exr" "${tests[@]}" --names "$seq_names" \
-      --csv "$dir/metrics-supersampled.csv" | tee "$dir/compare-supersampled.txt"
+      --csv "$dir/metrics-supersampled.csv" --json "$dir/metrics-supersampled.json" | tee "$dir/compare-supersampled.txt"
   fi
   if [[ "$NOISE_AVERAGED_SPP" -gt 0 ]]; then
     echo "== $name: compare against the noise-averaged payload ($NOISE_AVERAGED_SPP samples at the pixel centres)" >&2
@@ -206,32 +168,16 @@ for scene in "${scenes[@]}"; do
       --warmup "$WARMUP" --plot "$OUT/noise-averaged/$name/psnr.png" | tee "$dir/compare-noise-averaged.txt"
   fi
 
-  shade_low="$(csv_mean "$render_dir/timings.csv" shadeLow)"
-  shade_full="$(csv_mean "$render_dir/timings.csv" shadeFull)"
+  # The shading ms: render-gbuffer's timings.csv, which compare does not read (tables.py, "Numbers compare does
+  # not compute").
+  shade_low="$(python3 "$TABLES" csv-mean "$render_dir/timings.csv" shadeLow)"
+  shade_full="$(python3 "$TABLES" csv-mean "$render_dir/timings.csv" shadeFull)"
+  ss=()
+  [[ "$REFERENCE_SPP" -gt 0 ]] && ss=("$dir/metrics-supersampled.json" "$REFERENCE_SPP spp")
   {
     echo "## $name"
     echo
-    if [[ "$REFERENCE_SPP" -gt 0 ]]; then
-      echo "| method | shade ms | up ms | total ms | full-res shade ms | speed-up | PSNR dB | PSNR vs ${REFERENCE_SPP} spp |"
-      echo "|---|---|---|---|---|---|---|---|"
-    else
-      echo "| method | shade ms | up ms | total ms | full-res shade ms | speed-up | PSNR dB |"
-      echo "|---|---|---|---|---|---|---|"
-    fi
-    # compare's table: sequence frames psnr_rgb psnr_y ssim flicker compute_ms
-    awk -v low="$shade_low" -v full="$shade_full" -v ss="$dir/compare-supersampled.txt" -v has_ss="$REFERENCE_SPP" '
-      BEGIN { if (has_ss > 0) while ((getline line < ss) > 0) { split(line, f, " "); if (f[1] != "sequence") sspsnr[f[1]] = f[3] } }
-      NR > 1 && NF >= 7 {
-        up = ($7 == "-") ? 0 : $7; total = low + up
-        printf "| %s | %s | %s | %.3f | %s | %.1fx | %s |", $1, low, $7, total, full, (total > 0 ? full / total : 0), $3
-        if (has_ss > 0) printf " %s |", ($1 in sspsnr) ? sspsnr[$1] : "-"
-        printf "\n"
-      }' "$dir/compare.txt"
-    # The issue's reading of Table 1: herzog's margin over both baselines.
-    awk 'NR > 1 && NF >= 7 { p[$1] = $3 }
-      END { if (("herzog" in p) && ("spatial" in p) && ("temporal" in p))
-              printf "\nherzog - spatial: %+.2f dB, herzog - temporal: %+.2f dB.\n", p["herzog"] - p["spatial"], p["herzog"] - p["temporal"] }' \
-      "$dir/compare.txt"
+    python3 "$TABLES" upsample-st "$dir" "$shade_low" "$shade_full" "${ss[@]}"
     echo
     echo "Per-frame PSNR: $name/psnr.png; metrics: $name/metrics.csv, $name/metrics.json."
     echo
@@ -248,17 +194,17 @@ done
   echo
   echo "Against the full-resolution payload (that frame's SSAO pattern and VPL set):"
   echo
-  python3 "$here/pipelines/phlm_tables.py" scenes-by-row "$OUT" "$scene_names" "$seq_names" "$pair_args"
+  python3 "$TABLES" scenes-by-row "$OUT" "$scene_names" "$seq_names" "$pair_args"
   echo
   if [[ "$NOISE_AVERAGED_SPP" -gt 0 ]]; then
     echo "Against the noise-averaged payload ($NOISE_AVERAGED_SPP samples at every pixel centre, each with its own SSAO"
     echo "pattern and VPL set):"
     echo
-    python3 "$here/pipelines/phlm_tables.py" scenes-by-row "$OUT/noise-averaged" "$scene_names" "$seq_names" "$pair_args"
+    python3 "$TABLES" scenes-by-row "$OUT/noise-averaged" "$scene_names" "$seq_names" "$pair_args"
     echo
   fi
 } >> "$summary"
 
 echo
 cat "$summary"
-echo "upsample-st.sh: report in $OUT (summary.md, per scene: metrics.csv, metrics.json, psnr*.png)" >&2
+say "report in $OUT (summary.md, per scene: metrics.csv, metrics.json, psnr*.png)"

@@ -132,6 +132,9 @@ int Tool::run(int argc, char** argv, const std::function<Status()>& body) {
     sigemptyset(&action.sa_mask);
     sigaction(sig, &action, nullptr);
   }
+  // A file-size limit (ulimit -f) must fail the write, not kill the tool: with SIGXFSZ ignored the write returns
+  // EFBIG, the writer reports an output error (exit 4) and no file reaches its final name.
+  std::signal(SIGXFSZ, SIG_IGN);
   std::optional<ThreadLimit> limit;
   if (threads_ > 0) limit.emplace(threads_);
   try {

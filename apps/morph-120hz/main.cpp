@@ -47,6 +47,7 @@ int main(int argc, char** argv) {
   return tool.run(argc, argv, [&]() -> Status {
     auto stage = make_morph_stage(options, MorphStageIO{&read_exr_rgb, &load_display_gamma});
     if (!stage) return stage.error();
+    if (!options.lag_reference.empty()) seq.other_inputs.push_back(options.lag_reference);  // never an output
     auto summary = run_sequence(seq, **stage, tool.identity(), tool.hooks());
     if (!summary) return summary.error();
     tool.log(std::to_string(summary->frames) + " input frames, " + std::to_string(summary->outputs) +

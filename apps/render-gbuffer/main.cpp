@@ -1,124 +1,129 @@
-// render-gbuffer: replays an animated glTF or text USD scene with OSMesa into multi-layer EXR sequences
-// (docs/render-gbuffer.md). Binds the command line to the library's option structs (whose defaults are the
-// documented ones), loads the scene and runs the library's replay (temporal/render/replay.h).
+// render-gbuffer: replays an animated glTF or text USD scene with OpenGL (OSMesa's llvmpipe, or an EGL device such as
+// a GPU) into multi-layer EXR sequences (docs/render-gbuffer.md). Binds the command line to the library's option
+// structs through Param tables (whose defaults are the documented ones), loads the scene and runs the library's
+// replay (temporal/replay/replay.h).
 #include "tool.h"
 
-#include "temporal/core/jitter.h"
-#include "temporal/render/replay.h"
+#include "temporal/replay/replay.h"
 #include "temporal/scene/scene.h"
 
 #include <cstdlib>
+#include <limits>
+#include <iostream>
 #include <optional>
 
 using namespace temporal;
 
 namespace {
 
-// The options whose command-line form is text the library parses; each starts as the library's default.
-struct TextOptions {
-  explicit TextOptions(const RenderOptions& r, const SceneLoadOptions& l, const ReplayOptions& p)
-      : size(size_string(r)), payload(payload_terms_string(r.payload)), outputs(r.outputs.to_string()),
-        jitter(to_string(r.color_jitter)), shade_jitter(to_string(r.shade_jitter)), reference_jitter(to_string(r.reference_jitter)), shade_mip_bias(shade_mip_bias_string(r)),
-        camera_path(camera_path_name(l.camera.path)), compression(compression_name(p.compression)), mipmaps_off(!r.mipmaps) {}
-  std::string scene, size, payload, outputs, jitter, shade_jitter, reference_jitter, shade_mip_bias, camera_path, compression, frames;
-  bool mipmaps_off;
+// The scene and replay options: numbers bind to the option structs, text forms to this struct (each starts as the
+// library's default).
+struct SequenceText {
+  explicit SequenceText(const SceneLoadOptions& l, const ReplayOptions& p)
+      : camera_path(camera_path_name(l.camera.path)), compression(compression_name(p.compression)) {}
+  std::string scene, camera_path, compression, frames;
 };
 
-Status apply(const TextOptions& t, RenderOptions& r, SceneLoadOptions& l, ReplayOptions& p) {
-  if (auto s = parse_size(t.size, r); !s) return s;
-  auto payload = parse_payload_terms(t.payload, r.payload);
-  if (!payload) return payload.error();
-  r.payload = *payload;
-  auto outputs = RenderOutputs::parse(t.outputs);
-  if (!outputs) return outputs.error();
-  r.outputs = *outputs;
-  auto color = parse_jitter_mode(t.jitter);
-  if (!color) return color.error();
-  auto shade = parse_jitter_mode(t.shade_jitter);
-  if (!shade) return shade.error();
-  auto reference = parse_jitter_mode(t.reference_jitter);
-  if (!reference) return reference.error();
-  r.color_jitter = *color;
-  r.shade_jitter = *shade;
-  r.reference_jitter = *reference;
+ParamList sequence_params(SceneLoadOptions& l, ReplayOptions& p, SequenceText& t) {
+  const double inf = std::numeric_limits<double>::infinity();
+  Param fps{"--fps", "Frames per second: frame N is the scene at N / fps seconds", &p.fps, 0.0, 10000.0};
+  fps.above_min = true;
+  // Scene::load checks the period where a path uses it (> 0); a fixed camera ignores it.
+  Param period{"--camera-period", "Seconds per orbit turn or dolly back-and-forth", &l.camera.path_period_s, -inf, inf};
+  return {
+      fps,
+      Param::text("--frames", "Frames A-B (inclusive); default: the whole clip", &t.frames),
+      Param{"--duration", "Seconds to render from frame 0 (instead of --frames)", &p.duration_s, 0.0, inf},
+      Param::text("--camera", "Camera name, index or USD prim path; default: the first camera or an automatic one",
+                  &l.camera.camera),
+      Param::text("--clip", "glTF animation name or index; default: the first animation", &l.clip),
+      Param::choice("--camera-path", "fixed, or an automatic orbit | dolly camera path", &t.camera_path,
+                    {"fixed", "orbit", "dolly"}),
+      period,
+      Param::choice("--compression", "EXR compression", &t.compression, {"zip", "piz", "none"}),
+  };
+}
+
+Status apply_sequence_text(const SequenceText& t, SceneLoadOptions& l, ReplayOptions& p) {
   auto compression = parse_replay_compression(t.compression);
   if (!compression) return compression.error();
   p.compression = *compression;
-  if (auto s = parse_shade_mip_bias(t.shade_mip_bias, r); !s) return s;
-  r.mipmaps = !t.mipmaps_off;
   auto path = parse_camera_path(t.camera_path);
   if (!path) return path.error();
   l.camera.path = *path;
-  if (auto s = validate(p); !s) return s;
-  return validate(r);
+  if (!t.frames.empty()) {
+    auto range = FrameRange::parse(t.frames);
+    if (!range) return range.error();
+    p.frames = *range;
+  }
+  return validate(p);
 }
 
-Status run(const tool::Tool& tool, const TextOptions& text, RenderOptions render, SceneLoadOptions load, ReplayOptions replay) {
-  if (auto s = apply(text, render, load, replay); !s) return s;
-  auto scene = Scene::load(text.scene, load);
-  if (!scene) return scene.error();
-  for (const std::string& w : scene->warnings()) tool.log("warning: " + w);
-  if (!text.frames.empty()) {
-    auto range = FrameRange::parse(text.frames);
-    if (!range) return range.error();
-    replay.frames = *range;
+// --list-gl-devices: one line per EGL device (index, kind, renderer of a context made on it, its extensions).
+Status list_devices() {
+  auto devices = list_gl_devices();
+  if (!devices) return devices.error();
+  if (devices->empty()) std::cerr << "render-gbuffer: EGL finds no device (--gl osmesa still works)\n";
+  for (const GlDevice& d : *devices) {
+    std::cout << d.index << '\t' << (d.software ? "software" : "hardware") << '\t'
+              << (d.error.empty() ? d.renderer + " | " + d.version : "no OpenGL 4.5 core context: " + d.error) << '\t'
+              << d.extensions << '\n';
   }
-  // llvmpipe reads LP_NUM_THREADS when the context is created.
-  if (tool.threads() > 0) setenv("LP_NUM_THREADS", std::to_string(tool.threads()).c_str(), 1);
-  replay.tool = tool.signature();
-  replay.parameters = tool.command_line();
-  std::optional<tool::Progress> progress;
-  ReplayHooks hooks;
-  hooks.log = [&](const std::string& line) { tool.log(line); };
-  hooks.frame_done = [&](int frame, int total) {
-    if (!progress) progress.emplace(tool.name(), total);
-    progress->step(frame);
-  };
-  return temporal::replay(*scene, render, replay, hooks);
+  return {};
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
   tool::Tool tool("render-gbuffer",
-                  "Replays an animated glTF 2.0 or text USD scene with OSMesa (llvmpipe) into multi-layer EXR sequences:\n"
+                  "Replays an animated glTF 2.0 or text USD scene with OpenGL - OSMesa's llvmpipe, or a GPU through EGL "
+                  "(--gl) - into multi-layer EXR sequences:\n"
                   "G-buffer, low-resolution jittered payload, supersampled reference and 1-spp colour.");
   RenderOptions r;
   SceneLoadOptions l;
   ReplayOptions p;
-  TextOptions t(r, l, p);
-  PayloadOptions& pl = r.payload;
+  RenderText rt(r);
+  SequenceText st(l, p);
   auto& app = tool.app();
-  app.add_option("scene", t.scene, "glTF 2.0 (.gltf, .glb) or text USD (.usda, .usd) scene")->required();
+  app.add_option("scene", st.scene, "glTF 2.0 (.gltf, .glb) or text USD (.usda, .usd) scene")->required();
   app.add_option("--out", p.out_dir, "Output folder (gbuffer/shade/reference/color.####.exr, timings.csv)")->required();
-  app.add_option("--size", t.size, "Full resolution WIDTHxHEIGHT");
-  app.add_option("--fps", p.fps, "Frames per second: frame N is the scene at N / fps seconds");
-  auto* frames = app.add_option("--frames", t.frames, "Frames A-B (inclusive); default: the whole clip");
-  auto* duration = app.add_option("--duration", p.duration_s, "Seconds to render from frame 0 (instead of --frames)");
-  frames->excludes(duration);
-  app.add_option("--camera", l.camera.camera, "Camera name, index or USD prim path; default: the first camera or an automatic one");
-  app.add_option("--clip", l.clip, "glTF animation name or index; default: the first animation");
-  app.add_option("--camera-path", t.camera_path, "fixed, or an automatic orbit | dolly camera path");
-  app.add_option("--camera-period", l.camera.path_period_s, "Seconds per orbit turn or dolly back-and-forth");
-  app.add_option("--payload", t.payload, "Payload terms: any of direct,shadow,ssao,gi");
-  app.add_option("--factor", r.factor, "Low-resolution factor k: shade is width/k x height/k");
-  app.add_option("--jitter", t.jitter, "Colour jitter: regular|regular-raster|halton|random|none");
-  app.add_option("--shade-jitter", t.shade_jitter, "Shade jitter: regular (k x k pattern, dispersed order)|regular-raster (raster order)|halton|random|none");
-  app.add_option("--reference-spp", r.reference_spp, "Reference samples per pixel");
-  app.add_option("--reference-jitter", t.reference_jitter,
-                 "Reference sample positions: halton (supersampled) | none (pixel centres: the colour with its SSAO/VPL noise averaged)");
-  app.add_option("--outputs", t.outputs, "Outputs: any of gbuffer,shade,reference,color");
-  app.add_option("--pcf", pl.pcf_kernel, "Shadow PCF kernel N (N x N shadow-map texels)");
-  app.add_option("--shadow-map-size", pl.shadow_map_size, "Shadow map texels per side");
-  app.add_option("--shadow-bias", pl.shadow_bias, "Shadow normal offset in shadow-map texels");
-  app.add_option("--ssao-directions", pl.ssao_directions, "SSAO horizon directions");
-  app.add_option("--ssao-steps", pl.ssao_steps, "SSAO steps per direction");
-  app.add_option("--ssao-radius", pl.ssao_radius, "SSAO radius in world units; 0: 5% of the scene diagonal");
-  app.add_option("--vpls", pl.vpl_count, "Virtual point lights for gi");
-  app.add_option("--rsm-size", pl.rsm_size, "Reflective shadow map texels per side (VPL candidates)");
-  app.add_flag("--no-mipmaps", t.mipmaps_off, "Sample textures without mipmaps (severe undersampling)");
-  app.add_option("--shade-mip-bias", t.shade_mip_bias, "Texture LOD bias of the low-res payload; auto: -log2(K), the full-res mip level");
-  app.add_option("--seed", r.seed, "Seed of random jitter, SSAO patterns and VPL sets");
-  app.add_option("--compression", t.compression, "EXR compression: zip|piz|none");
-  return tool.run(argc, argv, [&]() { return run(tool, t, r, l, p); });
+  tool.add_params(sequence_params(l, p, st));
+  tool.add_params(render_params(r, rt));
+  app.get_option("--frames")->excludes("--duration");
+  // Lists and exits before the required scene and --out are checked (CLI11 runs flag callbacks first).
+  bool listed = false;
+  app.add_flag_callback(
+      "--list-gl-devices",
+      [&] {
+        listed = true;
+        throw CLI::Success();
+      },
+      "Print the EGL devices (index, software|hardware, the renderer of a 4.5 core context on it, EGL extensions; "
+      "tab-separated, one per line) and exit");
+  int rc = tool.run(argc, argv, [&]() -> Status {
+    if (auto s = apply_sequence_text(st, l, p); !s) return s;
+    if (auto s = apply_render_text(rt, r); !s) return s;
+    auto scene = Scene::load(st.scene, l);
+    if (!scene) return scene.error();
+    for (const std::string& w : scene->warnings()) tool.log("warning: " + w);
+    // llvmpipe reads LP_NUM_THREADS when the context is created.
+    if (tool.threads() > 0) setenv("LP_NUM_THREADS", std::to_string(tool.threads()).c_str(), 1);
+    p.tool = tool.signature();
+    p.parameters = tool.command_line();
+    std::optional<tool::Progress> progress;
+    ReplayHooks hooks;
+    hooks.log = [&](const std::string& line) { tool.log(line); };
+    hooks.frame_done = [&](int frame, int total) {
+      if (!progress) progress.emplace(tool.name(), total);
+      progress->step(frame);
+    };
+    return temporal::replay(*scene, r, p, hooks);
+  });
+  if (!listed) return rc;
+  // Listed outside Tool::run's body (the parse stopped at CLI::Success); errors map to the same exit codes.
+  if (Status s = list_devices(); !s) {
+    tool.print_error(s.error());
+    return tool::exit_code_for(s.error());
+  }
+  return tool::kExitOk;
 }

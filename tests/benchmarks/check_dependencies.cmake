@@ -1,6 +1,7 @@
 # Checks that a program's dynamic dependencies (the whole closure, as the dynamic loader resolves it) contain no
 # image or colour library, so that it can be copied to a machine that has only a GPU driver and the C++ runtime.
-# Run as: cmake -DPROGRAM=<file> -P check_dependencies.cmake
+# Run as: cmake -DPROGRAM=<file> [-DALLOW_GL=ON] -P check_dependencies.cmake (ALLOW_GL: the renderer's benchmark,
+# which needs OSMesa or libEGL by design; image and colour libraries stay refused).
 # Fails with the offending libraries listed.
 cmake_minimum_required(VERSION 3.25)
 if(NOT EXISTS "${PROGRAM}")
@@ -18,7 +19,11 @@ foreach(line IN LISTS _lines)
   if(line MATCHES "=>")
     math(EXPR _count "${_count} + 1")
   endif()
-  if(line MATCHES "(libOpenImageIO|libOpenEXR|libOpenColorIO|libImath|libIex|libIlmThread|libvtk|libOSMesa|libGL\\.so|libavcodec)")
+  set(_refused "libOpenImageIO|libOpenEXR|libOpenColorIO|libImath|libIex|libIlmThread|libvtk|libavcodec")
+  if(NOT ALLOW_GL)
+    string(APPEND _refused "|libOSMesa|libGL\\.so|libEGL|libOpenGL")
+  endif()
+  if(line MATCHES "(${_refused})")
     string(STRIP "${line}" line)
     list(APPEND _bad "${line}")
   endif()

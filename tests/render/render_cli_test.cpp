@@ -9,6 +9,7 @@
 #include <cstring>
 #include <fstream>
 #include <iterator>
+#include <sstream>
 #include <vector>
 
 namespace temporal {
@@ -374,6 +375,71 @@ TEST(RenderCli, RunawayRangesAndMalformedScenesAreRefused) {
                                   (dir / "o").string(), &out), 2) << out;
   EXPECT_NE(out.find("camera's transform"), std::string::npos) << out;
   EXPECT_FALSE(fs::exists(dir / "o" / "gbuffer.0000.exr"));
+}
+
+// Issue 22: the EGL path. On this machine EGL's only device is Mesa's software one (llvmpipe, as OSMesa), so
+// `--gl egl` must write exactly the files of `--gl osmesa` (every plane of the four outputs), and each header names
+// the context and renderer that made it.
+TEST(RenderCli, EglAndOsmesaWriteBitIdenticalFiles) {
+  const auto dir = test::scratch_dir("render_cli_egl");
+  const std::string scene = (test::source_dir() / "assets" / "scenes" / "tower.glb").string();
+  const std::string common = tool() + " " + scene + " --size 64x48 --frames 0-2 --reference-spp 2 --vpls 64 " +
+                             "--shadow-map-size 256";
+  std::string out;
+  ASSERT_EQ(test::run_command(common + " --gl osmesa --out " + (dir / "osmesa").string(), &out), 0) << out;
+  ASSERT_EQ(test::run_command(common + " --gl egl --out " + (dir / "egl").string(), &out), 0) << out;
+  for (const char* name : {"gbuffer", "shade", "reference", "color"})
+    for (const char* f : {".0000.exr", ".0001.exr", ".0002.exr"}) {
+      const std::string file = std::string(name) + f;
+      EXPECT_TRUE(same_pixels(dir / "osmesa" / file, dir / "egl" / file)) << file;
+      auto a = read_exr_info((dir / "osmesa" / file).string());
+      auto b = read_exr_info((dir / "egl" / file).string());
+      ASSERT_TRUE(a && b) << file;
+      EXPECT_EQ(a->metadata.extra["glContext"], "osmesa") << file;
+      EXPECT_EQ(b->metadata.extra["glContext"], "egl") << file;
+      EXPECT_EQ(b->metadata.extra["glDevice"], "0") << file;
+      EXPECT_EQ(a->metadata.extra["glRenderer"].rfind("llvmpipe", 0), 0u) << a->metadata.extra["glRenderer"];
+      EXPECT_EQ(a->metadata.extra["glRenderer"], b->metadata.extra["glRenderer"]);
+      EXPECT_NE(b->metadata.extra["glVersion"].find("4.5"), std::string::npos) << b->metadata.extra["glVersion"];
+      EXPECT_FALSE(b->metadata.extra["glVendor"].empty());
+    }
+}
+
+TEST(RenderCli, ListGlDevicesListsTheSoftwareDevice) {
+  std::string out;
+  // No scene and no --out: listing needs neither.
+  ASSERT_EQ(test::run_command(tool() + " --list-gl-devices", &out), 0) << out;
+  bool found = false;
+  std::istringstream lines(out);
+  for (std::string line; std::getline(lines, line);)
+    found = found || (line.find("\tsoftware\tllvmpipe") != std::string::npos &&
+                      line.find("EGL_MESA_device_software") != std::string::npos);
+  EXPECT_TRUE(found) << out;
+}
+
+TEST(RenderCli, GlOptionsAreCheckedAndAutoTakesOsmesaWithoutAGpu) {
+  const auto dir = test::scratch_dir("render_cli_gl_options");
+  const auto scene = write_test_scene(dir).string();
+  const std::string cmd = tool() + " " + scene + " --size 32x24 --frames 0-0 --outputs gbuffer";
+  std::string out;
+  EXPECT_EQ(test::run_command(cmd + " --gl vulkan --out " + (dir / "o").string(), &out), 1) << out;
+  EXPECT_EQ(test::run_command(cmd + " --gl egl --gl-device 99 --out " + (dir / "o").string(), &out), 1) << out;
+  EXPECT_NE(out.find("--gl-device"), std::string::npos) << out;
+  EXPECT_EQ(test::run_command(cmd + " --gl-device -2 --out " + (dir / "o").string(), &out), 1) << out;
+  EXPECT_FALSE(fs::exists(dir / "o" / "gbuffer.0000.exr"));
+  // auto: a hardware EGL device when --list-gl-devices shows one, else OSMesa.
+  std::string list;
+  ASSERT_EQ(test::run_command(tool() + " --list-gl-devices", &list), 0) << list;
+  const bool gpu = list.find("\thardware\t") != std::string::npos;
+  ASSERT_EQ(test::run_command(cmd + " --gl auto --out " + (dir / "auto").string(), &out), 0) << out;
+  auto info = read_exr_info((dir / "auto" / "gbuffer.0000.exr").string());
+  ASSERT_TRUE(info) << info.error().message;
+  EXPECT_EQ(info->metadata.extra["glContext"], gpu ? "egl" : "osmesa") << list;
+  // The default is OSMesa (the CI path).
+  ASSERT_EQ(test::run_command(cmd + " --out " + (dir / "default").string(), &out), 0) << out;
+  info = read_exr_info((dir / "default" / "gbuffer.0000.exr").string());
+  ASSERT_TRUE(info) << info.error().message;
+  EXPECT_EQ(info->metadata.extra["glContext"], "osmesa");
 }
 
 }  // namespace

@@ -89,6 +89,10 @@ TemporaryFile::~TemporaryFile() {
 
 Status TemporaryFile::commit() {
   std::error_code ec;
+  // rename() would replace a device node, a socket or a pipe by the file (as root, even /dev/null's twin): only a
+  // regular file or a new name may be written.
+  if (const fs::file_status st = fs::status(target_, ec); !ec && fs::exists(st) && !fs::is_regular_file(st))
+    return Error::output(target_, "exists and is not a regular file: name a new file or a regular one to replace");
   fs::rename(temporary_, target_, ec);
   if (ec) return Error::output(target_, "cannot move the finished file into place: " + ec.message());
   committed_ = true;
@@ -100,8 +104,11 @@ Status write_text_atomic(const std::string& path, const std::string& text) {
   {
     std::ofstream out(tmp.path(), std::ios::binary | std::ios::trunc);
     out << text;
-    out.flush();
+    out.close();  // close() flushes; its failure (a full disk) sets failbit, checked below
     if (!out) return Error::output(path, "cannot write (is the disk full or the folder read-only?)");
+    std::error_code ec;
+    if (fs::file_size(tmp.path(), ec) != text.size() || ec)
+      return Error::output(path, "cannot write the whole file (is the disk full or a file-size limit reached?)");
   }
   return tmp.commit();
 }

@@ -513,6 +513,12 @@ Status write_exr(const std::string& path, const Image& image, const ExrWriteOpti
   if (!ok)
     return Error::output(path, "cannot write: " + (write_error.empty() ? oiio_error("unknown error") : write_error) +
                                    " (is the disk full or the folder read-only?)");
+  // OpenEXR's stream does not report every failed write (a full disk gave a truncated file and no error), so the
+  // finished temporary file is checked the way inputs are - every part's last chunk inside the file - before it
+  // may take the final name. Cost: one header read of a file that is in the page cache.
+  if (Status s = check_exr_structure(tmp); !s)
+    return Error::output(path, "the file written is incomplete (is the disk full or a file-size limit reached?): " +
+                                   s.error().message);
   return file.commit();
 }
 

@@ -50,6 +50,10 @@ Expected<Plan> make_plan(const SequenceOptions& o, const StageInputs& needs) {
   if (Status s = check_output_name(o.out, "--out"); !s) return s.error();
   if (!o.state_out.empty())
     if (Status s = check_output_name(o.state_out, "--state-out"); !s) return s.error();
+  OutputPaths outputs;
+  if (Status s = outputs.add(o.out, "--out"); !s) return s.error();
+  if (!o.state_out.empty())
+    if (Status s = outputs.add(o.state_out, "--state-out"); !s) return s.error();
   std::optional<FrameRange> range;
   if (!o.frames.empty()) {
     auto r = FrameRange::parse(o.frames);
@@ -180,6 +184,59 @@ void ProtectedInputs::add(const std::string& path) {
   if (::stat(path.c_str(), &st) == 0) ids_.insert({std::uint64_t(st.st_dev), std::uint64_t(st.st_ino)});
 }
 
+namespace {
+
+// Does file name `name` match the frame pattern prefix + digits + suffix?
+bool matches_pattern(const std::string& name, const std::string& prefix, const std::string& suffix) {
+  if (name.size() <= prefix.size() + suffix.size() || name.compare(0, prefix.size(), prefix) != 0 ||
+      name.compare(name.size() - suffix.size(), suffix.size(), suffix) != 0)
+    return false;
+  const std::string digits = name.substr(prefix.size(), name.size() - prefix.size() - suffix.size());
+  return digits.find_first_not_of("0123456789") == std::string::npos;
+}
+
+}  // namespace
+
+Status OutputPaths::add(const std::string& path, const std::string& what) {
+  namespace fs = std::filesystem;
+  auto pattern = SequencePattern::parse(path);
+  if (!pattern) return pattern.error();
+  std::error_code ec;
+  if (!pattern->has_placeholder()) {
+    const fs::file_status st = fs::status(path, ec);
+    if (!ec && fs::exists(st) && !fs::is_regular_file(st))
+      return Error::usage(what + " '" + path + "' exists and is not a regular file (" +
+                          (fs::is_directory(st) ? "a folder" : "a device, pipe or socket") +
+                          "): name a new file or a regular one to replace");
+  }
+  Entry e;
+  const fs::path p(pattern->has_placeholder() ? pattern->prefix() : path);
+  const fs::path folder = p.has_parent_path() ? p.parent_path() : fs::path(".");
+  e.folder = fs::weakly_canonical(fs::absolute(folder, ec), ec).string();
+  e.pattern = pattern->has_placeholder();
+  e.prefix = p.filename().string();
+  e.suffix = e.pattern ? pattern->suffix() : std::string();
+  e.what = what;
+  e.text = path;
+  for (const Entry& o : entries_) {
+    if (o.folder != e.folder) continue;
+    bool same = false;
+    if (e.pattern && o.pattern)
+      same = e.prefix == o.prefix && e.suffix == o.suffix;  // any width: "####" and "%d" share frames >= 1000
+    else if (e.pattern)
+      same = matches_pattern(o.prefix, e.prefix, e.suffix);
+    else if (o.pattern)
+      same = matches_pattern(e.prefix, o.prefix, o.suffix);
+    else
+      same = e.prefix == o.prefix;
+    if (same)
+      return Error::usage(what + " '" + path + "' names the same file" + (e.pattern || o.pattern ? "s" : "") + " as " +
+                          o.what + " '" + o.text + "': one would overwrite the other; give each output its own name");
+  }
+  entries_.push_back(std::move(e));
+  return Status::ok();
+}
+
 Status ProtectedInputs::check(const std::string& path, const std::string& what) const {
   struct stat st {};
   if (::stat(path.c_str(), &st) != 0 || !ids_.count({std::uint64_t(st.st_dev), std::uint64_t(st.st_ino)}))
@@ -230,6 +287,11 @@ Expected<RunSummary> run_sequence(const SequenceOptions& options, FrameStage& st
     if (plan->gbuffer) inputs.add(plan->gbuffer->path(f));
   }
   if (!options.state_in.empty()) inputs.add(options.state_in);
+  for (const std::string& other : options.other_inputs) {
+    auto p = SequencePattern::parse(other);
+    if (!p) return p.error();
+    for (int f : plan->frames) inputs.add(p->path(f));
+  }
   if (Status s = inputs.check(plan->out.path(plan->frames.front()), "--out"); !s) return s.error();
   if (plan->state_out)
     if (Status s = inputs.check(plan->state_out->path(plan->frames.front()), "--state-out"); !s) return s.error();

@@ -1,48 +1,33 @@
 #include "gl_api.h"
 
-#include <GL/osmesa.h>
-
 #include <cstdio>
 #include <vector>
 
 namespace temporal::render_detail {
 
-Expected<std::unique_ptr<GlContext>> GlContext::create() {
-  // Core profile 4.5 is the highest llvmpipe grants (4.6 is refused, docs/building.md). No depth or
-  // stencil in the default framebuffer: every pass renders into its own FBO.
-  const int attribs[] = {OSMESA_FORMAT, OSMESA_RGBA, OSMESA_DEPTH_BITS, 0, OSMESA_STENCIL_BITS, 0,
-                         OSMESA_PROFILE, OSMESA_CORE_PROFILE, OSMESA_CONTEXT_MAJOR_VERSION, 4,
-                         OSMESA_CONTEXT_MINOR_VERSION, 5, 0};
-  std::unique_ptr<GlContext> ctx(new GlContext());
-  ctx->context_ = OSMesaCreateContextAttribs(attribs, nullptr);
-  if (!ctx->context_)
-    return Error::internal("OSMesa could not create an OpenGL 4.5 core context (is Mesa's llvmpipe installed?)");
-  if (!OSMesaMakeCurrent(static_cast<OSMesaContext>(ctx->context_), ctx->dummy_, GL_UNSIGNED_BYTE, 1, 1))
-    return Error::internal("OSMesaMakeCurrent failed");
+Status GlContext::load(void* (*get_proc)(const char*), const char* kind, int device) {
   std::string missing;
-#define TEMPORAL_GL_LOAD(type, name)                                                     \
-  ctx->gl_.name = reinterpret_cast<type>(OSMesaGetProcAddress("gl" #name));             \
-  if (!ctx->gl_.name) missing += " gl" #name;
+#define TEMPORAL_GL_LOAD(type, name)                                     \
+  gl_.name = reinterpret_cast<type>(get_proc("gl" #name));               \
+  if (!gl_.name) missing += " gl" #name;
   TEMPORAL_GL_FUNCTIONS(TEMPORAL_GL_LOAD)
 #undef TEMPORAL_GL_LOAD
-  if (!missing.empty()) return Error::internal("OSMesa lacks OpenGL entry points:" + missing);
-  return ctx;
-}
-
-GlContext::~GlContext() {
-  if (context_) OSMesaDestroyContext(static_cast<OSMesaContext>(context_));
-}
-
-void GlContext::make_current() {
-  OSMesaMakeCurrent(static_cast<OSMesaContext>(context_), dummy_, GL_UNSIGNED_BYTE, 1, 1);
-}
-
-std::string GlContext::description() const {
+  if (!missing.empty()) return Error::internal(std::string(kind) + " lacks OpenGL entry points:" + missing);
   auto str = [&](GLenum e) {
     const GLubyte* s = gl_.GetString(e);
     return s ? std::string(reinterpret_cast<const char*>(s)) : std::string("?");
   };
-  return str(GL_RENDERER) + ", OpenGL " + str(GL_VERSION);
+  info_.context = kind;
+  info_.device = device;
+  info_.vendor = str(GL_VENDOR);
+  info_.renderer = str(GL_RENDERER);
+  info_.version = str(GL_VERSION);
+  return {};
+}
+
+std::string GlContext::description() const {
+  return info_.renderer + ", OpenGL " + info_.version + " (" + info_.context +
+         (info_.device >= 0 ? " device " + std::to_string(info_.device) : std::string()) + ")";
 }
 
 namespace {

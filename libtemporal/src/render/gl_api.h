@@ -1,12 +1,14 @@
-// The OpenGL 4.5 core entry points the renderer uses, loaded through OSMesaGetProcAddress, and the OSMesa
-// context that owns them. Internal to src/render.
+// The OpenGL 4.5 core entry points the renderer uses, loaded through the context's own GetProcAddress
+// (OSMesaGetProcAddress or eglGetProcAddress), and the contexts that own them. Internal to src/render.
 //
 // Why a loader: libOSMesa exports every gl* symbol, and so does libGL. A process that has libGL loaded
 // first (VTK links it) silently sends every direct gl* call to libGL, which has no current context.
-// Loading each entry point from OSMesa by name keeps the renderer correct whatever else is linked.
+// Loading each entry point from the context's library by name keeps the renderer correct whatever else is
+// linked, and lets one renderer run on either context.
 #pragma once
 
 #include "temporal/core/error.h"
+#include "temporal/render/render.h"
 
 #include <GL/glcorearb.h>
 
@@ -85,7 +87,13 @@ namespace temporal::render_detail {
   X(PFNGLUNIFORM4FPROC, Uniform4f)                                            \
   X(PFNGLUNIFORM4FVPROC, Uniform4fv)                                          \
   X(PFNGLUNIFORMMATRIX3FVPROC, UniformMatrix3fv)                              \
-  X(PFNGLUNIFORMMATRIX4FVPROC, UniformMatrix4fv)
+  X(PFNGLUNIFORMMATRIX4FVPROC, UniformMatrix4fv)                              \
+  X(PFNGLGENQUERIESPROC, GenQueries)                                          \
+  X(PFNGLDELETEQUERIESPROC, DeleteQueries)                                    \
+  X(PFNGLBEGINQUERYPROC, BeginQuery)                                          \
+  X(PFNGLENDQUERYPROC, EndQuery)                                              \
+  X(PFNGLGETQUERYIVPROC, GetQueryiv)                                          \
+  X(PFNGLGETQUERYOBJECTUI64VPROC, GetQueryObjectui64v)
 
 // The function table. Members are named without the `gl` prefix: gl.DrawElements(...).
 struct GlFunctions {
@@ -94,27 +102,45 @@ struct GlFunctions {
 #undef TEMPORAL_GL_MEMBER
 };
 
-// An OSMesa OpenGL 4.5 core context (llvmpipe), current on the creating thread while it lives, and the
-// entry points loaded from it. LP_NUM_THREADS must be set before create() to take effect.
+// An OpenGL 4.5 core context, current on the creating thread while it lives, and the entry points loaded from
+// it. Two kinds make one (gl_context.cpp): OSMesa (llvmpipe in the process, the CI path) and EGL's device platform
+// (any EGL device: Mesa's software device, or a GPU's driver through glvnd's libEGL; no window, no X, surfaceless).
+// The renderer only sees this interface: every pass draws into its own FBOs and reads them back, so neither the
+// default framebuffer (OSMesa's 1x1 buffer, none with EGL) nor the context's kind can change what it writes.
+// LP_NUM_THREADS must be set before creation to take effect on llvmpipe.
 class GlContext {
  public:
-  static Expected<std::unique_ptr<GlContext>> create();
-  ~GlContext();
+  virtual ~GlContext() = default;
   GlContext(const GlContext&) = delete;
   GlContext& operator=(const GlContext&) = delete;
 
   const GlFunctions& gl() const { return gl_; }
-  // "llvmpipe (LLVM 15.0.6, 256 bits), OpenGL 4.5 (Core Profile) Mesa 22.3.6"
+  // What made the context: kind "osmesa" or "egl", the EGL device index (-1 for OSMesa), and GL_VENDOR,
+  // GL_RENDERER, GL_VERSION as the driver reports them.
+  const GlInfo& info() const { return info_; }
+  // "llvmpipe (LLVM 15.0.6, 256 bits), OpenGL 4.5 (Core Profile) Mesa 22.3.6 (egl device 0)"
   std::string description() const;
   // Makes this context current on the calling thread again.
-  void make_current();
+  virtual void make_current() = 0;
+
+ protected:
+  GlContext() = default;
+  // Loads every entry point through `get_proc` ("glDrawElements" -> address) and fills info() from the then
+  // current context. Internal error naming the entry points the driver lacks.
+  Status load(void* (*get_proc)(const char*), const char* kind, int device);
 
  private:
-  GlContext() = default;
-  void* context_ = nullptr;         // OSMesaContext
-  unsigned char dummy_[16] = {};     // 1x1 default framebuffer (all rendering goes to FBOs)
   GlFunctions gl_;
+  GlInfo info_;
 };
+
+// An OSMesa context (llvmpipe).
+Expected<std::unique_ptr<GlContext>> create_osmesa_context();
+// A context on EGL device `device` (index into eglQueryDevicesEXT's list); -1: the first hardware device, or
+// the first device when every one is software.
+Expected<std::unique_ptr<GlContext>> create_egl_context(int device);
+// The context RenderOptions asks for (GlApi::Auto: a hardware EGL device when one exists, else OSMesa).
+Expected<std::unique_ptr<GlContext>> create_context(GlApi api, int device);
 
 // Compiles and links a program from vertex and fragment sources; the error carries the info log.
 Expected<GLuint> build_program(const GlFunctions& gl, const std::string& name, const std::string& vertex,

@@ -4,6 +4,7 @@
 #include "shaders.h"
 
 #include <cmath>
+#include <limits>
 #include <sstream>
 
 namespace temporal {
@@ -134,6 +135,81 @@ Status validate(const RenderOptions& options) {
     return Error::usage("--vpls must be between 1 and " + std::to_string(kMaxVpls));
   if (p.rsm_size < 4 || p.rsm_size > 2048) return Error::usage("--rsm-size must be in 4..2048");
   return {};
+}
+
+RenderText::RenderText(const RenderOptions& d)
+    : size(size_string(d)), payload(payload_terms_string(d.payload)), outputs(d.outputs.to_string()),
+      jitter(to_string(d.color_jitter)), shade_jitter(to_string(d.shade_jitter)),
+      reference_jitter(to_string(d.reference_jitter)), shade_mip_bias(shade_mip_bias_string(d)), gl(to_string(d.gl)),
+      seed(double(d.seed)) {}
+
+ParamList render_params(RenderOptions& o, RenderText& t) {
+  PayloadOptions& p = o.payload;
+  const int most = std::numeric_limits<int>::max();
+  const std::vector<std::string> jitters = {"regular", "regular-raster", "halton", "random", "none"};
+  Param seed{"--seed", "Seed of random jitter, SSAO patterns and VPL sets", &t.seed, 0.0, 4294967295.0};
+  return {
+      Param::text("--size", "Full resolution WIDTHxHEIGHT", &t.size),
+      Param::text("--payload", "Payload terms: any of direct,shadow,ssao,gi", &t.payload),
+      Param::integer("--factor", "Low-resolution factor k: shade is width/k x height/k", &o.factor, 1, 16384),
+      Param::choice("--jitter", "Colour jitter", &t.jitter, jitters),
+      Param::choice("--shade-jitter",
+                    "Shade jitter: regular (k x k pattern, dispersed order), regular-raster (raster order), halton, "
+                    "random, none",
+                    &t.shade_jitter, jitters),
+      Param::integer("--reference-spp", "Reference samples per pixel", &o.reference_spp, 1, most),
+      Param::choice("--reference-jitter",
+                    "Reference sample positions: halton (supersampled) | none (pixel centres: the colour with its "
+                    "SSAO/VPL noise averaged)",
+                    &t.reference_jitter, {"halton", "none"}),
+      Param::text("--outputs", "Outputs: any of gbuffer,shade,reference,color", &t.outputs),
+      Param::integer("--pcf", "Shadow PCF kernel N (N x N shadow-map texels)", &p.pcf_kernel, 1, 32),
+      Param::integer("--shadow-map-size", "Shadow map texels per side", &p.shadow_map_size, 16, 8192),
+      Param::real("--shadow-bias", "Shadow normal offset in shadow-map texels", &p.shadow_bias,
+                  -std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity()),
+      Param::integer("--ssao-directions", "SSAO horizon directions", &p.ssao_directions, 1, most),
+      Param::integer("--ssao-steps", "SSAO steps per direction", &p.ssao_steps, 1, most),
+      Param::real("--ssao-radius", "SSAO radius in world units; 0: 5% of the scene diagonal", &p.ssao_radius,
+                  -std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity()),
+      Param::integer("--vpls", "Virtual point lights for gi", &p.vpl_count, 1, kMaxVpls),
+      Param::integer("--rsm-size", "Reflective shadow map texels per side (VPL candidates)", &p.rsm_size, 4, 2048),
+      Param::flag_off("--no-mipmaps", "Sample textures without mipmaps (severe undersampling)", &o.mipmaps),
+      Param::text("--shade-mip-bias", "Texture LOD bias of the low-res payload; auto: -log2(K), the full-res mip level",
+                  &t.shade_mip_bias),
+      seed,
+      Param::choice("--gl",
+                    "OpenGL context: osmesa (llvmpipe in the process), egl (EGL device platform: a GPU, or Mesa's "
+                    "software device), auto (a GPU through EGL when one exists, else osmesa)",
+                    &t.gl, {"osmesa", "egl", "auto"}),
+      Param::integer("--gl-device", "EGL device index (--list-gl-devices); -1: the first GPU, else the first device",
+                     &o.gl_device, -1, most),
+  };
+}
+
+Status apply_render_text(const RenderText& t, RenderOptions& r) {
+  if (auto s = parse_size(t.size, r); !s) return s;
+  auto payload = parse_payload_terms(t.payload, r.payload);
+  if (!payload) return payload.error();
+  r.payload = *payload;
+  auto outputs = RenderOutputs::parse(t.outputs);
+  if (!outputs) return outputs.error();
+  r.outputs = *outputs;
+  auto color = parse_jitter_mode(t.jitter);
+  if (!color) return color.error();
+  auto shade = parse_jitter_mode(t.shade_jitter);
+  if (!shade) return shade.error();
+  auto reference = parse_jitter_mode(t.reference_jitter);
+  if (!reference) return reference.error();
+  r.color_jitter = *color;
+  r.shade_jitter = *shade;
+  r.reference_jitter = *reference;
+  if (auto s = parse_shade_mip_bias(t.shade_mip_bias, r); !s) return s;
+  auto gl = parse_gl_api(t.gl);
+  if (!gl) return gl.error();
+  r.gl = *gl;
+  if (t.seed != std::floor(t.seed)) return Error::usage("--seed must be a whole number in [0, 4294967295]");
+  r.seed = std::uint32_t(t.seed);
+  return validate(r);
 }
 
 }  // namespace temporal

@@ -1,5 +1,5 @@
-// render-gbuffer's frame loop on the GPU (OSMesa llvmpipe): light maps, G-buffers, deferred payload
-// shading, read-back into planar images. docs/render-gbuffer.md explains every choice made here.
+// render-gbuffer's frame loop in OpenGL (OSMesa's llvmpipe or an EGL device, gl_api.h): light maps, G-buffers,
+// deferred payload shading, read-back into planar images. docs/render-gbuffer.md explains every choice made here.
 #include "temporal/render/render.h"
 
 #include "gl_api.h"
@@ -95,7 +95,7 @@ Expected<Fbo> make_fbo(const GlFunctions& gl, int w, int h, const std::vector<GL
   if (status != GL_FRAMEBUFFER_COMPLETE)
     return Error::usage(std::string("OpenGL cannot make the ") + std::to_string(w) + "x" + std::to_string(h) + " " + name +
                         " framebuffer (status " + std::to_string(status) +
-                        "): the image is beyond what llvmpipe can allocate here; reduce --size");
+                        "): the image is beyond what the OpenGL device can allocate here; reduce --size");
   return f;
 }
 
@@ -155,6 +155,10 @@ struct Renderer::Impl {
   std::vector<float> vpl_scratch;
   std::vector<float> readback;
   std::vector<std::uint32_t> readback_u;
+  // GL_TIME_ELAPSED queries (RenderOptions::gpu_timer on a device whose timer counts): two, because the colour
+  // pass times its G-buffer and its shading apart and elapsed-time queries cannot nest.
+  bool timer = false;
+  GLuint queries[2] = {0, 0};
 
   const GlFunctions& gl() const { return context->gl(); }
   ~Impl();
@@ -176,11 +180,25 @@ struct Renderer::Impl {
   Image gbuffer_image(const Fbo& f, const View& v, const FrameInput& in);
   Image shade_image(const Fbo& f, float scale);
   void set_metadata(Image& image, const FrameInput& in, const View& v, glm::vec2 jitter) const;
+  void timer_begin(int slot) const {
+    if (timer) gl().BeginQuery(GL_TIME_ELAPSED, queries[slot]);
+  }
+  void timer_end() const {
+    if (timer) gl().EndQuery(GL_TIME_ELAPSED);
+  }
+  // The device time of the query in `slot` (waits for it).
+  double timer_ms(int slot) const {
+    GLuint64 ns = 0;
+    gl().GetQueryObjectui64v(queries[slot], GL_QUERY_RESULT, &ns);
+    return double(ns) / 1e6;
+  }
 };
 
 Renderer::Impl::~Impl() {
   if (!context) return;
+  context->make_current();  // another renderer's context may have taken the thread since
   const auto& g = gl();
+  if (queries[0]) g.DeleteQueries(2, queries);
   gpu.reset();
   for (Fbo* f : {&gbuffer_full, &gbuffer_low, &shade_full, &shade_low, &shadow_map, &rsm}) delete_fbo(g, *f);
   for (GLuint p : {gbuffer_program, shadow_program, rsm_program, shade_program})
@@ -237,6 +255,15 @@ Status Renderer::Impl::init() {
   gpu = std::make_unique<SceneGpu>(g, scene, options.mipmaps);
   if (auto s = gpu->upload(); !s) return s;
   scene_diagonal = std::max(glm::length(scene.bounds_max - scene.bounds_min), 1e-3f);
+  if (options.gpu_timer) {
+    // llvmpipe (and softpipe) accept timer queries but answer 0: a software device has wall time only.
+    GLint bits = 0;
+    g.GetQueryiv(GL_TIME_ELAPSED, GL_QUERY_COUNTER_BITS, &bits);
+    const std::string& renderer = context->info().renderer;
+    const bool software = renderer.rfind("llvmpipe", 0) == 0 || renderer.rfind("softpipe", 0) == 0;
+    timer = bits > 0 && !software;
+    if (timer) g.GenQueries(2, queries);
+  }
   return check_gl(g, "renderer setup");
 }
 
@@ -603,6 +630,13 @@ void Renderer::Impl::set_metadata(Image& image, const FrameInput& in, const View
   m.time = double(in.frame) / in.fps;
   m.jitter = jitter;
   m.camera_cut = in.camera_cut;
+  // Which context made the image (issue 22): outputs of different devices may differ (docs/render-gbuffer.md).
+  const GlInfo& info = context->info();
+  m.extra["glContext"] = info.context;
+  if (info.device >= 0) m.extra["glDevice"] = std::to_string(info.device);
+  m.extra["glVendor"] = info.vendor;
+  m.extra["glRenderer"] = info.renderer;
+  m.extra["glVersion"] = info.version;
 }
 
 // ---- Renderer --------------------------------------------------------------------------------------------
@@ -614,6 +648,8 @@ Renderer::~Renderer() = default;
 
 const RenderOptions& Renderer::options() const { return impl_->options; }
 std::string Renderer::gl_description() const { return impl_->context->description(); }
+const GlInfo& Renderer::gl_info() const { return impl_->context->info(); }
+bool Renderer::has_gpu_timer() const { return impl_->timer; }
 
 Expected<Renderer> Renderer::create(const RenderOptions& options, const SceneGeometry& scene) {
   if (auto s = validate(options); !s) return s.error();
@@ -623,7 +659,7 @@ Expected<Renderer> Renderer::create(const RenderOptions& options, const SceneGeo
   Impl& impl = *r.impl_;
   impl.options = options;
   impl.scene = scene;
-  auto ctx = GlContext::create();
+  auto ctx = create_context(options.gl, options.gl_device);
   if (!ctx) return ctx.error();
   impl.context = std::move(*ctx);
   if (auto s = impl.init(); !s) return s.error();
@@ -648,10 +684,13 @@ Expected<RenderedFrame> Renderer::render(const FrameInput& in) {
   const bool payload = out.shade || out.reference || out.color;
   if (payload && (o.payload.shadow || o.payload.gi)) {
     const auto t0 = Clock::now();
+    im.timer_begin(0);
     if (auto s = im.light_maps(*in.current); !s) return s.error();
+    im.timer_end();
     im.select_vpls(instant_key(in.frame, in.fps), 0);
     finish();
     result.timings_ms[kPassLightMaps] = ms_since(t0);
+    if (im.timer) result.gpu_ms[kPassLightMaps] = im.timer_ms(0);
   }
   // Random patterns (SSAO rotations, VPL sets, random jitter) are keyed by the frame's instant, not its number, so
   // a 40 Hz frame n and a 120 Hz frame 3n are the same render (docs/conventions.md, "Jitter" and "Noise").
@@ -661,9 +700,12 @@ Expected<RenderedFrame> Renderer::render(const FrameInput& in) {
   const Impl::View full = im.make_view(in, w, h, {0.0f, 0.0f});
   if (out.gbuffer) {
     const auto t0 = Clock::now();
+    im.timer_begin(0);
     im.draw_gbuffer(im.gbuffer_full, full);
+    im.timer_end();
     finish();
     result.timings_ms[kPassGbuffer] = ms_since(t0);
+    if (im.timer) result.gpu_ms[kPassGbuffer] = im.timer_ms(0);
     result.gbuffer = im.gbuffer_image(im.gbuffer_full, full, in);
     im.set_metadata(*result.gbuffer, in, full, {0.0f, 0.0f});
     result.gbuffer->metadata().compute_ms = result.timings_ms[kPassGbuffer];
@@ -676,10 +718,13 @@ Expected<RenderedFrame> Renderer::render(const FrameInput& in) {
     const Impl::View low = im.make_view(in, w / k, h / k, jitter);
     const float lod_bias = o.shade_mip_bias ? *o.shade_mip_bias : -std::log2(float(k));
     const auto t0 = Clock::now();
+    im.timer_begin(0);
     im.draw_gbuffer(im.gbuffer_low, low, lod_bias);
     im.shade(im.gbuffer_low, im.shade_low, low, frame_seed, false, true);
+    im.timer_end();
     finish();
     result.timings_ms[kPassShadeLow] = ms_since(t0);
+    if (im.timer) result.gpu_ms[kPassShadeLow] = im.timer_ms(0);
     result.shade = im.shade_image(im.shade_low, 1.0f);
     im.set_metadata(*result.shade, in, low, jitter);
     result.shade->metadata().jitter_factor = k;
@@ -692,13 +737,21 @@ Expected<RenderedFrame> Renderer::render(const FrameInput& in) {
         frame_jitter(o.color_jitter, jitter_frame(o.color_jitter, in.frame, instant), k, o.seed ^ 0xc0104u);
     const Impl::View view = im.make_view(in, w, h, jitter);
     const auto t0 = Clock::now();
+    im.timer_begin(0);
     im.draw_gbuffer(im.gbuffer_full, view);
+    im.timer_end();
     finish();
     const auto t1 = Clock::now();
+    im.timer_begin(1);
     im.shade(im.gbuffer_full, im.shade_full, view, frame_seed, false, true);
+    im.timer_end();
     finish();
     result.timings_ms[kPassShadeFull] = ms_since(t1);
     result.timings_ms[kPassColor] = ms_since(t0);
+    if (im.timer) {
+      result.gpu_ms[kPassShadeFull] = im.timer_ms(1);
+      result.gpu_ms[kPassColor] = im.timer_ms(0) + im.timer_ms(1);
+    }
     Image full_payload = im.shade_image(im.shade_full, 1.0f);
     Image color(w, h);
     for (const char* c : {"R", "G", "B"}) std::copy_n(full_payload.plane(c), full_payload.pixel_count(), color.add_channel(c));
@@ -711,6 +764,7 @@ Expected<RenderedFrame> Renderer::render(const FrameInput& in) {
     // centres with reference_jitter = None), each with its own SSAO pattern and VPL set, accumulated in float
     // targets and averaged.
     const auto t0 = Clock::now();
+    im.timer_begin(0);
     const bool centred = o.reference_jitter == JitterMode::None;
     for (int s = 0; s < o.reference_spp; ++s) {
       const auto i = std::uint32_t(s + 1);
@@ -722,8 +776,10 @@ Expected<RenderedFrame> Renderer::render(const FrameInput& in) {
       im.shade(im.gbuffer_full, im.shade_full, view, hash_u32(o.seed, instant, 0xbeefu, i), true,
                s == 0);
     }
+    im.timer_end();
     finish();
     result.timings_ms[kPassReference] = ms_since(t0);
+    if (im.timer) result.gpu_ms[kPassReference] = im.timer_ms(0);
     result.reference = im.shade_image(im.shade_full, 1.0f / float(o.reference_spp));
     im.set_metadata(*result.reference, in, full, {0.0f, 0.0f});
     result.reference->metadata().compute_ms = result.timings_ms[kPassReference];

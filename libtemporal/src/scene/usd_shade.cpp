@@ -1,11 +1,12 @@
 // UsdShade to SceneMaterial: material bindings (material:binding:preview, else material:binding, on the
 // gprim or its nearest ancestor; GeomSubsets with their own binding), UsdPreviewSurface inputs (diffuseColor,
 // opacity and opacityThreshold, metallic, roughness, emissiveColor) and UsdUVTexture for the diffuse colour
-// (read with OpenImageIO; scale multiplies it like glTF's base colour factor), UsdPrimvarReader_float3 of
+// (read with stb_image, the reader tinygltf uses for glTF's images, so that the scene stage needs no
+// image library; scale multiplies it like glTF's base colour factor), UsdPrimvarReader_float3 of
 // displayColor. Materials are created in the order of their Material prims so that ids are stable.
 #include "usd_convert.h"
 
-#include <OpenImageIO/imageio.h>
+#include <stb_image.h>
 
 #include <algorithm>
 #include <array>
@@ -143,44 +144,29 @@ Status Converter::material_slots(MeshJob& job) {
 
 namespace {
 
-// An image file as RGBA8, top row first (OpenImageIO).
+// An image file as RGBA8, top row first (stb_image: PNG, JPEG, TGA, BMP, PSD, GIF, HDR, PIC, PNM). Colours as
+// stored: stb_image never premultiplies by alpha (glTF's images are not premultiplied either). Grey expands to
+// R = G = B, grey + alpha keeps its alpha, three channels get alpha 255.
 Status read_image(const std::string& file, const std::string& where, SceneTexture& tex) {
   std::error_code ec;
   if (!std::filesystem::is_regular_file(file, ec)) return Error::input(where, "the texture '" + file + "' does not exist");
-  // Colours as stored: OpenImageIO would otherwise premultiply them by alpha (glTF's images are not).
-  OIIO::ImageSpec config;
-  config.attribute("oiio:UnassociatedAlpha", 1);
-  auto in = OIIO::ImageInput::open(file, &config);
-  if (!in) return Error::input(where, "cannot read the texture '" + file + "': " + OIIO::geterror());
-  in->threads(1);  // textures are small; a thread pool would cost more than it saves (and scene loads may run in parallel)
-  const OIIO::ImageSpec& spec = in->spec();
-  const int channels = spec.nchannels;
-  if (spec.width <= 0 || spec.height <= 0 || spec.width > 16384 || spec.height > 16384 || channels < 1)
+  int width = 0, height = 0, channels = 0;
+  if (!stbi_info(file.c_str(), &width, &height, &channels))
+    return Error::input(where, "cannot read the texture '" + file + "': " + stbi_failure_reason() +
+                                   " (textures are read with stb_image: PNG, JPEG, TGA, BMP, PSD, GIF, HDR, PNM; convert "
+                                   "EXR or TIFF textures to PNG, e.g. with oiiotool)");
+  if (width <= 0 || height <= 0 || width > 16384 || height > 16384 || channels < 1)
     return Error::input(where, "the texture '" + file + "' has an unsupported size or no channels");
-  const std::size_t pixels = std::size_t(spec.width) * std::size_t(spec.height);
-  tex.width = spec.width;
-  tex.height = spec.height;
-  tex.rgba8.resize(pixels * 4);
-  if (channels == 4) {  // straight into place
-    if (!in->read_image(0, 0, 0, 4, OIIO::TypeDesc::UINT8, tex.rgba8.data()))
-      return Error::input(where, "cannot decode the texture '" + file + "': " + in->geterror());
-  } else {
-    std::vector<std::uint8_t> data(pixels * std::size_t(channels));
-    if (!in->read_image(0, 0, 0, channels, OIIO::TypeDesc::UINT8, data.data()))
-      return Error::input(where, "cannot decode the texture '" + file + "': " + in->geterror());
-    for (std::size_t i = 0; i < pixels; ++i) {
-      const std::uint8_t* c = &data[i * std::size_t(channels)];
-      std::uint8_t* o = &tex.rgba8[i * 4];
-      if (channels >= 3) {
-        o[0] = c[0], o[1] = c[1], o[2] = c[2], o[3] = 255;  // 3 channels, or the first 4 of more
-        if (channels > 4) o[3] = c[3];
-      } else {
-        o[0] = o[1] = o[2] = c[0], o[3] = channels == 2 ? c[1] : 255;
-      }
-    }
-  }
-  // "auto" colour space: 8-bit images are sRGB-encoded, float images linear (UsdUVTexture).
-  tex.srgb = spec.format == OIIO::TypeDesc::UINT8;
+  // "auto" colour space: 8-bit images are sRGB-encoded, 16-bit and float images linear (UsdUVTexture).
+  const bool high_precision = stbi_is_hdr(file.c_str()) || stbi_is_16_bit(file.c_str());
+  stbi_uc* data = stbi_load(file.c_str(), &width, &height, &channels, 4);
+  if (!data) return Error::input(where, "cannot decode the texture '" + file + "': " + stbi_failure_reason());
+  const std::size_t bytes = std::size_t(width) * std::size_t(height) * 4;
+  tex.width = width;
+  tex.height = height;
+  tex.rgba8.assign(data, data + bytes);
+  stbi_image_free(data);
+  tex.srgb = !high_precision;
   return {};
 }
 

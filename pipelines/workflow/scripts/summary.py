@@ -5,32 +5,12 @@ of compute time against PSNR, and its paired PSNR difference against the baselin
 formats what compare computed (docs/pipelines.md)."""
 import argparse
 import json
-import math
 import os
+import sys
 
-
-def num(v):
-    if v is None:
-        return None
-    if isinstance(v, str):
-        return math.inf if v == "inf" else -math.inf if v == "-inf" else None
-    return float(v)
-
-
-def fmt(v, digits=2):
-    v = num(v)
-    if v is None:
-        return "-"
-    if math.isinf(v):
-        return "inf" if v > 0 else "-inf"
-    return f"{v:.{digits}f}"
-
-
-def with_ci(m, digits=2):
-    if not m:
-        return "-"
-    ci = m.get("ci95") or [None, None]
-    return f"{fmt(m.get('mean'), digits)} [{fmt(ci[0], digits)}, {fmt(ci[1], digits)}]"
+# The cells are formatted by pipelines/tables.py, the pipelines' one table formatter.
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", ".."))
+from tables import fmt_value as fmt, num, with_ci  # noqa: E402
 
 
 def pareto(points):

@@ -1,5 +1,9 @@
-// Milliseconds of each render-gbuffer pass on llvmpipe, per built-in scene (assets/scenes), at 1280x1024
-// by default (the resolution of seed 000's Table 1):
+// Milliseconds of each render-gbuffer pass, per built-in scene (assets/scenes), at 1280x1024 by default (the
+// resolution of seed 000's Table 1), on the OpenGL context `--gl osmesa|egl|auto` picks (default osmesa; also
+// TEMPORAL_BENCH_GL; `--gl-device N` or TEMPORAL_BENCH_GL_DEVICE picks the EGL device). The time of an iteration is
+// the device's own (GL_TIME_ELAPSED queries) where its timer counts - a GPU - and otherwise the wall clock of the
+// pass after glFinish (llvmpipe, whose timer queries read 0); each benchmark's label says which, with the renderer,
+// and the counter wall_ms always holds the wall-clock time:
 //   Gbuffer/<scene>    full-resolution G-buffer raster (glFinish included, read-back excluded)
 //   ShadeLow/<scene>   low-res (1/4 x 1/4) jittered G-buffer + full payload shading
 //   ShadeFull/<scene>  full payload shading of one full-resolution G-buffer
@@ -31,6 +35,9 @@
 namespace {
 
 using namespace temporal;
+
+GlApi g_gl = GlApi::OSMesa;  // set by main() from --gl / TEMPORAL_BENCH_GL
+int g_gl_device = -1;
 
 int env_int(const char* name, int fallback) {
   const char* v = std::getenv(name);
@@ -79,6 +86,9 @@ void run_pass(benchmark::State& state, const std::string& scene_name, RenderOutp
   o.height = s.h;
   o.reference_spp = env_int("TEMPORAL_BENCH_SPP", 16);
   o.outputs = outputs;
+  o.gl = g_gl;
+  o.gl_device = g_gl_device;
+  o.gpu_timer = true;
   auto r = Renderer::create(o, l->geometry);
   if (!r) {
     state.SkipWithError(r.error().message.c_str());
@@ -96,16 +106,23 @@ void run_pass(benchmark::State& state, const std::string& scene_name, RenderOutp
     return r->render(in);
   };
   if (warm_up) render(frame++);  // llvmpipe compiles shader variants at their first draw
-  double light_maps = 0.0;
+  const bool gpu = r->has_gpu_timer();
+  double light_maps = 0.0, wall = 0.0;
   for (auto _ : state) {
     auto out = render(frame++);
     if (!out) {
       state.SkipWithError(out.error().message.c_str());
       return;
     }
-    state.SetIterationTime(out->timings_ms.at(pass) / 1000.0);
-    if (auto it = out->timings_ms.find(kPassLightMaps); it != out->timings_ms.end()) light_maps += it->second;
+    const auto& times = gpu ? out->gpu_ms : out->timings_ms;
+    state.SetIterationTime(times.at(pass) / 1000.0);
+    wall += out->timings_ms.at(pass);
+    if (auto it = times.find(kPassLightMaps); it != times.end()) light_maps += it->second;
   }
+  const GlInfo& info = r->gl_info();
+  state.SetLabel(std::string(gpu ? "gpu time (GL_TIME_ELAPSED)" : "wall time after glFinish") + ", " + info.context +
+                 ": " + info.renderer);
+  state.counters["wall_ms"] = benchmark::Counter(wall, benchmark::Counter::kAvgIterations);
   state.counters["lightMaps_ms"] = benchmark::Counter(light_maps, benchmark::Counter::kAvgIterations);
   state.counters["pixels"] = double(s.w) * s.h;
 }
@@ -187,4 +204,35 @@ const int registered = [] {
 
 }  // namespace
 
-BENCHMARK_MAIN();
+// --gl and --gl-device are taken out of argv before Google Benchmark sees it (it refuses flags it does not know).
+int main(int argc, char** argv) {
+  std::string gl = std::getenv("TEMPORAL_BENCH_GL") ? std::getenv("TEMPORAL_BENCH_GL") : "osmesa";
+  g_gl_device = env_int("TEMPORAL_BENCH_GL_DEVICE", -1);
+  int kept = 1;
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    if (a == "--gl" && i + 1 < argc) {
+      gl = argv[++i];
+    } else if (a == "--gl-device" && i + 1 < argc) {
+      g_gl_device = std::atoi(argv[++i]);
+    } else if (a.rfind("--gl=", 0) == 0) {
+      gl = a.substr(5);
+    } else if (a.rfind("--gl-device=", 0) == 0) {
+      g_gl_device = std::atoi(a.c_str() + 12);
+    } else {
+      argv[kept++] = argv[i];
+    }
+  }
+  argc = kept;
+  auto api = parse_gl_api(gl);
+  if (!api) {
+    std::fprintf(stderr, "render_benchmark: %s\n", api.error().message.c_str());
+    return 1;
+  }
+  g_gl = *api;
+  benchmark::Initialize(&argc, argv);
+  if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
+  benchmark::RunSpecifiedBenchmarks();
+  benchmark::Shutdown();
+  return 0;
+}

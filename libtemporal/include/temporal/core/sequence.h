@@ -30,6 +30,11 @@ class SequencePattern {
 
   const std::string& pattern() const { return pattern_; }
   bool has_placeholder() const { return width_ >= 0; }
+  // The text before and after the placeholder (the whole pattern is the prefix when there is none), and the
+  // zero-padded width (-1: no placeholder; 0: unpadded).
+  const std::string& prefix() const { return prefix_; }
+  const std::string& suffix() const { return suffix_; }
+  int width() const { return width_; }
   std::string path(int frame) const;
   // Frame numbers of the files matching the pattern in its folder, sorted.
   std::vector<int> frames_on_disk() const;

@@ -41,6 +41,9 @@ struct SequenceOptions {
   std::string compression = "zip";  // none | zip | piz (dwaa refused: outputs are data)
   std::string state_in;      // --state-in FILE (empty: none)
   std::string state_out;     // --state-out FILE or pattern (empty: none)
+  // Further files or patterns the stage reads itself (morph-120hz --lag-reference): protected like the inputs,
+  // so that no output replaces one of them.
+  std::vector<std::string> other_inputs;
 };
 
 // Observers of a run (the library never prints: the tool decides).
@@ -81,6 +84,23 @@ class ProtectedInputs {
 
  private:
   std::set<std::pair<std::uint64_t, std::uint64_t>> ids_;
+};
+
+// The outputs of one run by the files they name: no two options may name the same file (a frame pattern names
+// every file it can produce), and an output that exists must be a regular file (writing would replace a device,
+// a folder or a socket by a file). Folders are compared after resolving links.
+class OutputPaths {
+ public:
+  // Registers `path` (a file or a frame pattern) of option `what`; Usage error naming both options when it can
+  // name a file that an output registered before names, or when it is an existing path that is not a regular file.
+  Status add(const std::string& path, const std::string& what);
+
+ private:
+  struct Entry {
+    std::string folder, prefix, suffix, what, text;
+    bool pattern = false;
+  };
+  std::vector<Entry> entries_;
 };
 
 // The output compression of a data sequence: `none`, `zip`, `piz`; `dwaa` is refused (lossy on data).

@@ -1,7 +1,8 @@
-// Deferred OSMesa renderer of animated scenes (render-gbuffer, issue 3; docs/render-gbuffer.md).
+// Deferred OpenGL renderer of animated scenes (render-gbuffer, issue 3; docs/render-gbuffer.md).
 //
-// One Renderer owns an OpenGL 4.5 core context on llvmpipe (OSMesa, every entry point loaded through
-// OSMesaGetProcAddress), the scene's geometry and textures, and per-frame render targets. render() takes
+// One Renderer owns an OpenGL 4.5 core context - OSMesa's llvmpipe (the default and the CI path) or a device of
+// EGL's device platform (Mesa's software device, or a GPU; issue 22) with every entry point loaded through the
+// context's GetProcAddress - the scene's geometry and textures, and per-frame render targets. render() takes
 // the scene state of this frame and of the previous frame (scene.h, FrameState, instances paired by index)
 // and returns the images asked for:
 //
@@ -26,13 +27,15 @@
 //
 // Every image's metadata carries worldToCamera, worldToNDC (with that image's jitter), clipNear/Far,
 // frame, fps, time, jitter (+ jitterFactor/jitterIndex on shade), cameraCut, the pass timings and
-// compute_ms. Timings are wall-clock milliseconds of the GL work of each pass, glFinish included,
-// read-back excluded.
+// compute_ms, and the context that made it (`temporal:glContext`, glDevice, glVendor, glRenderer, glVersion;
+// docs/conventions.md). Timings are wall-clock milliseconds of the GL work of each pass, glFinish included,
+// read-back excluded; with RenderOptions::gpu_timer, RenderedFrame::gpu_ms holds GL_TIME_ELAPSED times too.
 #pragma once
 
 #include "temporal/core/error.h"
 #include "temporal/core/image.h"
 #include "temporal/core/jitter.h"
+#include "temporal/core/params.h"
 #include "temporal/scene/scene.h"
 
 #include <glm/vec3.hpp>
@@ -82,6 +85,34 @@ struct RenderOutputs {
   std::string to_string() const;
 };
 
+// How the renderer gets its OpenGL context (render-gbuffer --gl).
+enum class GlApi {
+  OSMesa,  // llvmpipe inside the process (libOSMesa): needs no device, the CI path
+  Egl,     // EGL's device platform (EGL_EXT_platform_device), surfaceless: a GPU, or Mesa's software device
+  Auto,    // a hardware EGL device when one exists, else OSMesa
+};
+Expected<GlApi> parse_gl_api(const std::string& name);  // "osmesa", "egl", "auto"
+const char* to_string(GlApi api);
+
+// The context a renderer made (the `temporal:gl*` header attributes).
+struct GlInfo {
+  std::string context;                  // "osmesa" or "egl"
+  int device = -1;                      // EGL device index (eglQueryDevicesEXT order); -1 for OSMesa
+  std::string vendor, renderer, version;  // GL_VENDOR, GL_RENDERER, GL_VERSION
+};
+
+// One device of EGL's device platform (render-gbuffer --list-gl-devices).
+struct GlDevice {
+  int index = 0;
+  std::string extensions;  // EGL_EXTENSIONS of the device ("EGL_MESA_device_software", "EGL_NV_device_cuda ...")
+  bool software = false;   // EGL_MESA_device_software: llvmpipe, not a GPU
+  // The context made on it: GL_RENDERER and GL_VERSION, or why none could be made (then renderer is empty).
+  std::string renderer, version, error;
+};
+// Lists the EGL devices and makes a 4.5 core context on each to name its renderer. Internal error when EGL or its
+// device extensions are missing; an empty list when there is no device.
+Expected<std::vector<GlDevice>> list_gl_devices();
+
 struct RenderOptions {
   int width = 1280, height = 1024;     // full resolution, pixels
   int factor = 4;                      // shade is width/factor x height/factor (must divide both)
@@ -100,12 +131,29 @@ struct RenderOptions {
   // their detail).
   std::optional<float> shade_mip_bias;
   std::uint32_t seed = 0;              // decorrelates random jitter, SSAO patterns and VPL sets
+  GlApi gl = GlApi::OSMesa;            // which context (outputs are bit-identical on llvmpipe either way)
+  int gl_device = -1;                  // EGL device index; -1: the first hardware device, else the first device
+  // Time each pass on the device too (GL_TIME_ELAPSED queries, RenderedFrame::gpu_ms) when the device has a timer
+  // that counts: not llvmpipe, whose queries read 0. Off by default: queries add a little work to every pass.
+  bool gpu_timer = false;
   PayloadOptions payload;
   RenderOutputs outputs;
 };
 
 // Checks sizes, factor and payload settings without touching OpenGL (Usage errors naming the option).
 Status validate(const RenderOptions& options);
+
+// The command-line form of RenderOptions (render-gbuffer; issue 21's Param tables, temporal/core/params.h). Numbers
+// and flags bind to the option fields themselves; values that are text on the command line (a size, a list of
+// terms, an enum) bind to a RenderText, which starts from the options' defaults and which apply_render_text() parses.
+struct RenderText {
+  explicit RenderText(const RenderOptions& defaults);
+  std::string size, payload, outputs, jitter, shade_jitter, reference_jitter, shade_mip_bias, gl;
+  double seed = 0.0;  // a uint32 (Param has no unsigned type; a double holds every uint32 exactly)
+};
+ParamList render_params(RenderOptions& options, RenderText& text);
+// Parses `text` into `options` and validates them (Usage errors naming the option).
+Status apply_render_text(const RenderText& text, RenderOptions& options);
 
 // Command-line forms of RenderOptions fields: "WIDTHxHEIGHT" and the shade mip bias ("auto" or a number).
 Status parse_size(const std::string& text, RenderOptions& options);
@@ -136,13 +184,14 @@ struct FrameInput {
 
 struct RenderedFrame {
   std::optional<Image> gbuffer, shade, reference, color;
-  std::map<std::string, double> timings_ms;  // pass name -> ms (only the passes that ran)
+  std::map<std::string, double> timings_ms;  // pass name -> ms (only the passes that ran), wall clock
+  std::map<std::string, double> gpu_ms;      // pass name -> device ms (GL_TIME_ELAPSED); empty without a timer
 };
 
 class Renderer {
  public:
-  // Creates the OSMesa context (LP_NUM_THREADS must already be set), compiles the shaders and uploads the
-  // scene's geometry and textures. Usage errors for bad sizes/factors; Internal when OpenGL fails.
+  // Creates the OpenGL context (RenderOptions::gl; LP_NUM_THREADS must already be set for llvmpipe), compiles
+  // the shaders and uploads the scene's geometry and textures. Usage errors for bad sizes/factors; Internal when OpenGL fails.
   static Expected<Renderer> create(const RenderOptions& options, const SceneGeometry& scene);
 
   // Renders one frame. The FrameState's instances must refer to the SceneGeometry given to create().
@@ -151,6 +200,10 @@ class Renderer {
   const RenderOptions& options() const;
   // OpenGL renderer and version strings, for --verbose.
   std::string gl_description() const;
+  // The context: kind, EGL device, GL vendor/renderer/version.
+  const GlInfo& gl_info() const;
+  // True when RenderOptions::gpu_timer is set and the device's GL_TIME_ELAPSED counts (RenderedFrame::gpu_ms).
+  bool has_gpu_timer() const;
 
   Renderer(Renderer&&) noexcept;
   Renderer& operator=(Renderer&&) noexcept;

@@ -1,5 +1,5 @@
 // The render-gbuffer sequence loop (replay.h).
-#include "temporal/render/replay.h"
+#include "temporal/replay/replay.h"
 
 #include <cmath>
 

@@ -1,0 +1,85 @@
+# shellcheck shell=bash
+# pipelines/lib.sh: the preamble every script of pipelines/ sources (docs/pipelines.md, "lib.sh"):
+#
+#   source "$(dirname "${BASH_SOURCE[0]}")/lib.sh"
+#   use_build "${1:-}"                          # BUILD: absolute build folder
+#   require_tools render-gbuffer filter-phlm compare
+#   filter="$(tool_path filter-phlm)"
+#   METHODS="${METHODS:-$(methods_of filter-phlm)}"
+#
+# It turns on strict mode (set -euo pipefail) in the sourcing script and sets ROOT (the repository root) and
+# PIPELINE (the sourcing script's file name, for messages). Method lists come from the tools' registries
+# (pipelines/workflow/scripts/methods.py, shared with the Snakefile), never from a list written here.
+set -euo pipefail
+
+ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+PIPELINE="$(basename "${BASH_SOURCE[1]:-$0}")"
+# The one table formatter (pipelines/tables.py) and the registry helper, for the sourcing scripts.
+# shellcheck disable=SC2034
+TABLES="$ROOT/pipelines/tables.py"
+METHODS_PY="$ROOT/pipelines/workflow/scripts/methods.py"
+
+# Messages on stderr, prefixed with the script's name; die exits with CODE (default 2: a setup error, as every
+# script exited before).
+say() { echo "$PIPELINE: $*" >&2; }
+die() {
+  echo "$PIPELINE: $1" >&2
+  exit "${2:-2}"
+}
+
+# use_build DIR: sets BUILD, the build folder holding apps/<tool>/<tool>: DIR (the script's BUILD_DIR argument),
+# else the BUILD environment variable, else build/release. A relative folder is taken from the current folder
+# when it exists there, else from the repository root (so a script works from any folder).
+use_build() {
+  BUILD="${1:-${BUILD:-build/release}}"
+  case "$BUILD" in
+    /*) ;;
+    *) if [[ -d "$PWD/$BUILD" ]]; then BUILD="$PWD/$BUILD"; else BUILD="$ROOT/$BUILD"; fi ;;
+  esac
+}
+
+# tool_path NAME: the built tool (a suite tool under apps/, or a path relative to BUILD such as
+# tests/benchmarks/phlm/phlm_edge_split).
+tool_path() {
+  case "$1" in
+    */*) echo "$BUILD/$1" ;;
+    *) echo "$BUILD/apps/$1/$1" ;;
+  esac
+}
+
+# How to build a missing target: the preset named by BUILD's folder when BUILD is build/<preset>.
+build_hint() {
+  local target="${1##*/}" preset
+  preset="$(basename "$BUILD")"
+  if [[ "$BUILD" == "$ROOT/build/$preset" && -n "$(sed -n "/\"name\": \"$preset\"/p" "$ROOT/CMakePresets.json" 2>/dev/null)" ]]; then
+    echo "cmake --preset $preset && cmake --build --preset $preset --target $target"
+  else
+    echo "cmake -S $ROOT -B $BUILD && cmake --build $BUILD --target $target"
+  fi
+}
+
+# require_tools NAME...: each tool exists and is executable, else exit 2 saying how to build it.
+require_tools() {
+  local t p
+  for t in "$@"; do
+    p="$(tool_path "$t")"
+    [[ -x "$p" ]] || die "$p is missing: build it first ($(build_hint "$t"))"
+  done
+}
+
+# methods_of TOOL: the tool's methods, space-separated, from its registry (--list-methods-json, else
+# --list-methods; methods.py says the transitional fallback). Named variants are not methods: method_args
+# resolves them.
+methods_of() {
+  local out
+  out="$(python3 "$METHODS_PY" names "$(tool_path "$1")")" || die "cannot read the methods of $1"
+  paste -sd ' ' <<< "$out"
+}
+
+# method_args TOOL NAME: the arguments that run NAME (a method, a named variant such as herzog-favor-spatial,
+# either with a name suffix such as -demod), from the tool's registry. Fails (status 2) on an unknown name.
+method_args() {
+  local out
+  out="$(python3 "$METHODS_PY" args "$(tool_path "$1")" "$2")" || return 2
+  echo "${out#*$'\t'}"
+}
