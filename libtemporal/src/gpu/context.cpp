@@ -1,17 +1,67 @@
 // EGL device platform -> OpenGL 4.5 core context, surfaceless (the recipe of shared/tools/egl-probe.c, verified on
 // llvmpipe and on an NVIDIA H200 driver-only machine).
+//
+// libEGL is opened at run time (dlopen), not linked: the method stages link this stage, and their CPU kernel
+// benchmarks must stay free of display libraries (kernel_dependencies.*, tests/benchmarks/CMakeLists.txt); a
+// program that never asks for the GPU never loads libEGL, and one that does on a machine without it gets an error.
 #include "temporal/gpu/context.h"
 
+#define EGL_NO_PROTOTYPES
 #include <EGL/egl.h>
 #include <EGL/eglext.h>
 
+#include <dlfcn.h>
+
 #include <chrono>
+#include <cstdio>
 #include <cstring>
+#include <type_traits>
 #include <string_view>
 #include <vector>
 
 namespace temporal::gpu {
 namespace {
+
+// The EGL 1.5 entry points this file calls, from libEGL.so.1 (glvnd's dispatcher, or a vendor's libEGL).
+struct Egl {
+  PFNEGLGETPROCADDRESSPROC GetProcAddress = nullptr;
+  PFNEGLINITIALIZEPROC Initialize = nullptr;
+  PFNEGLBINDAPIPROC BindAPI = nullptr;
+  PFNEGLCREATECONTEXTPROC CreateContext = nullptr;
+  PFNEGLDESTROYCONTEXTPROC DestroyContext = nullptr;
+  PFNEGLMAKECURRENTPROC MakeCurrent = nullptr;
+  PFNEGLGETCURRENTCONTEXTPROC GetCurrentContext = nullptr;
+  PFNEGLGETERRORPROC GetError = nullptr;
+  std::string error;  // why loading failed; empty when loaded
+};
+
+// Loaded once per process (the handle is never closed: contexts may live until exit).
+const Egl& egl() {
+  static const Egl loaded = [] {
+    Egl e;
+    void* lib = dlopen("libEGL.so.1", RTLD_NOW | RTLD_LOCAL);
+    if (!lib) {
+      const char* why = dlerror();
+      e.error = std::string("cannot load libEGL.so.1 (") + (why ? why : "?") +
+                "): install libegl1 and a driver (libegl-mesa0 for llvmpipe)";
+      return e;
+    }
+    auto load = [&](auto& fn, const char* name) {
+      fn = reinterpret_cast<std::remove_reference_t<decltype(fn)>>(dlsym(lib, name));
+      if (!fn && e.error.empty()) e.error = std::string("libEGL.so.1 has no ") + name;
+    };
+    load(e.GetProcAddress, "eglGetProcAddress");
+    load(e.Initialize, "eglInitialize");
+    load(e.BindAPI, "eglBindAPI");
+    load(e.CreateContext, "eglCreateContext");
+    load(e.DestroyContext, "eglDestroyContext");
+    load(e.MakeCurrent, "eglMakeCurrent");
+    load(e.GetCurrentContext, "eglGetCurrentContext");
+    load(e.GetError, "eglGetError");
+    return e;
+  }();
+  return loaded;
+}
 
 std::string hex(unsigned v) {
   char buf[16];
@@ -20,7 +70,7 @@ std::string hex(unsigned v) {
 }
 
 Error egl_error(const std::string& step) {
-  return Error::usage("--device gpu: " + step + " failed (EGL error " + hex(unsigned(eglGetError())) +
+  return Error::usage("--device gpu: " + step + " failed (EGL error " + hex(unsigned(egl().GetError())) +
                       "); this machine has no usable EGL device (install libegl-mesa0 for llvmpipe)");
 }
 
@@ -71,11 +121,12 @@ bool probe_timer_queries(const GlFunctions& gl) {
 }  // namespace
 
 Expected<std::shared_ptr<Context>> Context::create(const ContextOptions& options) {
-  auto query_devices = reinterpret_cast<PFNEGLQUERYDEVICESEXTPROC>(eglGetProcAddress("eglQueryDevicesEXT"));
+  if (!egl().error.empty()) return Error::usage("--device gpu: " + egl().error);
+  auto query_devices = reinterpret_cast<PFNEGLQUERYDEVICESEXTPROC>(egl().GetProcAddress("eglQueryDevicesEXT"));
   auto query_string =
-      reinterpret_cast<PFNEGLQUERYDEVICESTRINGEXTPROC>(eglGetProcAddress("eglQueryDeviceStringEXT"));
+      reinterpret_cast<PFNEGLQUERYDEVICESTRINGEXTPROC>(egl().GetProcAddress("eglQueryDeviceStringEXT"));
   auto platform_display =
-      reinterpret_cast<PFNEGLGETPLATFORMDISPLAYEXTPROC>(eglGetProcAddress("eglGetPlatformDisplayEXT"));
+      reinterpret_cast<PFNEGLGETPLATFORMDISPLAYEXTPROC>(egl().GetProcAddress("eglGetPlatformDisplayEXT"));
   if (!query_devices || !platform_display)
     return Error::usage("--device gpu: EGL has no device enumeration (EGL_EXT_device_enumeration, "
                         "EGL_EXT_platform_device); install libegl1 and a driver (libegl-mesa0 for llvmpipe)");
@@ -101,18 +152,18 @@ Expected<std::shared_ptr<Context>> Context::create(const ContextOptions& options
   EGLDisplay display = platform_display(EGL_PLATFORM_DEVICE_EXT, devices[pick], nullptr);
   if (display == EGL_NO_DISPLAY) return egl_error("eglGetPlatformDisplayEXT");
   EGLint major = 0, minor = 0;
-  if (!eglInitialize(display, &major, &minor)) return egl_error("eglInitialize");
-  if (!eglBindAPI(EGL_OPENGL_API)) return egl_error("eglBindAPI(EGL_OPENGL_API)");
+  if (!egl().Initialize(display, &major, &minor)) return egl_error("eglInitialize");
+  if (!egl().BindAPI(EGL_OPENGL_API)) return egl_error("eglBindAPI(EGL_OPENGL_API)");
   const EGLint attributes[] = {EGL_CONTEXT_MAJOR_VERSION, 4, EGL_CONTEXT_MINOR_VERSION, 5,
                                EGL_CONTEXT_OPENGL_PROFILE_MASK, EGL_CONTEXT_OPENGL_CORE_PROFILE_BIT, EGL_NONE};
-  EGLContext context = eglCreateContext(display, EGL_NO_CONFIG_KHR, EGL_NO_CONTEXT, attributes);
+  EGLContext context = egl().CreateContext(display, EGL_NO_CONFIG_KHR, EGL_NO_CONTEXT, attributes);
   if (context == EGL_NO_CONTEXT) return egl_error("eglCreateContext (OpenGL 4.5 core, no config)");
   ctx->display_ = display;
   ctx->context_ = context;
-  if (!eglMakeCurrent(display, EGL_NO_SURFACE, EGL_NO_SURFACE, context))
+  if (!egl().MakeCurrent(display, EGL_NO_SURFACE, EGL_NO_SURFACE, context))
     return egl_error("eglMakeCurrent (surfaceless)");
 #define TEMPORAL_GPU_GL_LOAD(type, name)                                                                  \
-  ctx->gl_.name = reinterpret_cast<type>(eglGetProcAddress("gl" #name));                                 \
+  ctx->gl_.name = reinterpret_cast<type>(egl().GetProcAddress("gl" #name));                                 \
   if (!ctx->gl_.name) return Error::usage("--device gpu: the EGL device has no entry point gl" #name);
   TEMPORAL_GPU_GL_FUNCTIONS(TEMPORAL_GPU_GL_LOAD)
 #undef TEMPORAL_GPU_GL_LOAD
@@ -139,15 +190,15 @@ Context::~Context() {
   // The display is not terminated: EGL returns the same EGLDisplay for a device to every caller in the process, so
   // eglTerminate would end the other contexts on it too. Its resources go with the process.
   if (display_ && context_) {
-    if (eglGetCurrentContext() == context_) eglMakeCurrent(display_, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
-    eglDestroyContext(display_, context_);
+    if (egl().GetCurrentContext() == context_) egl().MakeCurrent(display_, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
+    egl().DestroyContext(display_, context_);
   }
 }
 
 Status Context::make_current() const {
-  if (eglGetCurrentContext() == context_) return Status::ok();
-  if (!eglMakeCurrent(display_, EGL_NO_SURFACE, EGL_NO_SURFACE, context_))
-    return Error::internal("gpu: eglMakeCurrent failed (EGL error " + hex(unsigned(eglGetError())) + ")");
+  if (egl().GetCurrentContext() == context_) return Status::ok();
+  if (!egl().MakeCurrent(display_, EGL_NO_SURFACE, EGL_NO_SURFACE, context_))
+    return Error::internal("gpu: eglMakeCurrent failed (EGL error " + hex(unsigned(egl().GetError())) + ")");
   return Status::ok();
 }
 

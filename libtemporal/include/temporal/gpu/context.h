@@ -4,8 +4,9 @@
 //
 // Why a function table: libOSMesa (the renderer) and libGL (VTK) both export every gl* symbol, and a process that
 // loads one of them first would send direct gl* calls to a library without a current context. Every entry point
-// used here is loaded through eglGetProcAddress, so the stage links only libEGL (glvnd's dispatcher) and works
-// whatever else the program links.
+// used here is loaded through eglGetProcAddress, and libEGL itself (glvnd's dispatcher) is opened at run time on
+// the first Context::create: the stage links no display library (the method stages link it, and their CPU kernel
+// benchmarks must run where no display library is installed), and works whatever else the program links.
 //
 // Threading: an EGL context is current on one thread at a time. Every object of this stage calls
 // Context::make_current() before it issues GL calls, so one context may serve several methods on one thread;
@@ -82,7 +83,8 @@ struct ContextOptions {
 // An OpenGL 4.5 core context on an EGL device, surfaceless (compute only), and its entry points.
 class Context {
  public:
-  // Fails with a usage error (the machine cannot run `--device gpu`) when EGL has no device, the device index is
+  // Fails with a usage error (the machine cannot run `--device gpu`) when libEGL.so.1 cannot be loaded, EGL has no
+  // device, the device index is
   // out of range, the device gives no 4.5 core context, or an entry point is missing; the message says which step
   // failed.
   static Expected<std::shared_ptr<Context>> create(const ContextOptions& options = {});
