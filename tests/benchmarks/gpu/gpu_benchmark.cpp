@@ -1,12 +1,12 @@
 // The GPU kernels (temporal/gpu) per frame at the papers' sizes, beside the device's streaming bound: a copy kernel
 // timed in the same run, and each method's bytes moved (every plane it reads or writes counted once). Implemented
-// methods: filter-phlm's ema, taa and fxaa at 1920x1080 (seed 003's size). The same scene as phlm_bench (RGB noise on a
+// methods: filter-phlm's phlm, ema, taa and fxaa at 1920x1080 (seed 003's size). The same scene as phlm_bench (RGB noise on a
 // pattern, fractional motion, depth and ids).
 //
 // Time per iteration is the kernels' time (gpu::TimedKernel::last_timing: GL_TIME_ELAPSED on hardware, wall clock
 // after glFinish on llvmpipe; the `gpu_clock` counter says which: 1 = GPU queries), not the uploads and downloads
 // around them. Counters: bytes_moved (per frame), bound_ms (bytes_moved / the copy kernel's bandwidth), x_bound.
-// Each benchmark is also registered at a quarter size per axis (ema/taa/fxaa /480/270, spatial/temporal /320/256,
+// Each benchmark is also registered at a quarter size per axis (phlm/ema/taa/fxaa /480/270, spatial/temporal /320/256,
 // blend/warp /256/256) for quick runs on llvmpipe:
 //   gpu_benchmark --benchmark_filter='/(480|320|256)/'
 // Without an EGL device every benchmark is skipped with the reason.
@@ -177,6 +177,9 @@ void run_filter(benchmark::State& state, Make make) {
 void BM_Ema(benchmark::State& state) {
   run_filter(state, [](std::shared_ptr<gpu::Context> c) { return make_ema_filter_gpu(std::move(c)); });
 }
+void BM_Phlm(benchmark::State& state) {
+  run_filter(state, [](std::shared_ptr<gpu::Context> c) { return make_phlm_filter_gpu(std::move(c)); });
+}
 void BM_Fxaa(benchmark::State& state) {
   run_filter(state, [](std::shared_ptr<gpu::Context> c) { return make_fxaa_filter_gpu(std::move(c)); });
 }
@@ -287,6 +290,7 @@ BENCHMARK(BM_Copy)->Args({1920, 1080})->Args({1280, 1024})->Args({1024, 1024})->
     ->Args({256, 256})->UseManualTime()->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_Ema)->Args({1920, 1080})->Args({480, 270})->UseManualTime()->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_Taa)->Args({1920, 1080})->Args({480, 270})->UseManualTime()->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_Phlm)->Args({1920, 1080})->Args({480, 270})->UseManualTime()->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_Fxaa)->Args({1920, 1080})->Args({480, 270})->UseManualTime()->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_Spatial)->Args({1280, 1024})->Args({320, 256})->UseManualTime()->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_Temporal)->Args({1280, 1024})->Args({320, 256})->UseManualTime()->Unit(benchmark::kMillisecond);

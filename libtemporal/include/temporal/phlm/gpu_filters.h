@@ -9,6 +9,7 @@
 #include "temporal/phlm/ema.h"
 #include "temporal/phlm/frame_filter.h"
 #include "temporal/phlm/fxaa.h"
+#include "temporal/phlm/phlm.h"
 #include "temporal/phlm/taa.h"
 
 #include <memory>
@@ -26,5 +27,10 @@ Expected<std::unique_ptr<FrameFilter>> make_taa_filter_gpu(std::shared_ptr<gpu::
 // FXAA (temporal/phlm/fxaa.h) on `context` (created on the default device when null); spatial, no state.
 Expected<std::unique_ptr<FrameFilter>> make_fxaa_filter_gpu(std::shared_ptr<gpu::Context> context,
                                                            FxaaParams params = {});
+
+// PHLM (temporal/phlm/phlm.h) on `context` (created on the default device when null). Usage errors for invalid
+// parameters, as PhlmFilter::process reports them.
+Expected<std::unique_ptr<FrameFilter>> make_phlm_filter_gpu(std::shared_ptr<gpu::Context> context,
+                                                           PhlmParams params = {});
 
 }  // namespace temporal
