@@ -190,7 +190,8 @@ Context::~Context() {
   // The display is not terminated: EGL returns the same EGLDisplay for a device to every caller in the process, so
   // eglTerminate would end the other contexts on it too. Its resources go with the process.
   if (display_ && context_) {
-    if (egl().GetCurrentContext() == context_) egl().MakeCurrent(display_, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
+    if (egl().GetCurrentContext() == context_)
+      egl().MakeCurrent(display_, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
     egl().DestroyContext(display_, context_);
   }
 }

@@ -51,7 +51,8 @@ std::string storage(int binding, const char* name) {
 std::string_view reproject() {
   static const std::string text = [] {
     char constants[256];
-    std::snprintf(constants, sizeof constants, "const float kMinHitWeight = %.9g;\n", double(reproject::kMinHitWeight));
+    std::snprintf(constants, sizeof constants, "const float kMinHitWeight = %.9g;\n",
+                  double(reproject::kMinHitWeight));
     return std::string(constants) + R"(
 #ifndef REPROJECT_PREV_Z
 #define REPROJECT_PREV_Z(q) 0.0

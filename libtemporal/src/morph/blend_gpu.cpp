@@ -21,7 +21,8 @@ void main() {
   ivec2 p;
   uint i;
   if (!pixel_index(p, i)) return;
-  for (uint c = 0u; c < 3u; ++c) outb[c * u_n + i] = (1.0 - u_a) * frames[c * u_n + i] + u_a * frames[(3u + c) * u_n + i];
+  for (uint c = 0u; c < 3u; ++c)
+    outb[c * u_n + i] = (1.0 - u_a) * frames[c * u_n + i] + u_a * frames[(3u + c) * u_n + i];
 }
 )";
 

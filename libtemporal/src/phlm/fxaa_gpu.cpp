@@ -42,7 +42,9 @@ void main() {
 )";
 
 constexpr const char* kFxaaMain = R"(
-float at(int x, int y) { return work[uint(clamp(y, 0, u_size.y - 1)) * uint(u_size.x) + uint(clamp(x, 0, u_size.x - 1))]; }
+float at(int x, int y) {
+  return work[uint(clamp(y, 0, u_size.y - 1)) * uint(u_size.x) + uint(clamp(x, 0, u_size.x - 1))];
+}
 float sample_luma(float fx, float fy) {
   const Taps b = reproject_bilinear(vec2(fx, fy));
   return REPROJECT_GATHER(work, 0u, b);
@@ -239,7 +241,9 @@ class FxaaFilterGpu final : public FrameFilter, public gpu::TimedKernel {
   }
   bool has_state() const override { return false; }
   Image saved_state() const override { return {}; }
-  Status set_state(const Image& state, int channels) override { return FxaaFilter(params_).set_state(state, channels); }
+  Status set_state(const Image& state, int channels) override {
+    return FxaaFilter(params_).set_state(state, channels);  // the C++ filter's usage error
+  }
   gpu::KernelTiming last_timing() const override { return timing_; }
 
  private:
@@ -261,7 +265,8 @@ Expected<std::unique_ptr<FrameFilter>> make_fxaa_filter_gpu(std::shared_ptr<gpu:
     if (!created) return created.error();
     context = std::move(*created);
   }
-  const std::string decl = gpu::glsl::storage(0, "src") + gpu::glsl::storage(1, "work") + gpu::glsl::storage(2, "outb");
+  const std::string decl =
+      gpu::glsl::storage(0, "src") + gpu::glsl::storage(1, "work") + gpu::glsl::storage(2, "outb");
   auto luma = gpu::Program::compile(context, "fxaa luma", {gpu::glsl::prelude(), decl, kFxaaDecl, kLumaMain});
   if (!luma) return luma.error();
   auto fxaa = gpu::Program::compile(context, "fxaa",

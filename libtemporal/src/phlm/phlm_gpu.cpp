@@ -406,7 +406,8 @@ class PhlmFilterGpu final : public FrameFilter, public gpu::TimedKernel {
       for (int d = 0; d < 3; ++d)
         if (Status s = out_.download(C + d, output.add_channel(names[d])); !s) return s;
       for (int c = 0; c < C; ++c) {
-        const std::string name = C == 3 ? "debug.feature" + std::string(detail::channel_suffix(3, c)) : "debug.feature";
+        const std::string name =
+            C == 3 ? "debug.feature" + std::string(detail::channel_suffix(3, c)) : std::string("debug.feature");
         if (Status s = out_.download(C + 3 + c, output.add_channel(name)); !s) return s;
       }
     }

@@ -232,7 +232,8 @@ class TaaFilterGpu final : public FrameFilter, public gpu::TimedKernel {
     program.set("u_no_history", int(in.reset || !same));
     program.set("u_variance", int(cfg_.clip == TaaClip::Variance));
     program.set("u_debug", int(in.debug));
-    program.set("u_fetch", cfg_.history == HistoryFetch::CatmullRom ? 0 : cfg_.history == HistoryFetch::Bilinear ? 1 : 2);
+    program.set("u_fetch",
+                cfg_.history == HistoryFetch::CatmullRom ? 0 : cfg_.history == HistoryFetch::Bilinear ? 1 : 2);
     program.set("u_alpha", cfg_.alpha);
     program.set("u_gamma", cfg_.gamma);
     program.set("u_weight", weight, 9);

@@ -7,11 +7,15 @@
 #include "temporal/gpu/timer.h"
 
 #include <algorithm>
+#include <cstdio>
 
 namespace temporal::upsample {
 
 std::string_view joint_bilateral_glsl() {
-  static const std::string text = std::string("const float kKernelEpsilon = ") + std::to_string(kKernelEpsilon) + ";\n" + R"(
+  static const std::string text = [] {
+    char epsilon[64];
+    std::snprintf(epsilon, sizeof epsilon, "const float kKernelEpsilon = %.9g;\n", double(kKernelEpsilon));
+    return std::string(epsilon) + R"(
 uniform ivec2 u_low_size;
 uniform int u_k, u_sx, u_sy, u_C;
 uniform float u_inv_k, u_inv_sn2, u_inv_sd2;
@@ -97,6 +101,7 @@ float jb_value(JB j, int c) {
 }
 
 )";
+  }();
   return text;
 }
 

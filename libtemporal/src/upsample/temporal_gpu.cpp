@@ -199,7 +199,8 @@ Expected<std::unique_ptr<MethodState>> make_temporal_state_gpu(std::shared_ptr<g
   auto program = gpu::Program::compile(
       context, "temporal",
       {gpu::glsl::prelude(), gpu::glsl::storage(0, "gb"), gpu::glsl::storage(1, "lowb"),
-       gpu::glsl::storage(2, "outb"), gpu::glsl::storage(3, "hist"), gpu::glsl::storage(4, "prevg"), joint_bilateral_glsl(),
+       gpu::glsl::storage(2, "outb"), gpu::glsl::storage(3, "hist"), gpu::glsl::storage(4, "prevg"),
+       joint_bilateral_glsl(),
        kTemporalDecl, gpu::glsl::reproject(), kTemporalMain});
   if (!program) return program.error();
   auto counters = gpu::ImageBuffer::create(context, 4, 1, 1);

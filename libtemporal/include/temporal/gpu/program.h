@@ -37,8 +37,8 @@ class Program {
   void set(const char* name, float x, float y) const;
   void set(const char* name, const float* v, int count) const;  // float[count]
   void set_int2(const char* name, int x, int y) const;           // ivec2
-  // Sets u_size = (width, height), dispatches ceil(width / 16) x ceil(height / 16) work groups and makes its storage writes visible to the
-  // next dispatch and to buffer reads.
+  // Sets u_size = (width, height), dispatches ceil(width / 16) x ceil(height / 16) work groups and makes their
+  // storage writes visible to the next dispatch and to buffer reads.
   Status dispatch(int width, int height) const;
   // Dispatches `groups_x` x `groups_y` work groups (kernels with their own work-group size).
   Status dispatch_groups(unsigned groups_x, unsigned groups_y) const;
