@@ -23,6 +23,7 @@ find_package(CLI11 CONFIG REQUIRED)
 pkg_check_modules(OSMESA REQUIRED IMPORTED_TARGET osmesa)
 # The renderer's second context: EGL's device platform through glvnd's libEGL (libegl-dev; Mesa's software device
 # comes from libegl-mesa0, a GPU's from its driver). Only libEGL is linked: GL entry points come from eglGetProcAddress.
+# (The gpu stage opens libEGL at run time and needs only its headers.)
 pkg_check_modules(EGL REQUIRED IMPORTED_TARGET egl)
 find_package(TinyGLTF CONFIG REQUIRED)
 # stb_image (libstb, the library tinygltf decodes glTF images with) decodes USD textures too.

@@ -110,6 +110,7 @@ Status Morpher::process(const Image& color, const Image* gbuffer, const Image* n
   }
   MorphTimings t;
   method_->run(color, info_->gbuffer_layers.empty() ? nullptr : gbuffer, info_->lookahead > 0 ? next : nullptr, out, t);
+  if (Status s = method_->run_status(); !s) return s;
   if (timings) *timings = t;
   return Status::ok();
 }

@@ -2,6 +2,7 @@
 #pragma once
 
 #include "temporal/phlm/frame_filter.h"
+#include "temporal/phlm/taa.h"
 
 #include <cstdint>
 #include <string>
@@ -31,4 +32,16 @@ void allocate_history(Image& history, Image& next, int channels, int width, int 
 // Loads the history planes of a state image written by `--state-out` into `history` (and sizes `next` to
 // match), refusing a missing or non-finite plane. `method` names the method in the messages.
 Status load_history(const Image& state, int channels, const char* method, Image& history, Image& next);
+
+// The resolved choices of TaaParams (shared by the C++ and GPU TAA).
+struct TaaConfig {
+  float alpha = 0.0f, gamma = 1.0f;
+  TaaVelocity velocity = TaaVelocity::Nearest;
+  TaaClip clip = TaaClip::MinMax;
+  HistoryFetch history = HistoryFetch::CatmullRom;
+};
+// Checks and resolves TaaParams (usage errors name the flag).
+Expected<TaaConfig> resolve_taa(const TaaParams& p);
+// The frame-dependent check: `nearest` velocity needs depth when there is motion (a usage error naming the fix).
+Status check_taa_input(const TaaConfig& cfg, const FilterInput& in);
 }  // namespace temporal::detail

@@ -35,13 +35,7 @@ inline void from_box(const float* b, float* v) {
     v[0] = b[0];
 }
 
-// The resolved choices of TaaParams.
-struct TaaConfig {
-  float alpha = 0.0f, gamma = 1.0f;
-  TaaVelocity velocity = TaaVelocity::Nearest;
-  TaaClip clip = TaaClip::MinMax;
-  HistoryFetch history = HistoryFetch::CatmullRom;
-};
+using detail::TaaConfig;
 
 // Index of the 3x3 neighbour of pixel (xx, yy) with the smallest depth (the closest surface); the centre wins
 // ties, then raster order. Non-finite depths never win.
@@ -198,7 +192,9 @@ void run_taa(const FilterInput& in, const TaaParams& params, const TaaConfig& cf
   });
 }
 
-Expected<TaaConfig> resolve(const TaaParams& p) {
+}  // namespace
+
+Expected<TaaConfig> detail::resolve_taa(const TaaParams& p) {
   TaaConfig cfg;
   cfg.alpha = p.alpha;
   cfg.gamma = p.gamma;
@@ -222,7 +218,12 @@ Expected<TaaConfig> resolve(const TaaParams& p) {
   return cfg;
 }
 
-}  // namespace
+Status detail::check_taa_input(const TaaConfig& cfg, const FilterInput& in) {
+  if (cfg.velocity == TaaVelocity::Nearest && in.motion_x && !in.depth)
+    return Error::usage("taa: --taa-velocity nearest takes the motion of the closest surface and needs the "
+                        "G-buffer's depth; render it (render-gbuffer --outputs gbuffer) or use --taa-velocity centre");
+  return Status::ok();
+}
 
 TaaFilter::TaaFilter(TaaParams params) : params_(params) {}
 
@@ -234,11 +235,9 @@ Status TaaFilter::process(const FilterInput& in, Image& output, FilterStats* sta
   if (Status s = validate_filter_input(in); !s) return s;
   const int channels = int(in.channels.size());
   const int w = in.color->width(), h = in.color->height();
-  auto cfg = resolve(params_);
+  auto cfg = detail::resolve_taa(params_);
   if (!cfg) return cfg.error();
-  if (cfg->velocity == TaaVelocity::Nearest && in.motion_x && !in.depth)
-    return Error::usage("taa: --taa-velocity nearest takes the motion of the closest surface and needs the "
-                        "G-buffer's depth; render it (render-gbuffer --outputs gbuffer) or use --taa-velocity centre");
+  if (Status s = detail::check_taa_input(*cfg, in); !s) return s;
   const bool same = have_state_ && channels == channels_ && history_.width() == w && history_.height() == h;
   if (!same) {
     channels_ = channels;

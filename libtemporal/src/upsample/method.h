@@ -28,6 +28,9 @@ class MethodState {
   // the payload channels, plus debug.* layers when f.debug. `history` is false when every history must be ignored
   // (first frame, cut). Fills stats.hole_pixels and stats.history_pixels.
   virtual Image& run(const FrameContext& f, bool history, FrameStats& stats) = 0;
+  // Whether the last run() succeeded: the C++ states cannot fail; a GPU state (gpu_methods.h) reports a driver
+  // error here (its output is then undefined), and the Upsampler returns it.
+  virtual Status run_status() const { return Status::ok(); }
   // The persistent state as planes of `state` (an image at the G-buffer's size; smaller planes top-left, see
   // put_plane) and header attributes that describe its layout (checked on load).
   virtual void save(Image& state) const = 0;

@@ -330,6 +330,7 @@ Expected<Image*> Upsampler::process(const Image& gbuffer, const Image& low, std:
   if (u.options.demodulate) u.demodulate_low();
   gather_low_geometry(u.f);
   Image* result = &u.state->run(u.f, u.have_history, stats);
+  if (Status s = u.state->run_status(); !s) return s.error();
   u.have_history = true;
   if (u.options.demodulate) result = u.remodulate(result, channels);
   if (u.options.aa_factor > 1) result = u.downsample(result);

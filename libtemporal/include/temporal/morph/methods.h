@@ -34,6 +34,9 @@ class MorphMethod {
   // lookahead (null at the end of the sequence). Inputs are checked (Morpher::process) and finite. Fills `t`.
   virtual void run(const Image& color, const Image* gbuffer, const Image* next, std::vector<Image>& out,
                    MorphTimings& t) = 0;
+  // Whether the last run() succeeded: the C++ methods cannot fail; a GPU method (temporal/morph/gpu_methods.h)
+  // reports a driver error here (its outputs are then undefined), and Morpher::process returns it.
+  virtual Status run_status() const { return Status::ok(); }
 };
 
 // One registry entry.

@@ -1,0 +1,101 @@
+// `blend` (blend.cpp) as a GLSL compute kernel: one dispatch per in-between slot, the same expression.
+#include "method_common.h"
+#include "temporal/gpu/buffer.h"
+#include "temporal/gpu/glsl.h"
+#include "temporal/gpu/program.h"
+#include "temporal/gpu/timer.h"
+#include "temporal/morph/gpu_methods.h"
+
+#include <algorithm>
+
+namespace temporal {
+namespace {
+
+using namespace morph_detail;
+
+// frames (binding 0): R, G, B of frame n (planes 0-2) and of frame n+1 (3-5); outb (1): R, G, B of the slot.
+constexpr const char* kBlendMain = R"(
+uniform uint u_n;
+uniform float u_a;
+void main() {
+  ivec2 p;
+  uint i;
+  if (!pixel_index(p, i)) return;
+  for (uint c = 0u; c < 3u; ++c)
+    outb[c * u_n + i] = (1.0 - u_a) * frames[c * u_n + i] + u_a * frames[(3u + c) * u_n + i];
+}
+)";
+
+class BlendGpu final : public MorphMethod, public gpu::TimedKernel {
+ public:
+  BlendGpu(std::shared_ptr<gpu::Context> ctx, gpu::Program program)
+      : ctx_(std::move(ctx)), program_(std::move(program)), timer_(ctx_) {}
+  void run(const Image& color, const Image*, const Image* next, std::vector<Image>& out, MorphTimings& t) override {
+    const auto t0 = std::chrono::steady_clock::now();
+    status_ = run_gpu(color, next ? *next : color, out);
+    t.morph_ms = ms_since(t0);
+  }
+  Status run_status() const override { return status_; }
+  gpu::KernelTiming last_timing() const override { return timing_; }
+
+ private:
+  Status run_gpu(const Image& color, const Image& next, std::vector<Image>& out) {
+    const int w = color.width(), h = color.height();
+    const std::size_t np = color.pixel_count();
+    if (frames_.width() != w || frames_.height() != h) {
+      auto f = gpu::ImageBuffer::create(ctx_, w, h, 6);
+      if (!f) return f.error();
+      auto o = gpu::ImageBuffer::create(ctx_, w, h, 3);
+      if (!o) return o.error();
+      frames_ = std::move(*f);
+      slot_ = std::move(*o);
+    }
+    for (int c = 0; c < 3; ++c) {
+      if (Status s = frames_.upload(c, color, kRGB[c]); !s) return s;
+      if (Status s = frames_.upload(3 + c, next, kRGB[c]); !s) return s;
+      std::copy(color.plane(kRGB[c]), color.plane(kRGB[c]) + np, out[0].plane(kRGB[c]));
+    }
+    const int n = int(out.size());
+    timing_ = {};
+    timing_.clock = timer_.clock();
+    for (int k = 1; k < n; ++k) {
+      if (Status s = program_.use(); !s) return s;
+      program_.set("u_n", std::uint32_t(np));
+      program_.set("u_a", float(k) / float(n));
+      frames_.bind(0);
+      slot_.bind(1);
+      timer_.start();
+      if (Status s = program_.dispatch(w, h); !s) return s;
+      timing_.kernel_ms += timer_.stop_ms();
+      timing_.bytes_moved += 9.0 * double(np) * 4.0;  // two frames read, one slot written
+      for (int c = 0; c < 3; ++c)
+        if (Status s = slot_.download(c, out[std::size_t(k)].plane(kRGB[c])); !s) return s;
+    }
+    return Status::ok();
+  }
+
+  std::shared_ptr<gpu::Context> ctx_;
+  gpu::Program program_;
+  gpu::Timer timer_;
+  gpu::ImageBuffer frames_, slot_;
+  Status status_;
+  gpu::KernelTiming timing_;
+};
+
+}  // namespace
+
+Expected<std::unique_ptr<MorphMethod>> make_blend_method_gpu(std::shared_ptr<gpu::Context> context,
+                                                             const MorphOptions&) {
+  if (!context) {
+    auto created = gpu::Context::create();
+    if (!created) return created.error();
+    context = std::move(*created);
+  }
+  auto program = gpu::Program::compile(context, "blend",
+                                       {gpu::glsl::prelude(), gpu::glsl::storage(0, "frames"),
+                                        gpu::glsl::storage(1, "outb"), kBlendMain});
+  if (!program) return program.error();
+  return std::unique_ptr<MorphMethod>(new BlendGpu(std::move(context), std::move(*program)));
+}
+
+}  // namespace temporal

@@ -1,0 +1,228 @@
+// The EMA filter (ema.cpp) as one GLSL compute kernel: the same reprojection (the gpu stage's GLSL version of
+// core/reproject.h), the same eq. 1, the same state planes (history.<c>, history.depth, history.id).
+#include "filter_common.h"
+#include "temporal/gpu/buffer.h"
+#include "temporal/gpu/glsl.h"
+#include "temporal/gpu/program.h"
+#include "temporal/gpu/timer.h"
+#include "temporal/phlm/gpu_filters.h"
+
+#include <algorithm>
+
+namespace temporal {
+namespace {
+
+// Buffers: `src` (binding 0) the frame: colour planes 0..C-1, then motion.X, motion.Y, depth, the warped depth,
+// id; `hist` (1) the history: colour 0..C-1, depth C, id C+1; `nxt` (2) the next history, same layout plus the
+// debug plane C+2. Plane p of a buffer starts at p * u_n.
+constexpr const char* kEmaKernel = R"(
+uniform uint u_n;
+uniform int u_channels;
+uniform bool u_motion, u_reject_all, u_use_depth, u_use_ids, u_warped, u_write_depth, u_write_id, u_debug;
+uniform float u_alpha, u_tol, u_warped_tol;
+
+#define SRC(p) (uint(p) * u_n)
+#define REPROJECT_PREV_Z(q) hist[SRC(u_channels) + uint(q)]
+#define REPROJECT_PREV_ID(q) hist_u[SRC(u_channels + 1) + uint(q)]
+)";
+
+constexpr const char* kEmaMain = R"(
+void main() {
+  ivec2 p;
+  uint i;
+  const bool inside = pixel_index(p, i);
+  count_begin();
+  if (inside) {
+    const int C = u_channels;
+    const uint mx = SRC(C), my = SRC(C + 1), depth = SRC(C + 2), warped = SRC(C + 3), id = SRC(C + 4);
+    bool valid = true;
+    float y[3];
+    for (int c = 0; c < C; ++c) {
+      y[c] = src[SRC(c) + i];
+      valid = valid && is_finite_bits(y[c]);
+    }
+    // ema.cpp: reject = reset || no history of this size || the shared reprojection misses.
+    bool reject = u_reject_all;
+    Taps t;
+    if (!reject) {
+      t = reproject_taps(p, u_motion ? vec2(src[mx + i], src[my + i]) : vec2(0.0));
+      const float z = u_use_depth ? expect_depth(src[depth + i], src[warped + i], u_warped) : 0.0;
+      const float tol = expect_tolerance(u_tol, u_warped_tol, u_warped);
+      reject = !reproject_test(t, z, u_use_ids ? src_u[id + i] : 0u, u_use_depth, u_use_ids, tol);
+    }
+    for (int c = 0; c < C; ++c) {
+      const float hv = reject ? 0.0 : REPROJECT_GATHER(hist, SRC(c), t);
+      float v;
+      if (valid)
+        v = reject ? y[c] : u_alpha * hv + (1.0 - u_alpha) * y[c];  // eq. 1
+      else
+        v = hv;  // no valid sample: keep the history (0 when there is none)
+      nxt[SRC(c) + i] = v;
+    }
+    if (u_write_depth) nxt[SRC(C) + i] = src[depth + i];
+    if (u_write_id) nxt_u[SRC(C + 1) + i] = src_u[id + i];
+    if (u_debug) nxt[SRC(C + 2) + i] = reject ? 1.0 : 0.0;
+    count_add(0, !valid);
+    count_add(1, reject);
+  }
+  count_end();
+}
+)";
+
+class EmaFilterGpu final : public FrameFilter, public gpu::TimedKernel {
+ public:
+  EmaFilterGpu(std::shared_ptr<gpu::Context> ctx, EmaParams params, gpu::Program program, gpu::ImageBuffer counters)
+      : ctx_(std::move(ctx)), params_(params), program_(std::move(program)), counters_(std::move(counters)),
+        timer_(ctx_) {}
+
+  Status process(const FilterInput& in, Image& output, FilterStats* stats) override {
+    if (Status s = validate_filter_input(in); !s) return s;
+    const int channels = int(in.channels.size());
+    const int w = in.color->width(), h = in.color->height();
+    const bool same = have_state_ && channels == channels_ && hist_.width() == w && hist_.height() == h;
+    if (!same) {
+      if (Status s = allocate(channels, w, h); !s) return s;
+      has_depth_ = has_id_ = false;  // a fresh history (detail::allocate_history) has no G-buffer planes
+    }
+    const int C = channels;
+    for (int c = 0; c < C; ++c)
+      if (Status s = src_.upload(c, *in.color, in.channels[std::size_t(c)]); !s) return s;
+    if (in.motion_x) {
+      if (Status s = src_.upload(C, in.motion_x); !s) return s;
+      if (Status s = src_.upload(C + 1, in.motion_y); !s) return s;
+    }
+    if (in.depth)
+      if (Status s = src_.upload(C + 2, in.depth); !s) return s;
+    if (in.prev_depth)
+      if (Status s = src_.upload(C + 3, in.prev_depth); !s) return s;
+    if (in.id)
+      if (Status s = src_.upload(C + 4, in.id); !s) return s;
+    if (Status s = counters_.clear(0, 1); !s) return s;
+    const bool use_depth = in.depth && has_depth_ && same;
+    const bool use_id = in.id && has_id_ && same;
+
+    if (Status s = program_.use(); !s) return s;
+    program_.set("u_n", std::uint32_t(src_.pixel_count()));
+    program_.set("u_channels", C);
+    program_.set("u_motion", int(in.motion_x != nullptr));
+    program_.set("u_reject_all", int(in.reset || !same));
+    program_.set("u_use_depth", int(use_depth));
+    program_.set("u_use_ids", int(use_id));
+    program_.set("u_warped", int(use_depth && in.prev_depth != nullptr));
+    program_.set("u_write_depth", int(in.depth != nullptr));
+    program_.set("u_write_id", int(in.id != nullptr));
+    program_.set("u_debug", int(in.debug));
+    program_.set("u_alpha", params_.alpha);
+    program_.set("u_tol", params_.depth_tolerance);
+    program_.set("u_warped_tol", params_.warped_depth_tolerance);
+    src_.bind(0);
+    hist_.bind(1);
+    next_.bind(2);
+    counters_.bind(15);
+    timer_.start();
+    if (Status s = program_.dispatch(w, h); !s) return s;
+    timing_.kernel_ms = timer_.stop_ms();
+    timing_.clock = timer_.clock();
+    // Each plane read or written once: colour in and out, motion, depth (+ warped), id, the history planes read.
+    const double plane = double(src_.pixel_count()) * 4.0;
+    double planes = 2.0 * C + (in.motion_x ? 2 : 0) + (in.depth ? 2 : 0) + (in.prev_depth && use_depth ? 1 : 0) +
+                    (in.id ? 2 : 0) + (same ? C : 0) + (use_depth ? 1 : 0) + (use_id ? 1 : 0) + (in.debug ? 1 : 0);
+    timing_.bytes_moved = planes * plane;
+
+    float* out[3] = {};
+    detail::prepare_output(in, output, out);
+    for (int c = 0; c < C; ++c)
+      if (Status s = next_.download(c, out[c]); !s) return s;
+    if (in.debug)
+      if (Status s = next_.download(C + 2, output.add_channel("debug.reject")); !s) return s;
+    std::swap(hist_, next_);
+    has_depth_ = in.depth != nullptr;
+    has_id_ = in.id != nullptr;
+    have_state_ = true;
+    if (stats) {
+      std::uint32_t counts[4] = {};
+      if (Status s = counters_.download(0, counts); !s) return s;
+      *stats = {};
+      stats->non_finite = counts[0];
+      stats->history_resets = counts[1];
+    }
+    return Status::ok();
+  }
+
+  Image saved_state() const override {
+    if (!have_state_) return {};
+    Image state(hist_.width(), hist_.height());
+    const auto names = EmaFilter::state_channel_names(channels_);
+    // saved_state() cannot report an error; a failed download leaves the plane absent and set_state refuses it.
+    for (int c = 0; c < channels_; ++c)
+      if (!hist_.download(c, state, names[std::size_t(c)])) state.remove_channel(names[std::size_t(c)]);
+    if (has_depth_) (void)hist_.download(channels_, state, "history.depth");
+    if (has_id_) (void)hist_.download(channels_ + 1, state, "history.id", true);
+    return state;
+  }
+
+  Status set_state(const Image& state, int channels) override {
+    Image history, next;
+    if (Status s = detail::load_history(state, channels, "ema", history, next); !s) return s;
+    if (Status s = allocate(channels, state.width(), state.height()); !s) return s;
+    const auto names = EmaFilter::state_channel_names(channels);
+    for (int c = 0; c < channels; ++c)
+      if (Status s = hist_.upload(c, history, names[std::size_t(c)]); !s) return s;
+    has_depth_ = state.plane("history.depth") != nullptr;
+    has_id_ = state.uint_plane("history.id") != nullptr;
+    if (has_depth_)
+      if (Status s = hist_.upload(channels, state, "history.depth"); !s) return s;
+    if (has_id_)
+      if (Status s = hist_.upload(channels + 1, state, "history.id"); !s) return s;
+    have_state_ = true;
+    return Status::ok();
+  }
+
+  gpu::KernelTiming last_timing() const override { return timing_; }
+
+ private:
+  Status allocate(int channels, int w, int h) {
+    channels_ = channels;
+    if (src_.width() == w && src_.height() == h && src_.planes() == channels + 5) return Status::ok();
+    auto src = gpu::ImageBuffer::create(ctx_, w, h, channels + 5);
+    if (!src) return src.error();
+    auto hist = gpu::ImageBuffer::create(ctx_, w, h, channels + 3);
+    if (!hist) return hist.error();
+    auto next = gpu::ImageBuffer::create(ctx_, w, h, channels + 3);
+    if (!next) return next.error();
+    src_ = std::move(*src);
+    hist_ = std::move(*hist);
+    next_ = std::move(*next);
+    return Status::ok();
+  }
+
+  std::shared_ptr<gpu::Context> ctx_;
+  EmaParams params_;
+  gpu::Program program_;
+  gpu::ImageBuffer counters_;
+  gpu::Timer timer_;
+  gpu::ImageBuffer src_, hist_, next_;
+  int channels_ = 0;
+  bool have_state_ = false, has_depth_ = false, has_id_ = false;
+  gpu::KernelTiming timing_;
+};
+
+}  // namespace
+
+Expected<std::unique_ptr<FrameFilter>> make_ema_filter_gpu(std::shared_ptr<gpu::Context> context, EmaParams params) {
+  if (!context) {
+    auto created = gpu::Context::create();
+    if (!created) return created.error();
+    context = std::move(*created);
+  }
+  auto program = gpu::Program::compile(
+      context, "ema", {gpu::glsl::prelude(), gpu::glsl::storage(0, "src"), gpu::glsl::storage(1, "hist"),
+                       gpu::glsl::storage(2, "nxt"), kEmaKernel, gpu::glsl::reproject(), kEmaMain});
+  if (!program) return program.error();
+  auto counters = gpu::ImageBuffer::create(context, 4, 1, 1);
+  if (!counters) return counters.error();
+  return std::unique_ptr<FrameFilter>(
+      new EmaFilterGpu(std::move(context), params, std::move(*program), std::move(*counters)));
+}
+
+}  // namespace temporal

@@ -1,0 +1,45 @@
+// The GPU implementations of upsample-st's methods (GLSL compute kernels, temporal/gpu), not installed: each
+// factory returns the same MethodState as the method's C++ entry (method.h) with the same state planes, so a run
+// started on one device resumes on the other. The states also implement gpu::TimedKernel. Tolerances: docs/gpu.md.
+#pragma once
+
+#include "method.h"
+#include "temporal/gpu/buffer.h"
+#include "temporal/gpu/context.h"
+#include "temporal/gpu/program.h"
+
+#include <memory>
+#include <string_view>
+
+namespace temporal::upsample {
+
+// `spatial` (spatial.cpp): joint-bilateral upsampling, eq. 1-3 with the hat kernel.
+Expected<std::unique_ptr<MethodState>> make_spatial_state_gpu(std::shared_ptr<gpu::Context> context,
+                                                              const Options& options, const Geometry& geometry);
+// `temporal` (temporal.cpp): eq. 4 with the binary weight, holes filled by the joint-bilateral result.
+Expected<std::unique_ptr<MethodState>> make_temporal_state_gpu(std::shared_ptr<gpu::Context> context,
+                                                               const Options& options, const Geometry& geometry);
+
+// GLSL of the joint-bilateral weights (spatial_row / expanded_geometric_weights: the same operations in the same
+// order), shared by the upsampling kernels. Reads binding 0 `gb` (full-resolution planes: depth.Z 0, N.X/Y/Z 1-3)
+// and binding 1 `lowb` (the low-resolution payload, C planes of lw x lh). jb_weights(P) returns the four taps'
+// low-resolution offsets and their weights; jb_value(j, c) the payload value of a tap.
+std::string_view joint_bilateral_glsl();
+
+// Sets the uniforms joint_bilateral_glsl() reads from the frame (the constants computed on the host exactly as the
+// C++ kernels compute them).
+void set_joint_bilateral_uniforms(const gpu::Program& program, const FrameContext& f);
+
+// One frame's inputs on the GPU: `gb` (binding 0) the full-resolution planes depth.Z, N.X, N.Y, N.Z, motion.X,
+// motion.Y, prevDepth.Z, id (planes 0-7; motion, warped depth and id uploaded only when `history_layers` and
+// present); `low` (binding 1) the C low-resolution payload planes.
+struct GpuFrame {
+  gpu::ImageBuffer gb, low;
+  Status upload(const std::shared_ptr<gpu::Context>& context, const FrameContext& f, bool history_layers);
+  void bind() const {
+    gb.bind(0);
+    low.bind(1);
+  }
+};
+
+}  // namespace temporal::upsample
