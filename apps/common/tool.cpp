@@ -210,9 +210,15 @@ std::string progress_text(const std::string& tool, int frame, int done, int tota
   return text + ")";
 }
 
-Progress::Progress(std::string tool, int total, std::chrono::steady_clock::time_point start)
-    : tool_(std::move(tool)), total_(total), enabled_(isatty(STDERR_FILENO) != 0), start_(start) {
-  if (enabled_) g_active = this;
+Progress::Progress(std::string tool, int total, std::chrono::steady_clock::time_point start, Mode mode,
+                   double line_seconds)
+    : tool_(std::move(tool)),
+      total_(total),
+      enabled_(true),
+      terminal_(mode == Mode::Terminal || (mode == Mode::Automatic && isatty(STDERR_FILENO) != 0)),
+      line_seconds_(line_seconds),
+      start_(start) {
+  if (terminal_) g_active = this;
 }
 
 Progress::~Progress() {
@@ -237,8 +243,19 @@ void Progress::clear_active() {
 void Progress::step(int frame) {
   ++done_;
   if (!enabled_) return;
-  g_active = this;
   const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+  if (!terminal_) {
+    // A plain line every line_seconds_ (the first once the run has taken that long), and the last one.
+    const bool due = s - last_line_s_ >= line_seconds_;
+    if (due || (printed_line_ && done_ >= total_)) {
+      std::fprintf(stderr, "%s\n", progress_text(tool_, frame, done_, total_, s).c_str());
+      std::fflush(stderr);
+      last_line_s_ = s;
+      printed_line_ = true;
+    }
+    return;
+  }
+  g_active = this;
   std::fprintf(stderr, "\r\033[K%s", progress_text(tool_, frame, done_, total_, s).c_str());
   std::fflush(stderr);
   drawn_ = true;

@@ -94,13 +94,20 @@ std::string progress_text(const std::string& tool, int frame, int done, int tota
 // A duration for people: "0.4 s", "12 s", "3 min 05 s", "1 h 02 min".
 std::string duration_text(double seconds);
 
-// A single progress line on stderr (progress_text), drawn only when stderr is a terminal and erased when done
-// (destructor, or finish()) or before any message the Tool prints. One line is active per process at a time.
+// Progress on stderr (progress_text). On a terminal: one line, redrawn at each frame and erased when done
+// (destructor, or finish()) or before any message the Tool prints. Elsewhere (a log file, a Snakemake or Slurm
+// job log): one plain line every kProgressLineSeconds once the run has taken that long, and a last line at the end
+// if any was printed - so a long render shows that it advances, and a short run prints nothing. One progress is
+// active per process at a time.
+inline constexpr double kProgressLineSeconds = 5.0;
 class Progress {
  public:
-  // `start`: when the work began (default: now), so the first frame's rate counts its own time.
+  enum class Mode { Automatic, Terminal, Lines };
+  // `start`: when the work began (default: now), so the first frame's rate counts its own time. Automatic:
+  // Terminal when stderr is a terminal, else Lines. `line_seconds`: the interval of Lines.
   Progress(std::string tool, int total,
-           std::chrono::steady_clock::time_point start = std::chrono::steady_clock::now());
+           std::chrono::steady_clock::time_point start = std::chrono::steady_clock::now(),
+           Mode mode = Mode::Automatic, double line_seconds = kProgressLineSeconds);
   ~Progress();
   Progress(const Progress&) = delete;
   Progress& operator=(const Progress&) = delete;
@@ -115,7 +122,11 @@ class Progress {
   int total_;
   int done_ = 0;
   bool enabled_;
+  bool terminal_;
   bool drawn_ = false;
+  double line_seconds_;
+  double last_line_s_ = 0.0;  // when the last plain line was printed (seconds since start_)
+  bool printed_line_ = false;
   std::chrono::steady_clock::time_point start_;
 };
 

@@ -4,6 +4,8 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 namespace temporal::tool {
 namespace {
 
@@ -31,6 +33,38 @@ TEST(Progress, Durations) {
   EXPECT_EQ(duration_text(185.0), "3 min 05 s");
   EXPECT_EQ(duration_text(3725.0), "1 h 02 min");
   EXPECT_EQ(duration_text(-1.0), "?");
+}
+
+}  // namespace
+}  // namespace temporal::tool
+
+namespace temporal::tool {
+namespace {
+
+// Off a terminal (a log file, a Snakemake or Slurm job log) progress is plain lines: one per interval once the run
+// has taken that long, then the last frame; a run shorter than the interval prints nothing.
+TEST(ProgressLines, OneLinePerIntervalAndTheLastOnly) {
+  testing::internal::CaptureStderr();
+  {
+    Progress p("tool", 3, std::chrono::steady_clock::now(), Progress::Mode::Lines, 0.0);
+    p.step(10);
+    p.step(11);
+    p.step(12);
+  }
+  const std::string every = testing::internal::GetCapturedStderr();
+  EXPECT_EQ(every.find('\r'), std::string::npos) << every;
+  EXPECT_NE(every.find("tool: frame 10 (1/3"), std::string::npos) << every;
+  EXPECT_NE(every.find("tool: frame 12 (3/3"), std::string::npos) << every;
+  EXPECT_EQ(std::count(every.begin(), every.end(), '\n'), 3) << every;
+
+  testing::internal::CaptureStderr();
+  {
+    Progress p("tool", 3, std::chrono::steady_clock::now(), Progress::Mode::Lines, 3600.0);
+    p.step(10);
+    p.step(11);
+    p.step(12);
+  }
+  EXPECT_EQ(testing::internal::GetCapturedStderr(), "");
 }
 
 }  // namespace

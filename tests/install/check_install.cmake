@@ -13,6 +13,13 @@ function(run)
   message(STATUS "${out}")
 endfunction()
 run(${CMAKE_COMMAND} --install ${BUILD_DIR} --prefix ${prefix})
+# The five tools land in PREFIX/bin and run from there (issue 25: the README says where they are).
+foreach(tool compare render-gbuffer upsample-st filter-phlm morph-120hz)
+  if(NOT EXISTS ${prefix}/bin/${tool})
+    message(FATAL_ERROR "cmake --install did not put ${tool} in ${prefix}/bin")
+  endif()
+  run(${prefix}/bin/${tool} --version)
+endforeach()
 # A sanitizer build (preset dev) installs instrumented static libraries: the consumer must link the sanitizer
 # runtimes too, as any program linking those libraries would.
 file(STRINGS ${BUILD_DIR}/CMakeCache.txt sanitized REGEX "^TEMPORAL_SANITIZE:BOOL=ON$")

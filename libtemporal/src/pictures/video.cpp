@@ -90,7 +90,10 @@ Expected<VideoWriter> VideoWriter::open(const std::string& path, int width, int 
   std::vector<std::string> args = {ffmpeg, "-nostdin", "-hide_banner", "-loglevel", "error", "-y",
                                    "-f", "rawvideo", "-pix_fmt", "rgb24", "-s", size, "-framerate", fps, "-i", "pipe:0",
                                    "-an", "-c:v", "libx264", "-preset", "medium", "-crf", crf, "-pix_fmt", "yuv420p",
-                                   "-movflags", "+faststart", "-f", "mp4", impl->file->path()};
+                                   // The frames are sRGB-encoded Rec.709 (the report's display encoding): tag the stream
+                                   // so players do not guess (BT.709 primaries and matrix, the sRGB transfer curve).
+                                   "-color_primaries", "bt709", "-color_trc", "iec61966-2-1", "-colorspace", "bt709",
+                                   "-color_range", "tv", "-movflags", "+faststart", "-f", "mp4", impl->file->path()};
   std::vector<char*> argv;
   for (auto& a : args) argv.push_back(a.data());
   argv.push_back(nullptr);
