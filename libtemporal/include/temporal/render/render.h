@@ -20,7 +20,8 @@
 //   ssao.Y        horizon-based ambient occlusion (Bavoil & Sainz 2008), D directions x S steps, pattern
 //                 re-randomised every frame
 //   gi.R/G/B      one-bounce indirect radiance from V virtual point lights drawn from a reflective shadow
-//                 map of the key light (Dachsbacher & Stamminger 2005), no visibility (instant GI)
+//                 map of the key light (Dachsbacher & Stamminger 2005), no visibility (instant GI); plus a
+//                 DomeLight's ambient, and the fill and ambient of the automatic rig (LightingOptions)
 //   R,G,B         sum = direct * shadow + gi * ssao (a term that is off counts as 0 for direct/gi and 1
 //                 for shadow/ssao)
 // Background pixels: direct = gi = sum = 0, shadow = ssao = 1.
