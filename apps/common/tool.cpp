@@ -66,7 +66,11 @@ void Tool::add_params(const ParamList& params) {
             else
               app_.add_flag(p.flag, *v, help);
           } else {
-            app_.add_option(p.flag, *v, help);
+            // An empty value (`--flag=` or `--flag ""`) is a usage error naming the option: CLI11 would otherwise
+            // convert it to 0 (a valid value of many options) or keep an empty string (issue 26).
+            app_.add_option(p.flag, *v, help)->check(CLI::Validator(
+                [](const std::string& value) { return value.empty() ? std::string("needs a value, got an empty one") : std::string(); },
+                "", "non-empty"));
           }
         },
         p.value);

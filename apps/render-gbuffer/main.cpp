@@ -8,7 +8,6 @@
 #include "temporal/scene/scene.h"
 
 #include <cstdlib>
-#include <limits>
 #include <iostream>
 #include <optional>
 
@@ -25,15 +24,17 @@ struct SequenceText {
 };
 
 ParamList sequence_params(SceneLoadOptions& l, ReplayOptions& p, SequenceText& t) {
-  const double inf = std::numeric_limits<double>::infinity();
-  Param fps{"--fps", "Frames per second: frame N is the scene at N / fps seconds", &p.fps, 0.0, 10000.0};
-  fps.above_min = true;
-  // Scene::load checks the period where a path uses it (> 0); a fixed camera ignores it.
-  Param period{"--camera-period", "Seconds per orbit turn or dolly back-and-forth", &l.camera.path_period_s, -inf, inf};
+  // Finite ranges whose arithmetic stays finite (issue 26): a frame's time N / fps with N < 2^31 and fps >= 0.001 is
+  // at most 2.2e12 s (a rate of 1e-45 made it inf); an orbit's angle 2 pi t / period likewise; duration * fps is
+  // further bounded by validate(ReplayOptions) to a million frames.
+  Param fps{"--fps", "Frames per second: frame N is the scene at N / fps seconds", &p.fps, 0.001, 10000.0};
+  // Scene::load checks the period where a path uses it; a fixed camera ignores it.
+  Param period{"--camera-period", "Seconds per orbit turn or dolly back-and-forth", &l.camera.path_period_s, 0.001, 1e6};
   return {
       fps,
       Param::text("--frames", "Frames A-B (inclusive); default: the whole clip", &t.frames),
-      Param{"--duration", "Seconds to render from frame 0 (instead of --frames)", &p.duration_s, 0.0, inf},
+      Param{"--duration", "Seconds to render from frame 0 (instead of --frames; duration x fps <= 1e6 frames)",
+            &p.duration_s, 0.0, 1e9},
       Param::text("--camera", "Camera name, index or USD prim path; default: the first camera or an automatic one",
                   &l.camera.camera),
       Param::text("--clip", "glTF animation name or index; default: the first animation", &l.clip),
@@ -111,6 +112,7 @@ int main(int argc, char** argv) {
     p.tool = tool.signature();
     p.parameters = tool.command_line();
     std::optional<tool::Progress> progress;
+    r.warning = [&](const std::string& message) { tool.print_warning("", message); };
     ReplayHooks hooks;
     hooks.log = [&](const std::string& line) { tool.log(line); };
     hooks.frame_done = [&](int frame, int total) {

@@ -150,6 +150,26 @@ TEST(Robustness, NonFiniteAndOutOfRangeParametersAreUsageErrors) {
   EXPECT_EQ(param_range_text(q), "> 0");
 }
 
+// Issue 26: an empty value is a usage error naming the parameter, for text parameters too (it used to be kept as
+// an empty string, and a number's empty value is refused as before).
+TEST(Robustness, EmptyParameterValuesAreUsageErrors) {
+  float f = 0.5f;
+  std::string t = "keep";
+  const ParamList params = {Param::real("--alpha", "weight", &f, 0.0, 1.0), Param::text("--name", "a name", &t)};
+  for (const char* flag : {"--alpha", "--name"}) {
+    Status s = apply_args(params, {flag, ""});
+    ASSERT_FALSE(s) << flag;
+    EXPECT_EQ(s.error().kind, ErrorKind::Usage);
+    EXPECT_NE(s.error().message.find(std::string(flag) + " needs a value, got an empty one"), std::string::npos)
+        << s.error().message;
+  }
+  EXPECT_EQ(f, 0.5f);
+  EXPECT_EQ(t, "keep");
+  EXPECT_TRUE(apply_args(params, {"--name", "x", "--alpha", "0.25"}));
+  EXPECT_EQ(t, "x");
+  EXPECT_EQ(f, 0.25f);
+}
+
 TEST(Robustness, StaleTemporaryFilesOfDeadProcessesAreRemoved) {
   const auto dir = test::scratch_dir("robust-stale");
   // A process that has ended: its PID is free (the child below), so its temporary file is stale.

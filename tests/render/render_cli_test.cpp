@@ -377,6 +377,65 @@ TEST(RenderCli, RunawayRangesAndMalformedScenesAreRefused) {
   EXPECT_FALSE(fs::exists(dir / "o" / "gbuffer.0000.exr"));
 }
 
+// Issue 26 item 14 and its exit-code cases: every float option has a finite range (said in --help) that keeps its
+// arithmetic finite (--fps 1e-45 wrote temporal:time = inf), non-finite values are refused, and an empty value is a
+// usage error naming the option (CLI11 read `--ssao-radius ""` as 0, a valid radius). Nothing is written.
+TEST(RenderCli, FloatOptionsHaveFiniteRangesAndEmptyValuesAreRefused) {
+  const auto dir = test::scratch_dir("render_cli_ranges");
+  const auto scene = write_test_scene(dir).string();
+  // No --frames: it excludes --duration (every case is refused before anything renders).
+  const std::string cmd = tool() + " " + scene + " --size 32x24 --out " + (dir / "o").string();
+  std::string out;
+  const std::pair<const char*, const char*> cases[] = {
+      {"--fps 1e-45", "--fps"}, {"--fps 20000", "--fps"}, {"--shadow-bias nan", "--shadow-bias"},
+      {"--shadow-bias -inf", "--shadow-bias"}, {"--shadow-bias 1e30", "--shadow-bias"},
+      {"--ssao-radius inf", "--ssao-radius"}, {"--ssao-radius -1", "--ssao-radius"},
+      {"--camera-period 0", "--camera-period"}, {"--camera-period 1e300", "--camera-period"},
+      {"--duration 1e300", "--duration"}, {"--key-light -1", "--key-light"}, {"--fill-light nan", "--fill-light"},
+      {"--ambient inf", "--ambient"}, {"--ambient 1000", "--ambient"}, {"--lights sun", "--lights"},
+      {"--ssao-radius=", "--ssao-radius"}, {"--ssao-radius ''", "--ssao-radius"}, {"--shadow-bias ''", "--shadow-bias"},
+      {"--fps ''", "--fps"}, {"--seed ''", "--seed"}, {"--camera ''", "--camera"}, {"--key-light=", "--key-light"},
+      {"--lights ''", "--lights"}, {"--size ''", "--size"}, {"--pcf ''", "--pcf"}};
+  for (auto [bad, flag] : cases) {
+    EXPECT_EQ(test::run_command(cmd + " " + bad, &out), 1) << bad << "\n" << out;
+    EXPECT_NE(out.find(std::string("render-gbuffer: ") + flag), std::string::npos) << bad << "\n" << out;
+  }
+  EXPECT_FALSE(fs::exists(dir / "o" / "color.0000.exr"));
+  // --help gives each float option its range: the option's line (or the next, after CLI11's "Excludes") has one.
+  ASSERT_EQ(test::run_command(tool() + " --help", &out), 0) << out;
+  std::istringstream help(out);
+  std::vector<std::string> lines;
+  for (std::string line; std::getline(help, line);) lines.push_back(line);
+  int floats = 0;
+  for (std::size_t i = 0; i + 1 < lines.size(); ++i) {
+    if (lines[i].find(" FLOAT") == std::string::npos) continue;
+    ++floats;
+    const std::string text = lines[i] + lines[i + 1];
+    EXPECT_NE(text.find("(["), std::string::npos) << lines[i];
+  }
+  EXPECT_GE(floats, 9);
+  for (const char* range : {"--fps FLOAT=40", "[0.001, 10000]", "[-64, 64]", "[0, 1000000]", "--key-light", "--fill-light",
+                            "--ambient", "--lights"})
+    EXPECT_NE(out.find(range), std::string::npos) << range;
+}
+
+// Issue 25 item 4: a frame whose covered pixels are mostly below 1 % of its maximum is warned about (once, naming the
+// frame and the options that light it); the automatic lighting of the same scene gives no warning.
+TEST(RenderCli, DarkFramesAreWarnedAbout) {
+  const auto dir = test::scratch_dir("render_cli_dark");
+  const auto scene = write_test_scene(dir).string();
+  const std::string cmd = tool() + " " + scene + " --size 32x24 --frames 0-2 --outputs color --out " + (dir / "o").string();
+  std::string out;
+  ASSERT_EQ(test::run_command(cmd + " --key-light 0 --fill-light 0 --ambient 0", &out), 0) << out;
+  const std::string warning = "render-gbuffer: warning: frame 0: 100 % of the covered pixels are below 1 % of the "
+                              "frame's maximum: the render is mostly black";
+  EXPECT_NE(out.find(warning), std::string::npos) << out;
+  EXPECT_NE(out.find("--lights auto"), std::string::npos) << out;
+  EXPECT_EQ(out.find("warning", out.find(warning) + warning.size()), std::string::npos) << "warned more than once\n" << out;
+  ASSERT_EQ(test::run_command(cmd, &out), 0) << out;
+  EXPECT_EQ(out.find("warning"), std::string::npos) << out;
+}
+
 // Issue 22: the EGL path. On this machine EGL's only device is Mesa's software one (llvmpipe, as OSMesa), so
 // `--gl egl` must write exactly the files of `--gl osmesa` (every plane of the four outputs), and each header names
 // the context and renderer that made it.

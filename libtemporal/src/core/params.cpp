@@ -100,6 +100,7 @@ Status apply_args(const ParamList& params, const std::vector<std::string>& args)
     }
     if (i + 1 == args.size()) return Error::usage(p->flag + " needs a value");
     const std::string& text = args[++i];
+    if (text.empty()) return Error::usage(p->flag + " needs a value, got an empty one");
     char* end = nullptr;
     errno = 0;
     const double v = std::strtod(text.c_str(), &end);

@@ -80,6 +80,14 @@ std::string RenderOutputs::to_string() const {
   return s;
 }
 
+Expected<LightingOptions::Mode> parse_lighting_mode(const std::string& text) {
+  if (text == "scene") return LightingOptions::Mode::Scene;
+  if (text == "auto") return LightingOptions::Mode::Automatic;
+  return Error::usage("--lights '" + text + "' is not one of: scene, auto");
+}
+
+const char* to_string(LightingOptions::Mode mode) { return mode == LightingOptions::Mode::Automatic ? "auto" : "scene"; }
+
 Status parse_size(const std::string& text, RenderOptions& options) {
   int w = 0, h = 0;
   char x = 0, extra = 0;
@@ -134,6 +142,9 @@ Status validate(const RenderOptions& options) {
   if (p.vpl_count < 1 || p.vpl_count > kMaxVpls)
     return Error::usage("--vpls must be between 1 and " + std::to_string(kMaxVpls));
   if (p.rsm_size < 4 || p.rsm_size > 2048) return Error::usage("--rsm-size must be in 4..2048");
+  const LightingOptions& l = options.lighting;
+  for (auto [v, flag] : {std::pair{l.key, "--key-light"}, {l.fill, "--fill-light"}, {l.ambient, "--ambient"}})
+    if (!(v >= 0.0f && v <= 100.0f)) return Error::usage(std::string(flag) + " must be between 0 and 100");
   return {};
 }
 
@@ -141,10 +152,11 @@ RenderText::RenderText(const RenderOptions& d)
     : size(size_string(d)), payload(payload_terms_string(d.payload)), outputs(d.outputs.to_string()),
       jitter(to_string(d.color_jitter)), shade_jitter(to_string(d.shade_jitter)),
       reference_jitter(to_string(d.reference_jitter)), shade_mip_bias(shade_mip_bias_string(d)), gl(to_string(d.gl)),
-      seed(double(d.seed)) {}
+      lights(to_string(d.lighting.mode)), seed(double(d.seed)) {}
 
 ParamList render_params(RenderOptions& o, RenderText& t) {
   PayloadOptions& p = o.payload;
+  LightingOptions& l = o.lighting;
   const int most = std::numeric_limits<int>::max();
   const std::vector<std::string> jitters = {"regular", "regular-raster", "halton", "random", "none"};
   Param seed{"--seed", "Seed of random jitter, SSAO patterns and VPL sets", &t.seed, 0.0, 4294967295.0};
@@ -165,17 +177,25 @@ ParamList render_params(RenderOptions& o, RenderText& t) {
       Param::text("--outputs", "Outputs: any of gbuffer,shade,reference,color", &t.outputs),
       Param::integer("--pcf", "Shadow PCF kernel N (N x N shadow-map texels)", &p.pcf_kernel, 1, 32),
       Param::integer("--shadow-map-size", "Shadow map texels per side", &p.shadow_map_size, 16, 8192),
-      Param::real("--shadow-bias", "Shadow normal offset in shadow-map texels", &p.shadow_bias,
-                  -std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity()),
+      // Finite ranges (issue 26): the offset is bias x texel size in world units, the radius is projected to pixels
+      // and squared in the shader (float), so both stay far from overflow.
+      Param::real("--shadow-bias", "Shadow normal offset in shadow-map texels", &p.shadow_bias, -64.0, 64.0),
       Param::integer("--ssao-directions", "SSAO horizon directions", &p.ssao_directions, 1, most),
       Param::integer("--ssao-steps", "SSAO steps per direction", &p.ssao_steps, 1, most),
-      Param::real("--ssao-radius", "SSAO radius in world units; 0: 5% of the scene diagonal", &p.ssao_radius,
-                  -std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity()),
+      Param::real("--ssao-radius", "SSAO radius in world units; 0: 5% of the scene diagonal", &p.ssao_radius, 0.0, 1e6),
       Param::integer("--vpls", "Virtual point lights for gi", &p.vpl_count, 1, kMaxVpls),
       Param::integer("--rsm-size", "Reflective shadow map texels per side (VPL candidates)", &p.rsm_size, 4, 2048),
       Param::flag_off("--no-mipmaps", "Sample textures without mipmaps (severe undersampling)", &o.mipmaps),
       Param::text("--shade-mip-bias", "Texture LOD bias of the low-res payload; auto: -log2(K), the full-res mip level",
                   &t.shade_mip_bias),
+      Param::choice("--lights",
+                    "scene: the scene's lights, the automatic key/fill/ambient rig only for a scene without lights; "
+                    "auto: the rig for every scene",
+                    &t.lights, {"scene", "auto"}),
+      Param::real("--key-light", "Automatic key light: radiance a white surface facing it reflects (1: irradiance pi)",
+                  &l.key, 0.0, 100.0),
+      Param::real("--fill-light", "Automatic fill light (unshadowed, part of gi), same unit", &l.fill, 0.0, 100.0),
+      Param::real("--ambient", "Automatic ambient radiance (part of gi, times ssao)", &l.ambient, 0.0, 100.0),
       seed,
       Param::choice("--gl",
                     "OpenGL context: osmesa (llvmpipe in the process), egl (EGL device platform: a GPU, or Mesa's "
@@ -207,6 +227,9 @@ Status apply_render_text(const RenderText& t, RenderOptions& r) {
   auto gl = parse_gl_api(t.gl);
   if (!gl) return gl.error();
   r.gl = *gl;
+  auto lights = parse_lighting_mode(t.lights);
+  if (!lights) return lights.error();
+  r.lighting.mode = *lights;
   if (t.seed != std::floor(t.seed)) return Error::usage("--seed must be a whole number in [0, 4294967295]");
   r.seed = std::uint32_t(t.seed);
   return validate(r);

@@ -28,6 +28,22 @@ SceneGeometry geometry_of(const Scene& scene) {
   g.bounds_min = scene.bounds_min();
   g.bounds_max = scene.bounds_max();
   g.ambient = scene.ambient();
+  // The automatic rig's directions from the camera at t = 0 (render.h LightingOptions); the key is scene.h's
+  // automatic key light, computed the same way (scene_finish.cpp).
+  const FrameState first = scene.evaluate(0.0);
+  const glm::mat4 cam_to_world = glm::inverse(first.camera.view);
+  const glm::vec3 right(cam_to_world[0]), up(cam_to_world[1]), back(cam_to_world[2]);
+  g.key_direction = glm::normalize(-back * 1.0f - up * 1.2f + right * 0.6f);
+  g.fill_direction = glm::normalize(-back * 1.0f - up * 0.3f - right * 1.2f);
+  // Scene has no "has lights" flag: a scene without lights evaluates to exactly the automatic key light scene.h
+  // documents (one white directional light of intensity pi along that direction), which a scene's own light
+  // matches only by coincidence of every value.
+  if (first.lights.size() == 1) {
+    const LightState& l = first.lights.front();
+    g.own_lights = !(l.type == LightState::Type::Directional && l.color == glm::vec3(1.0f) &&
+                     l.intensity == 3.14159265f && l.range == 0.0f &&
+                     glm::length(l.direction - g.key_direction) < 1e-5f);
+  }
   return g;
 }
 
@@ -146,6 +162,10 @@ struct Renderer::Impl {
   GLuint empty_vao = 0, vpl_buffer = 0;
   Fbo gbuffer_full, gbuffer_low, shade_full, shade_low, shadow_map, rsm;
   float scene_diagonal = 1.0f;
+  // The automatic rig (LightingOptions) lights this scene: its key replaces the scene's lights.
+  bool rig = false;
+  std::vector<LightState> rig_lights;
+  bool dark_warned = false;  // RenderOptions::warning is called for the first dark frame only
 
   // Per frame.
   const FrameState* state = nullptr;
@@ -163,7 +183,9 @@ struct Renderer::Impl {
   const GlFunctions& gl() const { return context->gl(); }
   ~Impl();
   Status init();
-  void set_lights(GLuint program, const FrameState& state) const;
+  // The lights of this frame: the rig's key, or the scene's.
+  const std::vector<LightState>& lights() const { return rig ? rig_lights : state->lights; }
+  void set_lights(GLuint program) const;
   Status light_maps(const FrameState& state);
   void select_vpls(std::uint32_t instant, int sample);
   struct View {
@@ -178,7 +200,8 @@ struct Renderer::Impl {
   void read_rgba(const Fbo& f, int attachment, int components);
   void read_uint(const Fbo& f, int attachment);
   Image gbuffer_image(const Fbo& f, const View& v, const FrameInput& in);
-  Image shade_image(const Fbo& f, float scale);
+  // Also sets `dark` to RenderedFrame::dark_fraction of the sum it reads.
+  Image shade_image(const Fbo& f, float scale, double* dark = nullptr);
   void set_metadata(Image& image, const FrameInput& in, const View& v, glm::vec2 jitter) const;
   void timer_begin(int slot) const {
     if (timer) gl().BeginQuery(GL_TIME_ELAPSED, queries[slot]);
@@ -219,7 +242,17 @@ Status Renderer::Impl::init() {
   if (auto s = build("gbuffer", kGeometryVertex, kGbufferFragment, gbuffer_program); !s) return s;
   if (auto s = build("shadow", kGeometryVertex, kShadowFragment, shadow_program); !s) return s;
   if (auto s = build("rsm", kGeometryVertex, kRsmFragment, rsm_program); !s) return s;
-  if (auto s = build("shade", kFullscreenVertex, deferred_fragment(p.direct, p.shadow, p.ssao, p.gi, scene.ambient != glm::vec3(0.0f)), shade_program); !s)
+  rig = options.lighting.mode == LightingOptions::Mode::Automatic || !scene.own_lights;
+  if (rig) {
+    LightState key;
+    key.type = LightState::Type::Directional;
+    key.direction = scene.key_direction;
+    key.color = glm::vec3(1.0f);
+    key.intensity = 3.14159265f * options.lighting.key;
+    rig_lights = {key};
+  }
+  const bool ambient = scene.ambient != glm::vec3(0.0f) || rig;
+  if (auto s = build("shade", kFullscreenVertex, deferred_fragment(p.direct, p.shadow, p.ssao, p.gi, ambient, rig), shade_program); !s)
     return s;
   g.GenVertexArrays(1, &empty_vao);
   g.GenBuffers(1, &vpl_buffer);
@@ -267,12 +300,13 @@ Status Renderer::Impl::init() {
   return check_gl(g, "renderer setup");
 }
 
-void Renderer::Impl::set_lights(GLuint program, const FrameState& state) const {
+void Renderer::Impl::set_lights(GLuint program) const {
   const auto& g = gl();
-  const int n = std::min<int>(int(state.lights.size()), kMaxLights);
+  const std::vector<LightState>& all = lights();
+  const int n = std::min<int>(int(all.size()), kMaxLights);
   g.Uniform1i(g.GetUniformLocation(program, "u_light_count"), n);
   for (int i = 0; i < n; ++i) {
-    const LightState& l = state.lights[std::size_t(i)];
+    const LightState& l = all[std::size_t(i)];
     auto loc = [&](const char* name) {
       return g.GetUniformLocation(program, (std::string(name) + "[" + std::to_string(i) + "]").c_str());
     };
@@ -294,8 +328,8 @@ void Renderer::Impl::set_lights(GLuint program, const FrameState& state) const {
 Status Renderer::Impl::light_maps(const FrameState& state) {
   const auto& g = gl();
   const PayloadOptions& p = options.payload;
-  if (state.lights.empty()) return Error::internal("the scene evaluated without lights (scene.h promises a key light)");
-  const LightState& key = state.lights.front();
+  if (lights().empty()) return Error::internal("the scene evaluated without lights (scene.h promises a key light)");
+  const LightState& key = lights().front();
   const glm::vec3 lo = gpu->frame_min(), hi = gpu->frame_max();
   const glm::vec3 centre = 0.5f * (lo + hi);
   const float radius = std::max(0.5f * glm::length(hi - lo), 1e-3f);
@@ -362,7 +396,7 @@ Status Renderer::Impl::light_maps(const FrameState& state) {
     for (int i = 0; i < 3; ++i) g.ClearBufferfv(GL_COLOR, i, zero);
     g.ClearBufferfv(GL_DEPTH, 0, &one);
     geometry_uniforms(rsm_program);
-    set_lights(rsm_program, state);
+    set_lights(rsm_program);
     g.Uniform1f(g.GetUniformLocation(rsm_program, "u_texel_measure"), lv.rsm_measure);
     g.Uniform3f(g.GetUniformLocation(rsm_program, "u_light_axis"), lv.axis.x, lv.axis.y, lv.axis.z);
     gpu->draw_all(rsm_program, true);
@@ -485,7 +519,7 @@ void Renderer::Impl::shade(const Fbo& gb, const Fbo& target, const View& v, std:
   g.BindBufferBase(GL_UNIFORM_BUFFER, 0, vpl_buffer);
   const glm::mat4 bias = glm::translate(glm::mat4(1.0f), glm::vec3(0.5f)) * glm::scale(glm::mat4(1.0f), glm::vec3(0.5f));
   const glm::mat4 light_vp = bias * light.view_proj;
-  set_lights(prog, *state);
+  set_lights(prog);
   g.Uniform3f(g.GetUniformLocation(prog, "u_camera_pos"), v.camera_pos.x, v.camera_pos.y, v.camera_pos.z);
   g.UniformMatrix4fv(g.GetUniformLocation(prog, "u_light_vp"), 1, GL_FALSE, glm::value_ptr(light_vp));
   g.Uniform1i(g.GetUniformLocation(prog, "u_pcf"), p.pcf_kernel);
@@ -498,8 +532,17 @@ void Renderer::Impl::shade(const Fbo& gb, const Fbo& target, const View& v, std:
   g.Uniform1ui(g.GetUniformLocation(prog, "u_seed"), seed);
   const float clamp_d = p.vpl_clamp > 0 ? p.vpl_clamp : 0.02f * scene_diagonal;
   g.Uniform1f(g.GetUniformLocation(prog, "u_vpl_clamp2"), clamp_d * clamp_d);
-  if (scene.ambient != glm::vec3(0.0f))
-    g.Uniform3f(g.GetUniformLocation(prog, "u_ambient"), state->ambient.x, state->ambient.y, state->ambient.z);
+  if (scene.ambient != glm::vec3(0.0f) || rig) {
+    // The rig's ambient A is a radiance: gi adds a(1-m)/pi * u_ambient, so pi A makes a white surface reflect A.
+    const glm::vec3 a = state->ambient + glm::vec3(rig ? 3.14159265f * options.lighting.ambient : 0.0f);
+    g.Uniform3f(g.GetUniformLocation(prog, "u_ambient"), a.x, a.y, a.z);
+  }
+  if (rig) {
+    const float e = 3.14159265f * options.lighting.fill;
+    const glm::vec3 d = scene.fill_direction;
+    g.Uniform3f(g.GetUniformLocation(prog, "u_fill_irradiance"), e, e, e);
+    g.Uniform3f(g.GetUniformLocation(prog, "u_fill_direction"), d.x, d.y, d.z);
+  }
   g.BindVertexArray(empty_vao);
   g.DrawArrays(GL_TRIANGLES, 0, 3);
   g.BindVertexArray(0);
@@ -593,7 +636,7 @@ Image Renderer::Impl::gbuffer_image(const Fbo& f, const View& v, const FrameInpu
   return img;
 }
 
-Image Renderer::Impl::shade_image(const Fbo& f, float scale) {
+Image Renderer::Impl::shade_image(const Fbo& f, float scale, double* dark) {
   const PayloadOptions& p = options.payload;
   const int w = f.width, h = f.height;
   Image img(w, h);
@@ -602,6 +645,26 @@ Image Renderer::Impl::shade_image(const Fbo& f, float scale) {
   float* b = img.add_channel("B");
   read_rgba(f, 2, 4);
   scatter(readback, w, h, 4, {{0, r}, {1, gch}, {2, b}}, scale);
+  if (dark) {
+    // Covered pixels: the sum's alpha (1 per covered sample, shaders.cpp). Rec. 709 luminance of R,G,B.
+    const std::size_t n = std::size_t(w) * std::size_t(h);
+    auto luminance = [&](std::size_t i) {
+      return 0.2126f * readback[4 * i] + 0.7152f * readback[4 * i + 1] + 0.0722f * readback[4 * i + 2];
+    };
+    float most = 0.0f;
+    std::size_t covered = 0, below = 0;
+    for (std::size_t i = 0; i < n; ++i)
+      if (readback[4 * i + 3] > 0.0f) most = std::max(most, luminance(i));
+    // A maximum below 1e-20 is a black frame up to rounding (products with a zero light leave values of 1e-33):
+    // every covered pixel counts as dark.
+    const bool black = !(most >= 1e-20f);
+    for (std::size_t i = 0; i < n; ++i)
+      if (readback[4 * i + 3] > 0.0f) {
+        ++covered;
+        below += black || !(luminance(i) >= 0.01f * most);
+      }
+    *dark = covered ? double(below) / double(covered) : 0.0;
+  }
   if (p.direct || p.shadow) {
     read_rgba(f, 0, 4);
     if (p.direct)
@@ -725,7 +788,7 @@ Expected<RenderedFrame> Renderer::render(const FrameInput& in) {
     finish();
     result.timings_ms[kPassShadeLow] = ms_since(t0);
     if (im.timer) result.gpu_ms[kPassShadeLow] = im.timer_ms(0);
-    result.shade = im.shade_image(im.shade_low, 1.0f);
+    result.shade = im.shade_image(im.shade_low, 1.0f, &result.dark_fraction);
     im.set_metadata(*result.shade, in, low, jitter);
     result.shade->metadata().jitter_factor = k;
     if (o.shade_jitter == JitterMode::Regular) result.shade->metadata().jitter_index = regular_jitter_index(in.frame, k);
@@ -752,7 +815,7 @@ Expected<RenderedFrame> Renderer::render(const FrameInput& in) {
       result.gpu_ms[kPassShadeFull] = im.timer_ms(1);
       result.gpu_ms[kPassColor] = im.timer_ms(0) + im.timer_ms(1);
     }
-    Image full_payload = im.shade_image(im.shade_full, 1.0f);
+    Image full_payload = im.shade_image(im.shade_full, 1.0f, &result.dark_fraction);
     Image color(w, h);
     for (const char* c : {"R", "G", "B"}) std::copy_n(full_payload.plane(c), full_payload.pixel_count(), color.add_channel(c));
     result.color = std::move(color);
@@ -780,7 +843,9 @@ Expected<RenderedFrame> Renderer::render(const FrameInput& in) {
     finish();
     result.timings_ms[kPassReference] = ms_since(t0);
     if (im.timer) result.gpu_ms[kPassReference] = im.timer_ms(0);
-    result.reference = im.shade_image(im.shade_full, 1.0f / float(o.reference_spp));
+    double dark = -1.0;
+    result.reference = im.shade_image(im.shade_full, 1.0f / float(o.reference_spp), &dark);
+    if (!out.color) result.dark_fraction = dark;  // the colour image's count wins
     im.set_metadata(*result.reference, in, full, {0.0f, 0.0f});
     result.reference->metadata().compute_ms = result.timings_ms[kPassReference];
   }
@@ -788,6 +853,14 @@ Expected<RenderedFrame> Renderer::render(const FrameInput& in) {
   for (Image* img : {result.gbuffer ? &*result.gbuffer : nullptr, result.shade ? &*result.shade : nullptr,
                      result.color ? &*result.color : nullptr, result.reference ? &*result.reference : nullptr})
     if (img) img->metadata().timings_ms = result.timings_ms;
+  if (result.dark_fraction > 0.5 && !im.dark_warned && o.warning) {
+    im.dark_warned = true;
+    const int percent = int(std::lround(100.0 * result.dark_fraction));
+    o.warning("frame " + std::to_string(in.frame) + ": " + std::to_string(percent) +
+              " % of the covered pixels are below 1 % of the frame's maximum: the render is mostly black and flatters "
+              "every metric (raise --key-light, --fill-light or --ambient, or --lights auto; later dark frames are "
+              "not reported)");
+  }
   return result;
 }
 

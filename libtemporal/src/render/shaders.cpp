@@ -187,6 +187,8 @@ uniform uint u_seed;           // changes every frame (and every reference sampl
 uniform int u_vpl_count;
 uniform float u_vpl_clamp2;    // minimum squared VPL distance
 uniform vec3 u_ambient;        // radiance of the environment (AMBIENT only)
+uniform vec3 u_fill_irradiance;  // the automatic fill light (FILL only): irradiance facing it
+uniform vec3 u_fill_direction;   // the direction it travels (unit)
 const float PI = 3.14159265358979;
 
 uint pcg(uint v) {
@@ -306,22 +308,29 @@ void main() {
   // A uniform environment (USD DomeLight) of radiance L: a Lambertian surface reflects diffuse * L (docs/usd.md).
   gi += diffuse * u_ambient;
 #endif
+#ifdef FILL
+  // The automatic rig's fill light (render.h LightingOptions): unshadowed Lambert, E (n.l)+ of irradiance E.
+  gi += diffuse * u_fill_irradiance * max(dot(n, -u_fill_direction), 0.0);
+#endif
 #endif
   o_direct = vec4(direct, shadow);
   o_gi = vec4(gi, ao);
+  // The sum's alpha is 1 on covered pixels (0 on the background): the coverage the dark-frame check counts. It is
+  // never written to a file.
 #if defined(TERM_DIRECT) || defined(TERM_GI)
-  o_sum = vec4(direct * shadow + gi * ao, 0.0);
+  o_sum = vec4(direct * shadow + gi * ao, 1.0);
 #else
   // Neither radiance term: the sum is the visibility terms themselves, as grey, so that R,G,B is never an
   // all-zero image that every method reproduces "perfectly" (docs/render-gbuffer.md, Outputs).
-  o_sum = vec4(vec3(shadow * ao), 0.0);
+  o_sum = vec4(vec3(shadow * ao), 1.0);
 #endif
 }
 )GLSL";
 
-std::string deferred_fragment(bool direct, bool shadow, bool ssao, bool gi, bool ambient) {
+std::string deferred_fragment(bool direct, bool shadow, bool ssao, bool gi, bool ambient, bool fill) {
   std::string s = "#version 450 core\n";
   if (ambient) s += "#define AMBIENT 1\n";
+  if (fill) s += "#define FILL 1\n";
   if (direct) s += "#define TERM_DIRECT 1\n";
   if (shadow) s += "#define TERM_SHADOW 1\n";
   if (ssao) s += "#define TERM_SSAO 1\n";

@@ -17,8 +17,9 @@ extern const char* const kRsmFragment;
 extern const char* const kFullscreenVertex;
 // Deferred payload shading; `defines` switches terms on (TERM_DIRECT, TERM_SHADOW, TERM_SSAO, TERM_GI) and the
 // ambient of a uniform environment into gi (AMBIENT: only compiled for scenes that have one, so that other
-// scenes run exactly the shader they always ran).
-std::string deferred_fragment(bool direct, bool shadow, bool ssao, bool gi, bool ambient);
+// scenes run exactly the shader they always ran) and the automatic rig's fill light into gi (FILL: only for scenes
+// lit by the rig, render.h LightingOptions).
+std::string deferred_fragment(bool direct, bool shadow, bool ssao, bool gi, bool ambient, bool fill);
 
 inline constexpr int kMaxLights = 8;
 // VPLs live in a uniform block of two vec4 each: 64 KiB / 32 bytes, rounded down.

@@ -20,7 +20,8 @@
 //   ssao.Y        horizon-based ambient occlusion (Bavoil & Sainz 2008), D directions x S steps, pattern
 //                 re-randomised every frame
 //   gi.R/G/B      one-bounce indirect radiance from V virtual point lights drawn from a reflective shadow
-//                 map of the key light (Dachsbacher & Stamminger 2005), no visibility (instant GI)
+//                 map of the key light (Dachsbacher & Stamminger 2005), no visibility (instant GI); plus a
+//                 DomeLight's ambient, and the fill and ambient of the automatic rig (LightingOptions)
 //   R,G,B         sum = direct * shadow + gi * ssao (a term that is off counts as 0 for direct/gi and 1
 //                 for shadow/ssao)
 // Background pixels: direct = gi = sum = 0, shadow = ssao = 1.
@@ -41,6 +42,7 @@
 #include <glm/vec3.hpp>
 
 #include <cstdint>
+#include <functional>
 #include <map>
 #include <memory>
 #include <optional>
@@ -113,6 +115,31 @@ struct GlDevice {
 // device extensions are missing; an empty list when there is no device.
 Expected<std::vector<GlDevice>> list_gl_devices();
 
+// The automatic lighting (docs/render-gbuffer.md, "Lighting"): a rig of a key, a fill and an ambient term placed
+// relative to the camera at t = 0, for scenes without lights of their own (or every scene with Mode::Automatic).
+// Each value is the radiance a white Lambertian surface reflects when it faces the light (so 1 = irradiance pi):
+//   key      directional, travelling along -back - 1.2 up + 0.6 right of the camera (from above, behind the
+//            camera's left shoulder: most visible surfaces face it); light 0: it casts the shadow and feeds the
+//            RSM, so the gi bounce scales with it.
+//   fill     directional, travelling along -back - 0.3 up - 1.2 right (from the camera's right, near eye level:
+//            the sides the key leaves unlit); unshadowed, Lambert only; key:fill = 2.5:1, a classic three-point ratio.
+//   ambient  a uniform environment of that radiance (every side, so surfaces that face away from both lights are
+//            not black).
+// Fill and ambient stand for the light an environment would bounce: they are part of the indirect term
+// (gi.R/G/B, multiplied by ssao like a USD DomeLight), so R,G,B = direct * shadow + gi * ssao still holds, and a
+// payload without gi has neither.
+struct LightingOptions {
+  enum class Mode {
+    Scene,      // the scene's lights (and DomeLight); the rig only for a scene without lights
+    Automatic,  // the rig always, in place of the scene's lights (a DomeLight's ambient is kept)
+  } mode = Mode::Scene;
+  float key = 1.0f;
+  float fill = 0.4f;
+  float ambient = 0.15f;
+};
+Expected<LightingOptions::Mode> parse_lighting_mode(const std::string& text);  // "scene", "auto"
+const char* to_string(LightingOptions::Mode mode);
+
 struct RenderOptions {
   int width = 1280, height = 1024;     // full resolution, pixels
   int factor = 4;                      // shade is width/factor x height/factor (must divide both)
@@ -138,6 +165,10 @@ struct RenderOptions {
   bool gpu_timer = false;
   PayloadOptions payload;
   RenderOutputs outputs;
+  LightingOptions lighting;
+  // Called (the library never prints) for the first frame whose colour (else reference, else shade) image has more
+  // than half of its covered pixels below 1 % of the image's maximum luminance: a render too dark to measure.
+  std::function<void(const std::string&)> warning;
 };
 
 // Checks sizes, factor and payload settings without touching OpenGL (Usage errors naming the option).
@@ -148,7 +179,7 @@ Status validate(const RenderOptions& options);
 // terms, an enum) bind to a RenderText, which starts from the options' defaults and which apply_render_text() parses.
 struct RenderText {
   explicit RenderText(const RenderOptions& defaults);
-  std::string size, payload, outputs, jitter, shade_jitter, reference_jitter, shade_mip_bias, gl;
+  std::string size, payload, outputs, jitter, shade_jitter, reference_jitter, shade_mip_bias, gl, lights;
   double seed = 0.0;  // a uint32 (Param has no unsigned type; a double holds every uint32 exactly)
 };
 ParamList render_params(RenderOptions& options, RenderText& text);
@@ -169,6 +200,11 @@ struct SceneGeometry {
   glm::vec3 bounds_min{-1.0f}, bounds_max{1.0f};  // world-space bounds (SSAO radius, VPL clamp defaults)
   glm::vec3 ambient{0.0f};  // non-zero: the scene has a uniform environment (USD DomeLight), added to gi as
                             // albedo (1 - metallic) * FrameState::ambient
+  // False: the scene has no lights of its own (FrameState::lights holds only scene.h's automatic key light), so the
+  // renderer lights it with the automatic rig (LightingOptions). Hand-built geometries keep their lights.
+  bool own_lights = true;
+  // World-space directions the automatic key and fill travel, from the camera at t = 0 (LightingOptions).
+  glm::vec3 key_direction{0.0f, -1.0f, 0.0f}, fill_direction{0.0f, -1.0f, 0.0f};
 };
 
 // The geometry of a loaded scene (it must outlive the renderer).
@@ -186,6 +222,9 @@ struct RenderedFrame {
   std::optional<Image> gbuffer, shade, reference, color;
   std::map<std::string, double> timings_ms;  // pass name -> ms (only the passes that ran), wall clock
   std::map<std::string, double> gpu_ms;      // pass name -> device ms (GL_TIME_ELAPSED); empty without a timer
+  // Of the covered (non-background) pixels of the colour image (else reference, else shade), the fraction whose
+  // luminance is below 1 % of the image's maximum (all of them when the maximum is 0); -1 without a payload image.
+  double dark_fraction = -1.0;
 };
 
 class Renderer {
