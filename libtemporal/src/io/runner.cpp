@@ -124,7 +124,8 @@ class InputWindow {
                                                  : std::min(frame + needs_.lookahead, plan_.frames.back());
     for (; next <= last; ++next) {
       const std::string path = plan_.input.path(next);
-      if (next != frame && !std::filesystem::exists(path)) break;
+      std::error_code ec;  // a lookahead frame that cannot be examined (a link loop) is read below and reported
+      if (next != frame && !std::filesystem::exists(path, ec) && !ec) break;
       auto img = read_exr(path, ExrSelection{needs_.input_layers});
       if (!img) {
         Error e = img.error();
