@@ -253,6 +253,51 @@ TEST(Robustness, TheRunnerNeverWritesOverItsInputs) {
   EXPECT_FALSE(fs::exists(dir / "out.0.png"));
 }
 
+// Issue 26 item 10: an input that cannot be examined (a symbolic link loop as a colour or G-buffer frame, in a
+// range, as a single file, or read directly) is an Input error naming it, never a std::filesystem exception (which
+// the tools report as an internal error, exit 5).
+TEST(Robustness, InputsThatCannotBeExaminedAreInputErrors) {
+  const auto dir = test::scratch_dir("robust-link-loop");
+  for (int f = 0; f < 3; ++f)
+    ASSERT_TRUE(write_exr((dir / ("c." + std::to_string(f) + ".exr")).string(), frame(8, 8, float(f))));
+  ASSERT_TRUE(write_exr((dir / "g.0.exr").string(), frame(8, 8, 0.0f)));
+  fs::create_symlink("g.1.exr", dir / "g.1.exr");  // a link to itself: ELOOP
+  ASSERT_TRUE(write_exr((dir / "g.2.exr").string(), frame(8, 8, 0.0f)));
+  auto loop_error = [&](const Error& e, const std::string& file) {
+    EXPECT_EQ(e.kind, ErrorKind::Input) << e.message;
+    EXPECT_NE(e.file.find(file), std::string::npos) << e.file;
+    EXPECT_NE(e.message.find("cannot be examined"), std::string::npos) << e.message;
+  };
+  auto pattern = SequencePattern::parse((dir / "g.%d.exr").string());
+  ASSERT_TRUE(pattern);
+  auto frames = resolve_frames(*pattern, FrameRange{0, 2});
+  ASSERT_FALSE(frames);
+  loop_error(frames.error(), "g.1.exr");
+  auto single = SequencePattern::parse((dir / "g.1.exr").string());
+  ASSERT_TRUE(single);
+  auto one = resolve_frames(*single, std::nullopt);
+  ASSERT_FALSE(one);
+  loop_error(one.error(), "g.1.exr");
+  auto read = read_exr((dir / "g.1.exr").string());
+  ASSERT_FALSE(read);
+  loop_error(read.error(), "g.1.exr");
+  // Through the runner, the input's frame 1 being the loop: with --frames it is found before any work, without
+  // (frames found on disk) when frame 1 is read.
+  CopyStage stage;
+  SequenceOptions o;
+  o.input = pattern->pattern();
+  o.out = (dir / "o.%d.exr").string();
+  o.frames = "0-2";
+  auto r = run_sequence(o, stage, {"test", ""});
+  ASSERT_FALSE(r);
+  loop_error(r.error(), "g.1.exr");
+  EXPECT_FALSE(fs::exists(dir / "o.0.exr"));
+  o.frames.clear();
+  r = run_sequence(o, stage, {"test", ""});
+  ASSERT_FALSE(r);
+  loop_error(r.error(), "g.1.exr");
+}
+
 TEST(Robustness, AFrameOfAnotherSizeStopsTheRun) {
   const auto dir = test::scratch_dir("robust-size");
   ASSERT_TRUE(write_exr((dir / "c.0.exr").string(), frame(8, 8, 0.0f)));

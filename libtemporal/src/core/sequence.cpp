@@ -162,18 +162,28 @@ std::vector<int> SequencePattern::frames_on_disk() const {
   return frames;
 }
 
+Expected<bool> input_exists(const std::string& path) {
+  std::error_code ec;
+  const bool found = std::filesystem::exists(path, ec);
+  if (ec) return Error::input(path, "cannot be examined: " + ec.message());
+  return found;
+}
+
 Expected<std::vector<int>> resolve_frames(const SequencePattern& pattern, const std::optional<FrameRange>& range) {
-  namespace fs = std::filesystem;
   std::vector<int> frames;
   if (!pattern.has_placeholder()) {
-    if (!fs::exists(pattern.pattern()))
+    auto found = input_exists(pattern.pattern());
+    if (!found) return found.error();
+    if (!*found)
       return Error::input(pattern.pattern(), "no such file (for a sequence, put #### or %04d where the frame number goes)");
     if (range) return range->frames();
     return std::vector<int>{0};
   }
   if (range) {
     for (int f : range->frames()) {
-      if (!fs::exists(pattern.path(f)))
+      auto found = input_exists(pattern.path(f));
+      if (!found) return found.error();
+      if (!*found)
         return Error::input(pattern.path(f), "missing: frame " + std::to_string(f) + " of --frames " +
                                                  std::to_string(range->first) + "-" + std::to_string(range->last) +
                                                  " does not exist; render it or narrow --frames");

@@ -260,7 +260,7 @@ Status check_exr_attributes(const std::string& path, std::FILE* f, std::uint64_t
 Status check_exr_structure(const std::string& path) {
   std::error_code ec;
   if (fs::is_directory(path, ec)) return Error::input(path, "is a folder, not an OpenEXR file");
-  if (!fs::exists(path, ec)) return Error::input(path, "no such file");
+  if (!fs::exists(path, ec)) return Error::input(path, ec ? "cannot be examined: " + ec.message() : "no such file");
   const auto size = fs::file_size(path, ec);
   unsigned char magic[8] = {};
   std::size_t got = 0;

@@ -78,10 +78,13 @@ Expected<Plan> make_plan(const SequenceOptions& o, const StageInputs& needs) {
     auto g = SequencePattern::parse(o.gbuffer);
     if (!g) return g.error();
     // Every G-buffer file of the range must exist before any work is done.
-    for (int f : plan.frames)
-      if (!std::filesystem::exists(g->path(f)))
+    for (int f : plan.frames) {
+      auto found = input_exists(g->path(f));
+      if (!found) return found.error();
+      if (!*found)
         return Error::input(g->path(f), "missing: the G-buffer of frame " + std::to_string(f) + " (--gbuffer) does not "
                                         "exist; render it or narrow --frames");
+    }
     plan.gbuffer = *g;
   }
   if (!o.state_out.empty()) {
@@ -127,7 +130,8 @@ class InputWindow {
                                                  : std::min(frame + needs_.lookahead, plan_.frames.back());
     for (; next <= last; ++next) {
       const std::string path = plan_.input.path(next);
-      if (next != frame && !std::filesystem::exists(path)) break;
+      std::error_code ec;  // a lookahead frame that cannot be examined (a link loop) is read below and reported
+      if (next != frame && !std::filesystem::exists(path, ec) && !ec) break;
       auto img = read_exr(path, ExrSelection{needs_.input_layers});
       if (!img) {
         Error e = img.error();

@@ -130,7 +130,8 @@ Status validate(const RenderOptions& options) {
   if (options.factor < 1 || options.width % options.factor != 0 || options.height % options.factor != 0)
     return Error::usage("--factor " + std::to_string(options.factor) + " must divide the width and height (" +
                         std::to_string(options.width) + "x" + std::to_string(options.height) + ")");
-  if (options.reference_spp < 1) return Error::usage("--reference-spp must be at least 1");
+  if (options.reference_spp < 1 || options.reference_spp > kMaxReferenceSpp)
+    return Error::usage("--reference-spp must be between 1 and " + std::to_string(kMaxReferenceSpp));
   if (options.reference_jitter != JitterMode::Halton && options.reference_jitter != JitterMode::None)
     return Error::usage(std::string("--reference-jitter ") + to_string(options.reference_jitter) +
                         " is not a reference pattern: use halton (supersampled) or none (pixel centres, noise averaged)");
@@ -169,7 +170,8 @@ ParamList render_params(RenderOptions& o, RenderText& t) {
                     "Shade jitter: regular (k x k pattern, dispersed order), regular-raster (raster order), halton, "
                     "random, none",
                     &t.shade_jitter, jitters),
-      Param::integer("--reference-spp", "Reference samples per pixel", &o.reference_spp, 1, most),
+      Param::integer("--reference-spp", "Reference samples per pixel (the reference costs about spp renders a frame)",
+                     &o.reference_spp, 1, kMaxReferenceSpp),
       Param::choice("--reference-jitter",
                     "Reference sample positions: halton (supersampled) | none (pixel centres: the colour with its "
                     "SSAO/VPL noise averaged)",

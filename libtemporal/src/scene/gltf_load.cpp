@@ -9,8 +9,12 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <cstdio>
+#include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <set>
+#include <string_view>
 
 namespace temporal::scene_detail {
 
@@ -45,6 +49,77 @@ std::string one_line(std::string s) {
   return s;
 }
 
+// JSON nesting deeper than this is refused before tinygltf parses it: its JSON-to-Value conversion recurses once
+// per level, so 20 000 nested arrays in `extras` overflowed the stack (issue 26). Real glTF files nest a few
+// levels (extras included); 256 leaves room for any exporter's metadata.
+constexpr int kMaxJsonDepth = 256;
+
+// The deepest nesting of [ and { in `json` (outside strings), counting up to kMaxJsonDepth + 1; the byte offset
+// where the limit was passed in `where`.
+int json_depth(std::string_view json, std::size_t* where) {
+  int depth = 0, deepest = 0;
+  bool in_string = false, escaped = false;
+  for (std::size_t i = 0; i < json.size(); ++i) {
+    const char c = json[i];
+    if (in_string) {
+      if (escaped) escaped = false;
+      else if (c == '\\') escaped = true;
+      else if (c == '"') in_string = false;
+      continue;
+    }
+    if (c == '"') {
+      in_string = true;
+    } else if (c == '[' || c == '{') {
+      deepest = std::max(deepest, ++depth);
+      if (depth > kMaxJsonDepth) {
+        *where = i;
+        return depth;
+      }
+    } else if (c == ']' || c == '}') {
+      --depth;
+    }
+  }
+  return deepest;
+}
+
+// The JSON text of a .gltf file, or the JSON chunk of a .glb (empty when the file cannot be read: tinygltf says why).
+std::string json_text(const std::string& path, bool binary) {
+  std::ifstream in(path, std::ios::binary);
+  if (!binary) return std::string(std::istreambuf_iterator<char>(in), {});
+  unsigned char header[20] = {};
+  in.read(reinterpret_cast<char*>(header), sizeof header);
+  if (in.gcount() != sizeof header) return {};
+  const std::uint32_t length = std::uint32_t(header[12]) | std::uint32_t(header[13]) << 8 |
+                               std::uint32_t(header[14]) << 16 | std::uint32_t(header[15]) << 24;
+  std::string json(std::min<std::uint32_t>(length, 1u << 30), '\0');
+  in.read(json.data(), static_cast<std::streamsize>(json.size()));
+  json.resize(static_cast<std::size_t>(std::max<std::streamsize>(in.gcount(), 0)));
+  return json;
+}
+
+// A file a relative glTF uri names (percent-decoded, as tinygltf opens it); empty for data: URIs.
+std::string uri_file(const std::string& gltf, const std::string& uri) {
+  if (uri.empty() || uri.rfind("data:", 0) == 0) return {};
+  std::string decoded;
+  for (std::size_t i = 0; i < uri.size(); ++i) {
+    if (uri[i] == '%' && i + 2 < uri.size() && std::isxdigit(static_cast<unsigned char>(uri[i + 1])) &&
+        std::isxdigit(static_cast<unsigned char>(uri[i + 2]))) {
+      decoded += static_cast<char>(std::stoi(uri.substr(i + 1, 2), nullptr, 16));
+      i += 2;
+    } else {
+      decoded += uri[i];
+    }
+  }
+  return (std::filesystem::path(gltf).parent_path() / decoded).string();
+}
+
+// A rotation quaternion must have a length to normalise: (0, 0, 0, 0) would silently become the identity
+// (glm's normalize). Lengths of at least kMinRotationLength normalise exactly in float too.
+bool usable_rotation(double x, double y, double z, double w) {
+  const double len = std::sqrt(x * x + y * y + z * z + w * w);
+  return std::isfinite(len) && len >= kMinRotationLength;
+}
+
 
 }  // namespace
 
@@ -71,14 +146,27 @@ Status Loader::load_node(std::size_t i) {
     if (Status s = check(node_light[i], model.lights.size(), "light"); !s) return s;
     if (node_light[i] < 0) return Error::input(file, "node " + quoted_or_index(src.name, i) + " names light -1");
   }
+  // A transform that is not finite in float puts NaN into every matrix below it (docs/render-gbuffer.md: exit 2).
+  auto finite = [](const std::vector<double>& v) {
+    return std::all_of(v.begin(), v.end(), [](double x) { return std::isfinite(static_cast<float>(x)); });
+  };
+  if (!finite(src.matrix) || !finite(src.translation) || !finite(src.rotation) || !finite(src.scale)) {
+    return Error::input(file, "node " + quoted_or_index(src.name, i) +
+                                  " has a matrix, translation, rotation or scale that is not finite");
+  }
   if (src.matrix.size() == 16) {
     n.matrix = glm::make_mat4(src.matrix.data());
     n.use_matrix = true;
   } else {
     if (src.translation.size() == 3) n.translation = glm::vec3(src.translation[0], src.translation[1], src.translation[2]);
     if (src.rotation.size() == 4) {
-      n.rotation = glm::normalize(glm::quat(static_cast<float>(src.rotation[3]), static_cast<float>(src.rotation[0]),
-                                            static_cast<float>(src.rotation[1]), static_cast<float>(src.rotation[2])));
+      const auto& q = src.rotation;
+      if (!usable_rotation(q[0], q[1], q[2], q[3])) {
+        return Error::input(file, "node " + quoted_or_index(src.name, i) +
+                                      " has a rotation quaternion of length 0 (it must be a unit quaternion, x y z w)");
+      }
+      n.rotation = glm::normalize(glm::quat(static_cast<float>(q[3]), static_cast<float>(q[0]),
+                                            static_cast<float>(q[1]), static_cast<float>(q[2])));
     }
     if (src.scale.size() == 3) n.scale = glm::vec3(src.scale[0], src.scale[1], src.scale[2]);
   }
@@ -321,6 +409,17 @@ Status Loader::load_channel(std::size_t ai, std::size_t ci, std::map<int, int>& 
   if (!std::all_of(s.values.begin(), s.values.end(), [](float x) { return std::isfinite(x); })) {
     return Error::input(file, "output of " + what + " holds NaN or infinite values");
   }
+  if (channel.path == TargetPath::Rotation) {
+    // Keyframe values (for CUBICSPLINE the middle of each in-tangent, value, out-tangent triple; tangents may be 0).
+    const std::size_t stride = s.interpolation == Interpolation::CubicSpline ? 12 : 4;
+    const std::size_t first = s.interpolation == Interpolation::CubicSpline ? 4 : 0;
+    for (std::size_t k = first; k + 4 <= s.values.size(); k += stride) {
+      if (!usable_rotation(s.values[k], s.values[k + 1], s.values[k + 2], s.values[k + 3])) {
+        return Error::input(file, "output of " + what + " (accessor " + std::to_string(src.output) +
+                                      ") holds a rotation quaternion of length 0 at key " + std::to_string(k / stride));
+      }
+    }
+  }
   out.clip_duration = std::max(out.clip_duration, static_cast<double>(s.times.back()));
   channel.sampler = static_cast<int>(out.samplers.size());
   sampler_map[ch.sampler] = channel.sampler;
@@ -374,8 +473,16 @@ Status Loader::load_cameras_and_lights() {
       def.aspect = static_cast<float>(c.perspective.aspectRatio);
       def.znear = static_cast<float>(c.perspective.znear);
       def.zfar = static_cast<float>(c.perspective.zfar);
-      if (!(def.yfov > 0.0f && def.yfov < 3.14f) || !(def.znear > 0.0f) || (def.zfar != 0.0f && !(def.zfar > def.znear))) {
-        return Error::input(file, "camera " + quoted_or_index(c.name, i) + " has an invalid yfov, znear or zfar");
+      // yfov below kMinCameraYfov makes 1 / tan(yfov / 2) overflow float: a worldToNDC of NaN, blank frames.
+      if (!(def.yfov >= kMinCameraYfov && def.yfov < 3.14f) || !(def.znear > 0.0f) || !std::isfinite(def.zfar) ||
+          (def.zfar != 0.0f && !(def.zfar > def.znear))) {
+        char yfov[32];
+        std::snprintf(yfov, sizeof yfov, "%g", c.perspective.yfov);
+        return Error::input(file, "camera " + quoted_or_index(c.name, i) + " has an invalid yfov (" + yfov +
+                                      "; it must lie in [1e-4, 3.14) radians), znear or zfar");
+      }
+      if (def.aspect != 0.0f && !(def.aspect >= 1e-4f && def.aspect <= 1e4f)) {
+        return Error::input(file, "camera " + quoted_or_index(c.name, i) + " has an aspectRatio outside [1e-4, 1e4]");
       }
     }
     out.cameras.push_back(def);
@@ -414,6 +521,13 @@ Status read_gltf(const std::string& path, const SceneLoadOptions& options, Scene
     in.read(magic, 4);
     binary = in.gcount() == 4 && std::string(magic, 4) == "glTF";
   }
+  {
+    std::size_t where = 0;
+    if (json_depth(json_text(path, binary), &where) > kMaxJsonDepth) {
+      return Error::input(path, "its JSON nests arrays and objects more than " + std::to_string(kMaxJsonDepth) +
+                                    " deep (at byte " + std::to_string(where) + "): refused before parsing");
+    }
+  }
   tinygltf::TinyGLTF gltf;
   tinygltf::Model model;
   std::string err, warn;
@@ -436,6 +550,12 @@ Status read_gltf(const std::string& path, const SceneLoadOptions& options, Scene
   }
   out.file = path;
   out.format = "glTF 2.0";
+  // Every file the load read (render-gbuffer protects them from its outputs): the scene, its buffers and images.
+  out.inputs.push_back(path);
+  for (const tinygltf::Buffer& b : model.buffers)
+    if (std::string f = uri_file(path, b.uri); !f.empty()) out.inputs.push_back(f);
+  for (const tinygltf::Image& im : model.images)
+    if (std::string f = uri_file(path, im.uri); !f.empty()) out.inputs.push_back(f);
   if (!warn.empty()) out.warnings.push_back(one_line(warn));
   Loader ld{model, path, out, {}, {}, {}, {}, {}, {}, {}, {}, {}, -1};
   if (Status s = ld.load_nodes_and_order(); !s) return s;

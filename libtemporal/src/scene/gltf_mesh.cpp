@@ -264,7 +264,13 @@ Status Loader::load_primitive(const tinygltf::Primitive& prim, const std::string
   }
   sp.positions = to_vec3(f);
   bool has = false;
+  // Not-finite normals and texture coordinates are refused here, naming the accessor: normalising would hide
+  // NaN normals, and coordinates past kMaxTexcoord overflow the texture lookup into NaN pixels.
+  auto accessor_of = [&](const std::string& name) { return std::to_string(prim.attributes.at(name)); };
+  auto all_finite = [&] { return std::all_of(f.begin(), f.end(), [](float x) { return std::isfinite(x); }); };
   if (Status s = read_attribute(model, prim.attributes, "NORMAL", 3, n, file, what, f, &has); !s) return s;
+  if (has && !all_finite())
+    return Error::input(file, "NORMAL of " + what + " (accessor " + accessor_of("NORMAL") + ") holds NaN or infinite values");
   if (has) sp.normals = to_vec3(f);
   // The texture coordinate set the base colour texture reads (TEXCOORD_0 unless the material says otherwise).
   int set = 0;
@@ -277,6 +283,10 @@ Status Loader::load_primitive(const tinygltf::Primitive& prim, const std::string
       const glm::mat3& t = uv_transform[static_cast<std::size_t>(prim.material)];
       for (auto& uv : sp.texcoords) uv = glm::vec2(t * glm::vec3(uv, 1.0f));
     }
+    const std::string name = "TEXCOORD_" + std::to_string(set);
+    if (!std::all_of(sp.texcoords.begin(), sp.texcoords.end(), texcoord_in_range))
+      return Error::input(file, name + " of " + what + " (accessor " + accessor_of(name) + ") holds NaN, infinite or "
+                                    "huge values (beyond +-1e6, after KHR_texture_transform)");
   }
   if (Status s = triangle_list(model, prim, mode, n, file, what, out.warnings, sp.indices); !s) return s;
   if (sp.indices.empty()) {

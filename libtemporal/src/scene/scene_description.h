@@ -14,11 +14,21 @@
 #include <glm/mat4x4.hpp>
 
 #include <array>
+#include <cmath>
 #include <cstdint>
 #include <string>
 #include <vector>
 
 namespace temporal::scene_detail {
+
+// Rotation quaternions shorter than this (in double) are refused on load: a zero quaternion has no rotation to
+// normalise to (docs/scenes.md).
+inline constexpr double kMinRotationLength = 1e-6;
+
+// Texture coordinates beyond +-kMaxTexcoord are refused on load: 3e38 is finite but overflows the texture
+// lookup (coordinate x texture size) into NaN pixels, and past 1e6 float has no sub-texel precision anyway.
+inline constexpr float kMaxTexcoord = 1e6f;
+inline bool texcoord_in_range(const glm::vec2& uv) { return std::abs(uv.x) <= kMaxTexcoord && std::abs(uv.y) <= kMaxTexcoord; }
 
 enum class TargetPath { Translation, Rotation, Scale, Weights };
 enum class Interpolation { Step, Linear, CubicSpline };
@@ -137,6 +147,7 @@ struct LightDef {
 // camera instances and lights appear in that order, which fixes the instance order of every evaluation.
 struct SceneDescription {
   std::string file;
+  std::vector<std::string> inputs;  // every file the reader read: the scene, buffers, images, layers, textures
   std::string format;  // "glTF 2.0" or "USD"
   std::vector<ScenePrimitive> primitives;
   std::vector<SceneMaterial> materials;

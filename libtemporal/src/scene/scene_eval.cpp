@@ -37,6 +37,8 @@ std::vector<std::string> Scene::camera_names() const {
 }
 
 const std::vector<std::string>& Scene::warnings() const { return impl_->warnings; }
+const std::vector<std::string>& Scene::input_files() const { return impl_->inputs; }
+const std::string& Scene::file() const { return impl_->file; }
 
 FrameRange Scene::default_frames(double fps, double duration_s) const {
   double seconds = duration_s;

@@ -67,10 +67,10 @@ Status Scene::finish(const SceneLoadOptions& options) {
   for (std::size_t i = 0; i < impl.primitives.size(); ++i) {
     const ScenePrimitive& p = impl.primitives[i];
     auto finite3 = [](const glm::vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); };
-    auto finite2 = [](const glm::vec2& v) { return std::isfinite(v.x) && std::isfinite(v.y); };
+    auto finite2 = [](const glm::vec2& v) { return scene_detail::texcoord_in_range(v); };  // false for NaN, inf
     const char* bad = !std::all_of(p.positions.begin(), p.positions.end(), finite3)   ? "positions"
                       : !std::all_of(p.normals.begin(), p.normals.end(), finite3)     ? "normals"
-                      : !std::all_of(p.texcoords.begin(), p.texcoords.end(), finite2) ? "texture coordinates"
+                      : !std::all_of(p.texcoords.begin(), p.texcoords.end(), finite2) ? "texture coordinates (or beyond +-1e6)"
                                                                                       : nullptr;
     if (bad)
       return Error::input(path, "primitive " + std::to_string(i) + " has " + bad + " that hold NaN or infinite values: "

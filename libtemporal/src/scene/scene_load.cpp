@@ -54,7 +54,10 @@ Expected<Scene> Scene::load(const std::string& path, const SceneLoadOptions& opt
 Expected<Scene> Scene::load_checked(const std::string& path, const SceneLoadOptions& options) {
   std::error_code ec;
   if (!std::filesystem::is_regular_file(path, ec)) {
-    return Error::input(path, "no such file (give a .gltf, .glb or text .usda/.usd scene)");
+    // A path that cannot be examined (a symbolic link loop, no permission) says why.
+    return Error::input(path, ec && ec != std::errc::no_such_file_or_directory
+                                  ? "cannot be examined: " + ec.message()
+                                  : "no such file (give a .gltf, .glb or text .usda/.usd scene)");
   }
   if (options.camera.path != CameraOptions::Path::Fixed && !(options.camera.path_period_s > 0.0)) {
     return Error::usage("the camera path period must be positive (--camera-period)");

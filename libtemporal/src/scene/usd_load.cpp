@@ -197,6 +197,21 @@ Expected<int> Converter::transform_node(const Prim& prim, int parent_node, bool 
     else for (int c = 0; c < n; ++c) op.value[std::size_t(c)] = static_cast<float>(v->numbers[std::size_t(c)]);
     auto s = sampler(prim, name, n, Interpolation::Linear, op.kind == Kind::Orient ? quat_to_xyzw : nullptr);
     if (!s) return s.error();
+    if (op.kind == Kind::Orient) {
+      // A zero quaternion has no rotation (glm would silently normalise it to the identity): refused.
+      auto usable = [](double x, double y, double z, double w) {
+        const double len = std::sqrt(x * x + y * y + z * z + w * w);
+        return std::isfinite(len) && len >= scene_detail::kMinRotationLength;
+      };
+      bool ok = usable(v->numbers[0], v->numbers[1], v->numbers[2], v->numbers[3]);
+      if (*s >= 0) {
+        const std::vector<float>& q = out.samplers[std::size_t(*s)].values;
+        for (std::size_t j = 0; ok && j + 4 <= q.size(); j += 4) ok = usable(q[j], q[j + 1], q[j + 2], q[j + 3]);
+      }
+      if (!ok)
+        return Error::input(where(prim), "'" + name + "' of prim " + prim.path +
+                                             " is a quaternion of length 0 (or not finite): it has no rotation");
+    }
     op.sampler = *s;
     ops.push_back(op);
     names.push_back(name);
@@ -300,6 +315,9 @@ Status Converter::camera(const Prim& p, int node) {
   def.focal_length = static_cast<float>(focal);
   def.vertical_aperture = static_cast<float>(aperture);
   def.yfov = static_cast<float>(2.0 * std::atan(0.5 * aperture / focal));
+  if (!(def.yfov >= kMinCameraYfov) || !std::isfinite(clipping[1]) || !(float(clipping[0]) > 0.0f))
+    return Error::input(where(p), "camera " + p.path + " has a field of view under 1e-4 radians (verticalAperture / "
+                                  "focalLength too small) or a clippingRange that is not finite");
   def.znear = static_cast<float>(clipping[0]);
   def.zfar = static_cast<float>(clipping[1]);
   auto f = sampler(p, "focalLength", 1, Interpolation::Linear);
@@ -392,6 +410,9 @@ Status read_usd(const std::string& path, const SceneLoadOptions& options, SceneD
   out.file = path;
   out.format = "USD";
   out.warnings = (*stage)->warnings();
+  out.inputs.push_back(path);
+  for (const std::string& layer : (*stage)->layer_paths())
+    if (layer != path) out.inputs.push_back(layer);
   usd_detail::Converter cv(**stage, out);
   cv.start_tc = (*stage)->start_time_code();
   cv.tcps = (*stage)->time_codes_per_second();

@@ -252,6 +252,11 @@ Status Converter::mesh(const MeshJob& job) {
   if (!normals) {
     b.full.normals = smooth_normals(b.full.positions, all_tris, b.data.vertex_point, topo.point_count);
     b.data.smooth_normals = true;
+  } else if (!std::all_of(b.full.normals.begin(), b.full.normals.end(), [](const glm::vec3& n) {
+               return std::isfinite(n.x) && std::isfinite(n.y) && std::isfinite(n.z);
+             })) {
+    // Checked before normalising, which would quietly replace them (docs/render-gbuffer.md: exit 2).
+    return Error::input(where(p), "the normals of mesh " + p.path + " hold NaN or infinite values");
   }
   normalise_normals(b.full.normals);
 

@@ -279,6 +279,7 @@ Status Converter::uv_texture(const Prim& tex, SceneMaterial& m, std::string& uv)
     return {};
   }
   SceneTexture t;
+  out.inputs.push_back(path);
   if (Status s = read_image(path, where(tex), t); !s) return s;
   if (space == "raw") t.srgb = false;
   if (space == "sRGB") t.srgb = true;

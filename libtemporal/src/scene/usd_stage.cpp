@@ -329,9 +329,13 @@ class Composer {
     return parent.children.insert(pos, std::move(n))->get();
   }
 
+  // Whether an arc to `path` in layer `l` comes back to a site of the chain above `n`: the same prim, or an
+  // ancestor of it (whose namespace holds the arc again, so composing it would never end).
   static bool in_chain(const Node& n, const Layer* l, const std::string& path) {
     for (const Node* p = &n; p; p = p->parent)
-      if (p->layer == l && p->path == path) return true;
+      if (p->layer == l && (p->path == path || (p->path.size() > path.size() && p->path.compare(0, path.size(), path) == 0 &&
+                                                (path == "/" || p->path[path.size()] == '/'))))
+        return true;
     return false;
   }
 
@@ -343,9 +347,12 @@ class Composer {
     }
     bool found = false;
     for (const auto& [l, off] : stack->layers) {
+      // OpenUSD reports an arc cycle as a composition error and drops the arc; a scene whose prim references
+      // itself (or an arc chain that comes back to it) is malformed, and rendering it without that arc would
+      // draw something else than its author meant: an Input error naming the prim (issue 26).
       if (in_chain(n, l, target)) {
-        stage_.warnings_.push_back(where + ": the arc to <" + target + "> in " + l->path + " forms a cycle: skipped");
-        continue;
+        return Error::input(where, "the arc to <" + target + "> in " + l->path + " forms a cycle (prim " + n.path +
+                                       " references itself or an ancestor, directly or through other arcs)");
       }
       auto child = std::make_unique<Node>();
       child->arc = arc;

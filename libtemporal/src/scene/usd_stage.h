@@ -72,8 +72,8 @@ struct StageLimits {
 class Stage {
  public:
   // Opens the root layer and composes everything it reaches. Errors: the first layer that cannot be read
-  // or parsed, a reference without a target prim; composition problems that USD tolerates (a reference to
-  // a prim that does not exist, a cycle of arcs) become warnings.
+  // or parsed, a reference without a target prim, a cycle of arcs (a prim that references itself); a
+  // reference to a prim that does not exist and a cycle of subLayers are warnings (USD tolerates them).
   static Expected<std::unique_ptr<Stage>> open(const std::string& path, const StageLimits& limits = {});
 
   const Prim& root() const { return root_; }
@@ -81,6 +81,12 @@ class Stage {
   const Layer& root_layer() const { return *root_layer_; }
   const std::vector<std::string>& warnings() const { return warnings_; }
   std::size_t layer_count() const { return layers_.size(); }
+  // The file of every layer the stage read (root layer, sublayers, referenced and payload layers).
+  std::vector<std::string> layer_paths() const {
+    std::vector<std::string> paths;
+    for (const auto& [path, layer] : layers_) paths.push_back(path);
+    return paths;
+  }
 
   // Stage metadata (root layer) with USD's fallbacks.
   double start_time_code() const;

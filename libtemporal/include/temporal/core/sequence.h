@@ -64,6 +64,11 @@ class SequencePattern {
 // be contiguous: a gap is an error naming the first missing file). An empty result is an error.
 Expected<std::vector<int>> resolve_frames(const SequencePattern& pattern, const std::optional<FrameRange>& range);
 
+// Whether the input file `path` exists, without throwing: a path that cannot be examined (a symbolic link loop, a
+// folder without search permission) is an Input error naming it ("cannot be examined: ..."), not a
+// std::filesystem exception that a tool would report as an internal error.
+Expected<bool> input_exists(const std::string& path);
+
 // Parses a comma-separated list of frame numbers and ranges ("10,20-22") into sorted unique frames.
 Expected<std::vector<int>> parse_frame_list(std::string_view text);
 

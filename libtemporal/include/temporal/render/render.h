@@ -140,12 +140,18 @@ struct LightingOptions {
 Expected<LightingOptions::Mode> parse_lighting_mode(const std::string& text);  // "scene", "auto"
 const char* to_string(LightingOptions::Mode mode);
 
+// The most reference samples per pixel: each costs about one G-buffer and full-resolution payload render (16 spp
+// took about 10 minutes a frame at 1280x1024 on llvmpipe), so 4096 is already days a frame there; more (a typing
+// error like 1000000) would run for as long as it is allowed (issue 26).
+inline constexpr int kMaxReferenceSpp = 4096;
+
 struct RenderOptions {
   int width = 1280, height = 1024;     // full resolution, pixels
   int factor = 4;                      // shade is width/factor x height/factor (must divide both)
   JitterMode shade_jitter = JitterMode::Regular;
   JitterMode color_jitter = JitterMode::Random;
-  int reference_spp = 16;              // reference samples per pixel (Halton (2,3) sub-pixel positions)
+  int reference_spp = 16;              // reference samples per pixel (Halton (2,3) sub-pixel positions), at most
+                                       // kMaxReferenceSpp
   // Where the reference's samples lie in each pixel: Halton (a supersampled, antialiased reference) or None (every
   // sample at the pixel centre: only the per-sample SSAO pattern and VPL set vary, so the reference is the
   // 1-spp colour with its noise averaged - the target of methods that accumulate over frames; issue 15 item 6).

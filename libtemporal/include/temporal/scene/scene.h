@@ -76,6 +76,10 @@ struct PrimitiveInstance {
   std::vector<glm::vec3> world_normals;    // deformed only, world space, normalised
 };
 
+// The narrowest vertical field of view a camera may have (radians): below it 1 / tan(yfov / 2) overflows float
+// and every projected position is NaN. Loaders refuse such cameras; render-gbuffer checks every frame's camera.
+inline constexpr float kMinCameraYfov = 1e-4f;
+
 struct CameraState {
   glm::mat4 view{1.0f};              // world to camera (OpenGL: looks down -Z)
   float yfov = 0.8f;                 // radians
@@ -164,6 +168,12 @@ class Scene {
   // The same, reusing `out`'s storage (instances and deformed vertex arrays keep their capacity; the
   // per-call scratch is a few matrices per node): for per-frame loops.
   void evaluate(double time_s, FrameState& out) const;
+
+  // Every file the load read: the scene file first, then glTF buffers and images or USD layers and textures
+  // (render-gbuffer refuses to write over any of them).
+  const std::vector<std::string>& input_files() const;
+  // The scene file as given to load().
+  const std::string& file() const;
 
   // What the loader skipped or changed (points/lines primitives, ignored channels, ...), one line each.
   const std::vector<std::string>& warnings() const;
