@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <limits>
 
 namespace temporal {
 namespace {
@@ -130,6 +131,30 @@ TEST_F(MorphCli, OutOfRangeAndNonFiniteParametersAreUsageErrors) {
   EXPECT_NE(out.find("dwaa"), std::string::npos) << out;
   EXPECT_EQ(test::run_command(base + " --gamma 2.4 --display srgb_display", &out), 1) << out;
   EXPECT_FALSE(std::filesystem::exists(dir_ / "x")) << "nothing is written on a usage error";
+}
+
+// Issue 26 items 7 and 13: output frame numbers past 99,999,999 (they wrapped to negative names) and an
+// infinite temporal:fps in a header are input errors naming the file; nothing is written.
+TEST_F(MorphCli, OverflowingFrameNumbersAndInfiniteHeaderRatesAreRefused) {
+  Image c = test::make_color(32, 24, [](float x, float y, int ch) { return test::texture(x, y, ch); });
+  c.metadata().fps = 40.0;
+  ASSERT_TRUE(write_exr((dir_ / "big.99999998.exr").string(), c));
+  std::string out;
+  EXPECT_EQ(test::run_command(tool() + " --input " + (dir_ / "big.########.exr").string() + " --out " +
+                                  (dir_ / "big_out" / "m.#########.exr").string() + " --method repeat --factor 32",
+                              &out),
+            2)
+      << out;
+  EXPECT_NE(out.find("big.99999998.exr"), std::string::npos) << out;
+  EXPECT_FALSE(std::filesystem::exists(dir_ / "big_out") && !std::filesystem::is_empty(dir_ / "big_out"));
+  c.metadata().fps = std::numeric_limits<double>::infinity();
+  ASSERT_TRUE(write_exr((dir_ / "inf.0000.exr").string(), c));
+  EXPECT_EQ(test::run_command(tool() + " --input " + (dir_ / "inf.####.exr").string() + " --out " +
+                                  (dir_ / "inf_out" / "m.####.exr").string() + " --method repeat",
+                              &out),
+            2)
+      << out;
+  EXPECT_NE(out.find("temporal:fps"), std::string::npos) << out;
 }
 
 }  // namespace

@@ -77,7 +77,18 @@ class UpsampleStage final : public FrameStage {
       if (!color->metadata().fps)
         return Error::input(f.input_path, "no temporal:fps in the header: pass --fps (the rate it was rendered at)");
       fps = *color->metadata().fps;
+      // A header is validated like an option: an infinite or absurd rate would give non-finite times (issue 26).
+      if (!std::isfinite(fps) || fps < 1e-3 || fps > 1e4)
+        return Error::input(f.input_path, "temporal:fps is " + std::to_string(fps) +
+                                              ", not a rate in [0.001, 10000]: fix the header or pass --fps");
     }
+    // Output frame numbers n * factor + k stay within the frame numbers every tool accepts (at most 99,999,999):
+    // beyond, an int would wrap to a negative file name (issue 26 item 7).
+    if ((long long)f.frame * options_.morph.factor + options_.morph.factor - 1 > 99'999'999LL)
+      return Error::input(f.input_path, "frame " + std::to_string(f.frame) + " times --factor " +
+                                            std::to_string(options_.morph.factor) +
+                                            " is past frame 99,999,999, the largest output frame number; renumber "
+                                            "the input frames from 0");
     if (!morpher_) {  // the viewing geometry and rate of the first frame set the eye-tracking limit
       MorphOptions mo = options_.morph;
       mo.grid.pixels_per_degree = tracking_pixels_per_degree(options_.viewing, color->width());
