@@ -92,18 +92,17 @@ class Run {
 
   Expected<ComparisonReport> run() {
     if (auto st = open(); !st) return st.error();
-    // A range that starts after the first frame on disk (a shard of a longer sequence) first reads the frame
-    // before it, without reporting it: the first compared frame then gets the flicker value a single run over the
-    // whole sequence gives it, and per-shard results merge exactly (docs/compare.md, "Shards").
-    std::vector<int> order;
     // The latency of each test, from its first compared frame's header (docs/conventions.md, "Latency").
     if (setup_.latency_aware)
       for (auto& t : tests_)
         if (auto st = read_latency(t); !st) return st.error();
-    // The same for every gap of a stepped list (--frames 0-47y3): the frame before each selected frame whose
-    // predecessor is not selected is read for its history and not reported, so that each compared frame's flicker
-    // is its change from the frame before it, whichever frames are listed. Without that frame on disk the compared
-    // frame has no flicker value (as after a cut).
+    // A range that starts after the first frame on disk (a shard of a longer sequence) first reads the frame
+    // before it, without reporting it: the first compared frame then gets the flicker value a single run over the
+    // whole sequence gives it, and per-shard results merge exactly (docs/compare.md, "Shards"). The same for
+    // every gap of a stepped list (--frames 0-47y3): each compared frame's flicker is its change from the frame
+    // just before it, whichever frames are listed; without that frame on disk it has no flicker value (as after
+    // a cut).
+    std::vector<int> order;
     std::vector<bool> primes;
     for (std::size_t i = 0; i < report_.frames.size(); ++i) {
       const int f = report_.frames[i];

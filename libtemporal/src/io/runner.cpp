@@ -12,15 +12,6 @@
 namespace temporal {
 namespace {
 
-std::string join(const std::vector<std::string>& v) {
-  std::string s;
-  for (const auto& x : v) {
-    if (!s.empty()) s += ", ";
-    s += x;
-  }
-  return s.empty() ? std::string("(none)") : s;
-}
-
 std::string dims(int w, int h) { return std::to_string(w) + "x" + std::to_string(h); }
 
 // Outputs are OpenEXR: refuse another extension before any work is done.
