@@ -15,7 +15,7 @@
 #include <cmath>
 #include <stdexcept>
 
-namespace temporal {
+namespace temporal::morph {
 namespace {
 
 constexpr int kW = 32, kH = 12;
@@ -143,4 +143,4 @@ TEST_F(LatencyScoring, WithoutTheOptionNothingChanges) {
 }
 
 }  // namespace
-}  // namespace temporal
+}  // namespace temporal::morph

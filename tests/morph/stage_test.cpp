@@ -12,7 +12,7 @@
 #include <cmath>
 #include <limits>
 
-namespace temporal {
+namespace temporal::morph {
 namespace {
 
 class MorphStageRun : public ::testing::Test {
@@ -231,4 +231,4 @@ TEST_F(MorphStageRun, ClearErrors) {
 }
 
 }  // namespace
-}  // namespace temporal
+}  // namespace temporal::morph

@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-namespace temporal::detail {
+namespace temporal::phlm::detail {
 
 // Marks the finite pixels of the input (valid = 1 when every filtered channel is finite) and, when
 // `want_ycgco`, converts the three channels to YCgCo planes (temporal/core/color.h). Buffers are resized only
@@ -31,4 +31,4 @@ void allocate_history(Image& history, Image& next, int channels, int width, int 
 // Loads the history planes of a state image written by `--state-out` into `history` (and sizes `next` to
 // match), refusing a missing or non-finite plane. `method` names the method in the messages.
 Status load_history(const Image& state, int channels, const char* method, Image& history, Image& next);
-}  // namespace temporal::detail
+}  // namespace temporal::phlm::detail

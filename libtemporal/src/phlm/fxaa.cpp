@@ -3,6 +3,7 @@
 #include "temporal/phlm/fxaa.h"
 
 #include "filter_common.h"
+#include "temporal/phlm/filters.h"
 #include "temporal/core/color.h"
 #include "temporal/core/parallel.h"
 #include "temporal/core/reproject.h"
@@ -13,7 +14,7 @@
 #include <cmath>
 #include <vector>
 
-namespace temporal {
+namespace temporal::phlm {
 namespace {
 // Search steps of FXAA_QUALITY__PRESET 12 (FXAA_QUALITY__P0 .. P11).
 constexpr float kSteps[12] = {1.0f, 1.0f, 1.0f, 1.0f, 1.0f, 1.5f, 2.0f, 2.0f, 2.0f, 2.0f, 4.0f, 8.0f};
@@ -182,4 +183,33 @@ Status fxaa(const FilterInput& in, Image& output, const FxaaParams& params, Filt
   return Status::ok();
 }
 
-}  // namespace temporal
+// --- Registry entry (temporal/phlm/filters.h) ------------------------------------------------------------------
+
+namespace {
+
+// fxaa's parameters on the command line: the fields of FxaaParams (fxaa.h).
+struct FxaaOptions : FxaaParams {
+  ParamList params() {
+    return {
+        Param::real("--fxaa-subpix", "sub-pixel aliasing removal (fxaaQualitySubpix)", &subpix, 0.0, 1.0),
+        Param::real("--fxaa-edge-threshold", "fxaaQualityEdgeThreshold", &edge_threshold, 0.0, 1.0),
+        Param::real("--fxaa-edge-threshold-min", "fxaaQualityEdgeThresholdMin", &edge_threshold_min, 0.0, 1.0),
+    };
+  }
+};
+
+}  // namespace
+
+const MethodEntry& fxaa_method() {
+  static const MethodEntry entry{
+      .info = {.name = "fxaa", .summary = "weak reference: FXAA 3.11 (Lottes 2011), spatial only"},
+      .make_options = OptionsOf<FxaaOptions>::make,
+      .layers = [](const FilterOptions&) { return std::vector<LayerNeed>{}; },
+      .implementations = {{kCpuDevice, [](const FilterOptions& o) -> std::unique_ptr<FrameFilter> {
+                             return std::make_unique<FxaaFilter>(method_options<FxaaOptions>(o.per_method, "fxaa"));
+                           }}},
+  };
+  return entry;
+}
+
+}  // namespace temporal::phlm

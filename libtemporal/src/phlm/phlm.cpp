@@ -3,6 +3,7 @@
 #include "temporal/phlm/phlm.h"
 
 #include "filter_common.h"
+#include "temporal/phlm/filters.h"
 #include "temporal/core/color.h"
 #include "temporal/core/parallel.h"
 #include "temporal/core/reproject.h"
@@ -15,7 +16,7 @@
 #include <cstring>
 #include <vector>
 
-namespace temporal {
+namespace temporal::phlm {
 namespace {
 
 // Plain comparisons instead of std::fmin / std::fmax: those honour NaN operands and are not inlined by GCC
@@ -570,4 +571,47 @@ std::string PhlmFilter::stats_text(const FilterStats& stats) const {
   return ", max trace(P) " + std::to_string(stats.max_trace_p);
 }
 
-}  // namespace temporal
+// --- Registry entry (temporal/phlm/filters.h) ------------------------------------------------------------------
+
+namespace {
+
+// phlm's parameters on the command line: the fields of PhlmParams (phlm.h).
+struct PhlmOptions : PhlmParams {
+  ParamList params() {
+    return {
+        Param::real("--lambda", "RLS forgetting factor (seed 003 eq. 6-7)", &lambda, 0.5, 1.0),
+        Param::positive("--p-init", "P = p_init * I at reset (seed 003 section 6)", &p_init),
+        Param::real("--feature-a", "a of phi(v,l) = a l^2 + b v l^3 (section 5.1)", &feature_a, -1e6, 1e6),
+        Param::real("--feature-b", "b of phi(v,l)", &feature_b, -1e6, 1e6),
+        Param::positive("--trace-factor", "trace(P) <= factor * N * p_init (wind-up guard)", &trace_factor),
+        Param::flag_on("--no-feature",
+                       "ablation: predictor x = [1], an intercept-only RLS (a per-pixel running mean with the same "
+                       "resets)",
+                       &no_feature),
+        Param::flag_on("--no-box-test", "ablation: skip the box test and its resets (Algorithm 1 lines 13-19)",
+                       &no_box_test),
+        Param::choice("--feature-alpha",
+                      "reading of the feature's alpha: ue4 = weight of the new sample, eq1 = history weight of eq. 1 "
+                      "(ablation)",
+                      &alpha_reading, {"ue4", "eq1"}),
+        Param::choice("--model-fetch", "fetch of the previous models at p + motion (section 6: bilinear)",
+                      &model_fetch, {"bilinear", "nearest", "catmull-rom"}),
+    };
+  }
+};
+
+}  // namespace
+
+const MethodEntry& phlm_method() {
+  static const MethodEntry entry{
+      .info = {.name = "phlm", .summary = "pixel history linear models (seed 003)", .has_state = true},
+      .make_options = OptionsOf<PhlmOptions>::make,
+      .layers = [](const FilterOptions&) { return std::vector<LayerNeed>{{"motion"}}; },
+      .implementations = {{kCpuDevice, [](const FilterOptions& o) -> std::unique_ptr<FrameFilter> {
+                             return std::make_unique<PhlmFilter>(method_options<PhlmOptions>(o.per_method, "phlm"));
+                           }}},
+  };
+  return entry;
+}
+
+}  // namespace temporal::phlm

@@ -3,6 +3,7 @@
 #include "temporal/phlm/taa.h"
 
 #include "filter_common.h"
+#include "temporal/phlm/filters.h"
 #include "temporal/core/color.h"
 #include "temporal/core/parallel.h"
 #include "temporal/core/reproject.h"
@@ -11,7 +12,7 @@
 #include <atomic>
 #include <cmath>
 
-namespace temporal {
+namespace temporal::phlm {
 namespace {
 
 // Plain comparisons instead of std::fmin / std::fmax: those honour NaN operands and are not inlined by GCC
@@ -286,4 +287,45 @@ Status TaaFilter::set_state(const Image& state, int channels) {
   return Status::ok();
 }
 
-}  // namespace temporal
+// --- Registry entry (temporal/phlm/filters.h) ------------------------------------------------------------------
+
+namespace {
+
+// taa's parameters on the command line: the fields of TaaParams (taa.h).
+struct TaaOptions : TaaParams {
+  ParamList params() {
+    return {
+        Param::real("--taa-alpha", "weight of the current frame (chosen on the tuning set, docs/filter-phlm.md)",
+                    &alpha, 0.0, 1.0),
+        Param::choice("--taa-velocity",
+                      "motion of the closest surface of the 3x3 neighbourhood (nearest, UE4) or of the pixel",
+                      &velocity, {"nearest", "centre"}),
+        Param::choice("--taa-clip",
+                      "history clipping in YCoCg to mu +- gamma sigma (variance, Salvi 2016) or to the 3x3 min/max "
+                      "box (minmax, Karis 2014)",
+                      &clip, {"variance", "minmax"}),
+        Param::positive("--taa-gamma", "gamma of variance clipping (Salvi 2016: 1)", &gamma, 0.0, 8.0),
+        Param::choice("--taa-history", "history fetch (Karis 2014: catmull-rom)", &history,
+                      {"catmull-rom", "bilinear", "nearest"}),
+    };
+  }
+};
+
+}  // namespace
+
+const MethodEntry& taa_method() {
+  static const MethodEntry entry{
+      .info = {.name = "taa",
+               .summary = "engine-strength TAA: Karis 2014 with nearest-depth velocity, Catmull-Rom history, variance "
+                          "clipping (Salvi 2016)",
+               .has_state = true},
+      .make_options = OptionsOf<TaaOptions>::make,
+      .layers = [](const FilterOptions&) { return std::vector<LayerNeed>{{"motion"}, {"depth", false}}; },
+      .implementations = {{kCpuDevice, [](const FilterOptions& o) -> std::unique_ptr<FrameFilter> {
+                             return std::make_unique<TaaFilter>(method_options<TaaOptions>(o.per_method, "taa"));
+                           }}},
+  };
+  return entry;
+}
+
+}  // namespace temporal::phlm

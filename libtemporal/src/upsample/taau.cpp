@@ -85,7 +85,7 @@ struct TaauOptions {
   }
 };
 
-const TaauOptions& taau_options(const Options& o) { return method_options<TaauOptions>(o, "taau"); }
+const TaauOptions& taau_options(const Options& o) { return method_options<TaauOptions>(o.per_method, "taau"); }
 
 // The payload in the space the method filters in: R, G, B triples as YCoCg (Malvar & Sullivan 2003, core/color.h;
 // Karis 2014 and FSR 2 clamp there), other channels as they are. Linear, so blends are the same in either space.
@@ -492,18 +492,18 @@ std::size_t streamed_bytes(const Options&, int W, int H, int k, int C) {
 
 const MethodEntry& taau_method() {
   static const MethodEntry entry{
-      {"taau",
-       "engine-class temporal upscaler after FSR 2 / UE4 TAAU: Lanczos-2 reconstruction of the jittered samples, "
-       "depth disocclusion, YCoCg history clamp, per-pixel accumulation weight, thin-feature locks",
-       true,
-       {}},
-      OptionsOf<TaauOptions>::make,
-      history_method_layers,
-      [](const Options& o, const Geometry& g) -> std::unique_ptr<MethodState> {
-        return std::make_unique<TaauState>(o, g);
-      },
-      streamed_bytes,
-      nullptr};
+      .info = {.name = "taau",
+               .summary = "engine-class temporal upscaler after FSR 2 / UE4 TAAU: Lanczos-2 reconstruction of the "
+                          "jittered samples, depth disocclusion, YCoCg history clamp, per-pixel accumulation "
+                          "weight, thin-feature locks",
+               .has_state = true},
+      .make_options = OptionsOf<TaauOptions>::make,
+      .layers = history_method_layers,
+      .implementations = {{kCpuDevice,
+                           [](const Options& o, const Geometry& g) -> std::unique_ptr<MethodState> {
+                             return std::make_unique<TaauState>(o, g);
+                           }}},
+      .streamed_bytes = streamed_bytes};
   return entry;
 }
 

@@ -29,6 +29,7 @@
 namespace {
 
 using namespace temporal;
+using namespace temporal::phlm;
 
 struct Test {
   std::string name;

@@ -24,7 +24,7 @@
 #include <memory>
 #include <string>
 
-namespace temporal {
+namespace temporal::morph {
 
 // Where the viewer sits: the eye-tracking limit of didyk (seed 004 section 6) needs pixels per degree. Defaults:
 // the paper's display (Samsung 2233RZ, 0.473 m wide, 1680 pixels) seen from 0.6 m, images shown 1:1.
@@ -57,12 +57,13 @@ struct MorphStageOptions {
   LagSearchOptions lag;
 };
 
-// Every parameter of the tool: the method (its choices and help from the registry), factor, fps, debug layers,
-// perceive and its window, then each registered method's own parameters (a flag listed by several methods once).
+// Every parameter of the tool: those of MorphOptions (params(), temporal/morph/methods.h: the method, factor,
+// gamma, debug layers, each registered method's own), then the input rate, the display and viewing geometry,
+// perceive and its window.
 ParamList morph_stage_params(MorphStageOptions& options);
 
 // The stage for these options. Errors (before any frame is read): Usage for invalid options (unknown method,
 // factor < 2, a grid that is not a power of two), the colour config's errors for `display`.
 Expected<std::unique_ptr<FrameStage>> make_morph_stage(const MorphStageOptions& options);
 
-}  // namespace temporal
+}  // namespace temporal::morph

@@ -24,7 +24,7 @@
 
 #include <cmath>
 
-namespace temporal::rls {
+namespace temporal::phlm::rls {
 
 // Plain comparisons instead of std::fmin / std::fmax: those honour NaN operands and are not inlined by GCC
 // (a libm call per use, measured 11% of the PHLM frame); every operand here is finite.
@@ -162,4 +162,4 @@ inline float update(Model<N, C>& m, const float x[N], const float y[C], float la
   return t;
 }
 
-}  // namespace temporal::rls
+}  // namespace temporal::phlm::rls
