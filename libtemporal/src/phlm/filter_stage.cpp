@@ -113,7 +113,8 @@ class FilterStage final : public FrameStage {
 Expected<std::unique_ptr<FrameStage>> make_filter_stage(const FilterOptions& options) {
   auto filter = make_filter(options);  // checks the options
   if (!filter) return filter.error();
-  return std::unique_ptr<FrameStage>(std::make_unique<FilterStage>(options, *find_entry(options.method), std::move(*filter)));
+  return std::unique_ptr<FrameStage>(
+      std::make_unique<FilterStage>(options, *find_entry(options.method), std::move(*filter)));
 }
 
 }  // namespace temporal::phlm

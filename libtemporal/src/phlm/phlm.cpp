@@ -5,6 +5,7 @@
 #include "filter_common.h"
 #include "temporal/phlm/filters.h"
 #include "temporal/core/color.h"
+#include "temporal/core/minmax.h"
 #include "temporal/core/parallel.h"
 #include "temporal/core/reproject.h"
 #include "temporal/phlm/rls.h"
@@ -18,11 +19,6 @@
 
 namespace temporal::phlm {
 namespace {
-
-// Plain comparisons instead of std::fmin / std::fmax: those honour NaN operands and are not inlined by GCC
-// (a libm call per use, measured 11% of the PHLM frame); every operand here is finite.
-inline float min_(float a, float b) { return b < a ? b : a; }
-inline float max_(float a, float b) { return a < b ? b : a; }
 
 template <int C>
 constexpr int kN = C + 1;
@@ -38,28 +34,14 @@ inline float luma(const float* v) {
 }
 
 // The box test of Algorithm 1 runs in YCgCo for colour (section 5.2 names RGB or YCgCo; YCgCo gives a tighter
-// box around chroma, as in Karis 2014) and on the value itself for one channel.
-template <int C>
-inline void to_box_space(const float* v, float* b) {
-  if constexpr (C == 3)
-    rgb_to_ycgco(v[0], v[1], v[2], b[0], b[1], b[2]);
-  else
-    b[0] = v[0];
-}
-template <int C>
-inline void from_box_space(const float* b, float* v) {
-  if constexpr (C == 3)
-    ycgco_to_rgb(b[0], b[1], b[2], v[0], v[1], v[2]);
-  else
-    v[0] = b[0];
-}
+// box around chroma, as in Karis 2014) and on the value itself for one channel: to_ycgco_box (core/color.h).
 
 // Scale of a model reset to colour c: the regression runs on y / s and z / s so that the predictor
 // x = [1, z / s] stays of order one. s = 1 for values up to 1 (the paper's setting, unchanged); HDR values
 // (1e4) would otherwise make P ill-conditioned beyond float precision. See docs, "HDR scaling".
 template <int C>
 inline float model_scale(const float* c) {
-  return max_(1.0f, std::fabs(luma<C>(c)));
+  return fast_max(1.0f, std::fabs(luma<C>(c)));
 }
 
 // One pixel's model record, interleaved: beta (C x N), D (N), U (N (N - 1) / 2), feature (C), scale (1), in the
@@ -174,8 +156,8 @@ void run_phlm(const FilterInput& in, const PhlmParams& params, const Variant& va
           float* lo = vlow[c] + 1;
           for (int xx = 0; xx < w; ++xx) {
             const bool va = v0[xx] != 0, vb = v1[xx] != 0, vc = v2[xx] != 0;
-            mn[xx] = min_(min_(va ? b0[xx] : INFINITY, vb ? b1[xx] : INFINITY), vc ? b2[xx] : INFINITY);
-            mx[xx] = max_(max_(va ? b0[xx] : -INFINITY, vb ? b1[xx] : -INFINITY), vc ? b2[xx] : -INFINITY);
+            mn[xx] = fast_min(fast_min(va ? b0[xx] : INFINITY, vb ? b1[xx] : INFINITY), vc ? b2[xx] : INFINITY);
+            mx[xx] = fast_max(fast_max(va ? b0[xx] : -INFINITY, vb ? b1[xx] : -INFINITY), vc ? b2[xx] : -INFINITY);
             lo[xx] = (va ? y0p[xx] : 0.0f) + 2.0f * (vb ? y1p[xx] : 0.0f) + (vc ? y2p[xx] : 0.0f);
           }
         }
@@ -199,8 +181,8 @@ void run_phlm(const FilterInput& in, const PhlmParams& params, const Variant& va
           float* omx = hmax[c];
           float* olo = hlow[c];
           for (int xx = 0; xx < w; ++xx) {
-            omn[xx] = min_(min_(mn[xx], mn[xx + 1]), mn[xx + 2]);
-            omx[xx] = max_(max_(mx[xx], mx[xx + 1]), mx[xx + 2]);
+            omn[xx] = fast_min(fast_min(mn[xx], mn[xx + 1]), mn[xx + 2]);
+            omx[xx] = fast_max(fast_max(mx[xx], mx[xx + 1]), mx[xx + 2]);
             olo[xx] = hw[xx] > 0.0f ? (lo[xx] + 2.0f * lo[xx + 1] + lo[xx + 2]) / hw[xx] : 0.0f;
           }
         }
@@ -276,20 +258,20 @@ void run_phlm(const FilterInput& in, const PhlmParams& params, const Variant& va
             // Luminances enter the heuristic relative to k = max(1, Y(low)): values up to 1 (the display-
             // referred range the constants a, b were tuned for) are used as they are, HDR values by their
             // Weber contrast, so that alpha does not saturate to 1 on highlights (docs, "HDR scaling").
-            const float k = 1.0f / max_(1.0f, std::fabs(luma<C>(low)));
+            const float k = 1.0f / fast_max(1.0f, std::fabs(luma<C>(low)));
             const float lh = luma<C>(zh);
             const float delta = (bmax[0] - bmin[0]) * k;  // box[0] is the luma (YCgCo Y)
-            const float l = min_(std::fabs(lh - bmin[0]), std::fabs(lh - bmax[0])) * k;
+            const float l = fast_min(std::fabs(lh - bmin[0]), std::fabs(lh - bmax[0])) * k;
             const float v = std::sqrt(mvx * mvx + mvy * mvy);
             const float phi = a * l * l + b * v * l * l * l;
             const float den = l + delta;
-            alpha = den > 0.0f ? min_(phi / den, 1.0f) : 0.0f;
+            alpha = den > 0.0f ? fast_min(phi / den, 1.0f) : 0.0f;
             // The accumulated feature is kept inside the current neighbourhood box (as Karis' history), so a
             // disoccluded region cannot keep a stale feature.
             float zb[C];
-            to_box_space<C>(zh, zb);
+            to_ycgco_box(zh, zb, C);
             for (int c = 0; c < C; ++c) zb[c] = std::clamp(zb[c], bmin[c], bmax[c]);
-            from_box_space<C>(zb, zh);
+            from_ycgco_box(zb, zh, C);
             // alpha weighs the new low-frequency sample (the reading of Karis / UE4, whose code the constants
             // a, b come from; see docs): z = (1 - alpha) z_prev + alpha low. The eq1 ablation reads it as eq. 1's
             // history weight: z = alpha z_prev + (1 - alpha) low.
@@ -330,8 +312,8 @@ void run_phlm(const FilterInput& in, const PhlmParams& params, const Variant& va
           // Lines 12-19: initial prediction, box test, ray-box clip towards the input and model reset.
           float f[C], fb[C], yb[C];
           for (int c = 0; c < C; ++c) f[c] = s * rls::predict(m, c, x);
-          to_box_space<C>(f, fb);
-          to_box_space<C>(yc, yb);
+          to_ycgco_box(f, fb, C);
+          to_ycgco_box(yc, yb, C);
           bool inside = true;
           for (int c = 0; c < C; ++c) inside = inside && fb[c] >= bmin[c] && fb[c] <= bmax[c];
           inside = inside || !variant.box_test;
@@ -347,12 +329,12 @@ void run_phlm(const FilterInput& in, const PhlmParams& params, const Variant& va
                 const float dir = yb[c] - fb[c];
                 if (dir == 0.0f) continue;
                 const float t0 = (bmin[c] - fb[c]) / dir, t1 = (bmax[c] - fb[c]) / dir;
-                t_near = max_(t_near, min_(t0, t1));
+                t_near = fast_max(t_near, fast_min(t0, t1));
               }
-              t_hit = min_(t_near, 1.0f);
+              t_hit = fast_min(t_near, 1.0f);
             }
             for (int c = 0; c < C; ++c) fb[c] = finite ? fb[c] + t_hit * (yb[c] - fb[c]) : yb[c];
-            from_box_space<C>(fb, f);
+            from_ycgco_box(fb, f, C);
             s = model_scale<C>(f);  // line 18: Reset(beta, P) <- f
             float v0[C];
             for (int c = 0; c < C; ++c) v0[c] = f[c] / s;
@@ -370,7 +352,7 @@ void run_phlm(const FilterInput& in, const PhlmParams& params, const Variant& va
           // non-finite input never enters a history).
           trace_p = rls::trace<N>(m.u, m.d);
         }
-        local_trace = max_(local_trace, trace_p);
+        local_trace = fast_max(local_trace, trace_p);
 
         // Line 22 / eq. 8: the output is the updated model's prediction. Where this frame has no sample the
         // carried model was not box-tested (Algorithm 1 tests against y, which is missing): its prediction is
@@ -381,9 +363,9 @@ void run_phlm(const FilterInput& in, const PhlmParams& params, const Variant& va
           for (int c = 0; c < C; ++c) f[c] = s * rls::predict(m, c, x);
           if (!centre_valid && any_valid) {
             float fb[C];
-            to_box_space<C>(f, fb);
+            to_ycgco_box(f, fb, C);
             for (int c = 0; c < C; ++c) fb[c] = std::isfinite(fb[c]) ? std::clamp(fb[c], bmin[c], bmax[c]) : bmin[c];
-            from_box_space<C>(fb, f);
+            from_ycgco_box(fb, f, C);
           }
           for (int c = 0; c < C; ++c) out[c][i] = f[c];
         }

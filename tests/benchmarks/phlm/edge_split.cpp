@@ -29,7 +29,6 @@
 namespace {
 
 using namespace temporal;
-using namespace temporal::phlm;
 
 struct Test {
   std::string name;
