@@ -2,19 +2,22 @@
 // baselines of its Table 2 (TAA after Karis 2014, FXAA after Lottes 2011) plus the exponential history of its
 // eq. 1. The methods and their parameters come from the library's registry (temporal/phlm/filters.h); the
 // sequence runner owns the frame loop. Options, defaults and every choice: docs/filter-phlm.md.
+#include "method_list.h"
 #include "tool.h"
 
 #include "temporal/phlm/filters.h"
+#include "temporal/phlm/phlm.h"
 
 #include <string>
 
 namespace {
 
 using namespace temporal;
+using namespace temporal::phlm;
 
 std::string description() {
   std::string methods;
-  for (const auto& m : filter_methods()) methods += std::string("  ") + m.name + ": " + m.summary + "\n";
+  for (const MethodEntry* e : registry()) methods += "  " + e->info.name + ": " + e->info.summary + "\n";
   return "Temporal filtering of a 1-spp sequence: pixel history linear models (seed 003, --method phlm), the "
          "engine-strength baseline taa, and the papers' weak references ema and fxaa.\n" +
          methods +
@@ -35,17 +38,14 @@ int main(int argc, char** argv) {
   tool::Tool tool("filter-phlm", description());
   SequenceOptions seq;
   FilterOptions options;
-  auto& app = tool.app();
   tool.add_sequence_options(
       seq, {"Input sequence, e.g. color.####.exr (1 spp, scene-linear)",
             "G-buffer sequence with `motion` (and `depth` for taa's nearest-depth velocity, `depth`, `id` for ema); "
             "without it the scene is static",
             "Output sequence, e.g. phlm.####.exr", false, true, true});
-  app.add_option("--method", options.method, filter_method_names());
-  app.add_option("--layer", options.layer, "Layer to filter: rgb (R,G,B) or a layer name (ssao, shadow, direct, ...)");
-  app.add_flag("--debug-layers", options.debug_layers, "Add debug.* layers (phlm: feature, alpha, reset, traceP; taa: clip, noHistory, velocity; ema: reject; "
-                 "fxaa: edge)");
-  for (const auto& method : filter_methods()) tool.add_params(method.params(options));
+  tool.add_params(params(options));
+  // --list-methods(-json): the registry's methods (pipelines/filter-phlm.sh and the workflow read them).
+  tool::add_method_lists(tool, tool::method_rows(registry()));
   return tool.run(argc, argv, [&]() -> Status {
     auto stage = make_filter_stage(options);
     if (!stage) return stage.error();

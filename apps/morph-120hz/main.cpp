@@ -2,6 +2,7 @@
 // 004's grid morphing (didyk) or a baseline; or, with --perceive, simulates what an eye tracking the motion
 // perceives on a hold-type display (seed 004 section 3). The methods, their parameters and the per-frame policy
 // live in libtemporal (temporal/morph/methods.h, morph_stage.h); docs/morph-120hz.md describes them.
+#include "method_list.h"
 #include "tool.h"
 
 #include "temporal/io/color_config.h"
@@ -10,13 +11,13 @@
 #include "temporal/morph/morph_stage.h"
 
 #include <algorithm>
-#include <iostream>
 #include <string>
 
 int main(int argc, char** argv) {
   using namespace temporal;
+  using namespace temporal::morph;
   std::string methods;
-  for (const auto& m : morph_methods()) methods += "\n  " + m.name + ": " + m.summary;
+  for (const MethodEntry* e : registry()) methods += "\n  " + e->info.name + ": " + e->info.summary;
   tool::Tool tool("morph-120hz",
                   "Temporal upsampling of rendered frames for high-refresh-rate displays (Didyk et al. 2010): "
                   "each input frame n becomes output frames n*factor+k, k = 0..factor-1, at time "
@@ -35,14 +36,8 @@ int main(int argc, char** argv) {
   app.get_option("--display")->excludes("--gamma");
   for (const char* geometry : {"--screen-width-m", "--distance-m", "--pixels-x"})
     app.get_option(geometry)->excludes("--ppd");
-  // For scripts (pipelines/morph-120hz.sh): the registry's method names, one per line, then a tab and the summary.
-  app.add_flag_callback(
-      "--list-methods",
-      [] {
-        for (const auto& m : morph_methods()) std::cout << m.name << '\t' << m.summary << '\n';
-        throw CLI::Success();
-      },
-      "Print the methods (name, tab, summary; one per line) and exit");
+  // --list-methods(-json), for scripts (pipelines/morph-120hz.sh) and the workflow: the registry's methods.
+  tool::add_method_lists(tool, tool::method_rows(registry()));
 
   return tool.run(argc, argv, [&]() -> Status {
     auto stage = make_morph_stage(options, MorphStageIO{&read_exr_rgb, &load_display_gamma});

@@ -2,40 +2,26 @@
 // full-resolution G-buffer, with the methods of seed 000 (spatial, temporal, herzog) and seed 002 (drobot).
 // The algorithms, the per-frame loop and the method table live in libtemporal (temporal/upsample/stage.h,
 // temporal/upsample/methods.h); docs/upsample-st.md describes them.
+#include "method_list.h"
 #include "tool.h"
 
 #include "temporal/upsample/methods.h"
 #include "temporal/upsample/stage.h"
 
 #include <cstdio>
-#include <iostream>
 #include <string>
+#include <vector>
 
 namespace {
 
 using namespace temporal;
 namespace up = temporal::upsample;
 
-std::string join_args(const std::vector<std::string>& args) {
-  std::string s;
-  for (const auto& a : args) s += " " + a;
-  return s;
-}
-
-// --list-methods: one line per method and named variant, tab-separated (name, arguments, summary), then the name
-// suffixes any method takes; pipelines/upsample-st.sh turns METHODS names into arguments with it.
-void list_methods() {
-  for (const up::MethodVariant& v : up::method_variants())
-    std::cout << v.name << "\t--method " << v.method << join_args(v.args) << "\t" << v.summary << "\n";
-  for (const up::VariantSuffix& s : up::variant_suffixes())
-    std::cout << "*" << s.suffix << "\t" << join_args(s.args).substr(1) << "\t" << s.summary << "\n";
-}
-
 std::string description() {
   std::string d =
       "Upsamples low-resolution jittered shading (the shade sequence of render-gbuffer) to the resolution of the "
       "G-buffer. Methods:\n";
-  for (const up::MethodInfo& m : up::methods()) d += "  " + m.name + ": " + m.summary + "\n";
+  for (const up::MethodEntry* e : up::registry()) d += "  " + e->info.name + ": " + e->info.summary + "\n";
   return d + "Usage: upsample-st --gbuffer G.####.exr --input shade.####.exr --out up.####.exr --method herzog";
 }
 
@@ -50,13 +36,11 @@ int main(int argc, char** argv) {
                  "Output sequence, e.g. up.####.exr", true, true, true});
   up::Options options;
   tool.add_params(up::params(options));
-  tool.app().add_flag_callback(
-      "--list-methods",
-      [] {
-        list_methods();
-        throw CLI::Success();
-      },
-      "List the methods and their named variants (name, arguments, summary) and exit");
+  // --list-methods(-json): every method and named variant, then the name suffixes any method takes ("-demod");
+  // pipelines/upsample-st.sh turns METHODS names into arguments with it.
+  std::vector<tool::SuffixRow> suffixes;
+  for (const up::VariantSuffix& s : up::variant_suffixes()) suffixes.push_back({s.suffix, s.args, s.summary});
+  tool::add_method_lists(tool, tool::method_rows(up::registry()), suffixes);
 
   return tool.run(argc, argv, [&]() -> Status {
     if (Status s = up::check(options); !s) return s;

@@ -10,7 +10,7 @@
 #include <filesystem>
 #include <limits>
 
-namespace temporal {
+namespace temporal::morph {
 namespace {
 
 class MorphCli : public ::testing::Test {
@@ -106,13 +106,21 @@ TEST_F(MorphCli, NoCompensationFlagClearsTheDefaultOnField) {
   EXPECT_EQ(slot0_differs_from_input(" --no-compensation", "plain"), 0);
 }
 
-// The method list scripts read (pipelines/morph-120hz.sh) is the registry's, one `name<TAB>summary` per line.
+// The method list scripts read (pipelines/morph-120hz.sh) is the registry's, one `name<TAB>arguments<TAB>summary`
+// per line as in every method tool; the JSON form adds statefulness, implementations and latency.
 TEST_F(MorphCli, ListMethodsPrintsTheRegistry) {
   std::string out;
   ASSERT_EQ(test::run_command(tool() + " --list-methods 2>/dev/null", &out), 0) << out;
   std::string expected;
-  for (const auto& m : morph_methods()) expected += m.name + "\t" + m.summary + "\n";
+  for (const MethodEntry* e : registry())
+    expected += e->info.name + "\t--method " + e->info.name + "\t" + e->info.summary + "\n";
   EXPECT_EQ(out, expected);
+  ASSERT_EQ(test::run_command(tool() + " --list-methods-json 2>/dev/null", &out), 0) << out;
+  EXPECT_NE(out.find("{\"name\": \"blend\", \"method\": \"blend\", \"args\": [], \"summary\": "), std::string::npos)
+      << out;
+  EXPECT_NE(out.find("\"stateful\": false, \"implementations\": [\"cpu\"], \"latency_frames\": 1}"), std::string::npos)
+      << out;
+  EXPECT_NE(out.find("\"implementations\": [\"cpu\"], \"latency_frames\": 0}"), std::string::npos) << out;
 }
 
 TEST_F(MorphCli, OutOfRangeAndNonFiniteParametersAreUsageErrors) {
@@ -158,4 +166,4 @@ TEST_F(MorphCli, OverflowingFrameNumbersAndInfiniteHeaderRatesAreRefused) {
 }
 
 }  // namespace
-}  // namespace temporal
+}  // namespace temporal::morph

@@ -1,5 +1,6 @@
 // High-frequency compensation (seed 004 section 5.1) and the eye-tracking limit (section 6).
 #include "temporal/morph/grid_warp.h"
+#include "temporal/morph/methods.h"
 #include "temporal/morph/morph.h"
 
 #include "synthetic.h"
@@ -8,7 +9,7 @@
 
 #include <cmath>
 
-namespace temporal {
+namespace temporal::morph {
 namespace {
 
 TEST(MorphCompensation, GammaOneIsAPlainScalingByN) {
@@ -64,7 +65,8 @@ TEST(MorphCompensation, StaticImageMeanOverDisplayedFramesEqualsOriginalInLinear
   MorphOptions o;
   o.factor = n;
   o.gamma = 2.2f;
-  o.min_blur = 1.0f;  // every in-between frame fully blurred, so the whole image is compensated
+  // Every in-between frame fully blurred, so the whole image is compensated.
+  ASSERT_TRUE(apply_args(params(o), {"--min-blur", "1"}));
   Morpher m(o);
   std::vector<Image> out;
   ASSERT_TRUE(m.process(color, &gb, nullptr, out));
@@ -125,4 +127,4 @@ TEST(EyeTracking, DampsVertexMotionOfUntrackableSpeeds) {
 }
 
 }  // namespace
-}  // namespace temporal
+}  // namespace temporal::morph

@@ -1,5 +1,6 @@
 // Hold-type blur under smooth pursuit (seed 004 section 3).
 #include "temporal/morph/hold_blur.h"
+#include "temporal/morph/methods.h"
 #include "temporal/morph/morph.h"
 
 #include "synthetic.h"
@@ -8,7 +9,7 @@
 
 #include <cmath>
 
-namespace temporal {
+namespace temporal::morph {
 namespace {
 
 // A vertical step edge at x = edge (0 left, 1 right), all channels.
@@ -67,9 +68,9 @@ TEST(HoldBlur, BadInput) {
 }
 
 }  // namespace
-}  // namespace temporal
+}  // namespace temporal::morph
 
-namespace temporal {
+namespace temporal::morph {
 namespace {
 
 // Seed 004's claim on a synthetic pan: what a tracking eye sees of `didyk` (40 -> 120 Hz) is closer to the
@@ -84,7 +85,8 @@ TEST(HoldBlur, DidykIsPerceivedCloserToNative120HzThanRepeat) {
   Image rendered = frame120(3);  // 40 Hz frame 1 = 120 Hz frame 3
   Image gb40 = test::make_gbuffer(w, h, [&](int, int, float& mx, float& my, float& d) { mx = -3.0f * v120; my = 0.0f; d = 3.0f; });
   MorphOptions o;
-  o.min_blur = 1.0f;  // the paper's interleaving of a sharpened and blurred frames, everywhere
+  // The paper's interleaving of a sharpened and blurred frames, everywhere.
+  ASSERT_TRUE(apply_args(params(o), {"--min-blur", "1"}));
   Morpher m(o);
   std::vector<Image> slots;
   ASSERT_TRUE(m.process(rendered, &gb40, nullptr, slots));
@@ -155,4 +157,4 @@ TEST(LagAlignment, WithoutMotionThereIsNoLag) {
 }
 
 }  // namespace
-}  // namespace temporal
+}  // namespace temporal::morph

@@ -19,9 +19,9 @@
 #include <stdexcept>
 
 // The tool's file and colour services (morph-120hz passes the same).
-static const temporal::MorphStageIO kMorphIO{&temporal::read_exr_rgb, &temporal::load_display_gamma};
+static const temporal::morph::MorphStageIO kMorphIO{&temporal::read_exr_rgb, &temporal::load_display_gamma};
 
-namespace temporal {
+namespace temporal::morph {
 namespace {
 
 constexpr int kW = 32, kH = 12;
@@ -149,4 +149,4 @@ TEST_F(LatencyScoring, WithoutTheOptionNothingChanges) {
 }
 
 }  // namespace
-}  // namespace temporal
+}  // namespace temporal::morph

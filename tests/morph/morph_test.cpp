@@ -1,5 +1,6 @@
 // Grid morphing (seed 004 sections 5-6) against analytically known in-between frames, and the baselines.
 #include "temporal/morph/grid_warp.h"
+#include "temporal/morph/methods.h"
 #include "temporal/morph/morph.h"
 
 #include "synthetic.h"
@@ -8,7 +9,7 @@
 
 #include <cmath>
 
-namespace temporal {
+namespace temporal::morph {
 namespace {
 
 struct ErrorStats {
@@ -153,7 +154,7 @@ TEST(Didyk, SnappingToTheMotionDiscontinuityReducesTearing) {
   Image color = s.color(), gb = s.gbuffer();
   auto run = [&](bool snap) {
     MorphOptions o;
-    o.grid.snap = snap;
+    if (!snap) EXPECT_TRUE(apply_args(params(o), {"--no-snap"}));  // didyk's own parameter (DidykOptions)
     Morpher m(o);
     std::vector<Image> out;
     EXPECT_TRUE(m.process(color, &gb, nullptr, out));
@@ -221,7 +222,7 @@ TEST(Didyk, AnyCellSizeAndImageSizeNotAMultipleOfTheCell) {
   });
   for (int cell : {2, 4, 8, 16, 32}) {
     MorphOptions o;
-    o.grid.cell = cell;
+    ASSERT_TRUE(apply_args(params(o), {"--grid", std::to_string(cell)}));
     o.debug_layers = true;
     Morpher m(o);
     std::vector<Image> out;
@@ -298,7 +299,7 @@ TEST(MorphBadInput, ClearErrors) {
   EXPECT_NE(s.error().message.find("factor"), std::string::npos);
 
   o.factor = 3;
-  o.grid.cell = 6;
+  ASSERT_TRUE(apply_args(params(o), {"--grid", "6"}));  // inside --grid's range; not a power of two
   s = Morpher(o).process(color, &small, nullptr, out);
   ASSERT_FALSE(s);
   EXPECT_NE(s.error().message.find("power of two"), std::string::npos);
@@ -311,4 +312,4 @@ TEST(MorphBadInput, ClearErrors) {
 }
 
 }  // namespace
-}  // namespace temporal
+}  // namespace temporal::morph

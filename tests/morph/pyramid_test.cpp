@@ -9,7 +9,7 @@
 #include <random>
 #include <vector>
 
-namespace temporal {
+namespace temporal::morph {
 namespace {
 
 TEST(MaxPyramid, MatchesBruteForceMaximumAndPositionWithOffsetBlocks) {
@@ -99,4 +99,4 @@ TEST(BlurPyramid, BlursAnImpulseIntoASymmetricNormalisedKernel) {
 }
 
 }  // namespace
-}  // namespace temporal
+}  // namespace temporal::morph

@@ -12,38 +12,51 @@
 #include <set>
 
 // The tool's file and colour services (morph-120hz passes the same).
-static const temporal::MorphStageIO kMorphIO{&temporal::read_exr_rgb, &temporal::load_display_gamma};
+static const temporal::morph::MorphStageIO kMorphIO{&temporal::read_exr_rgb, &temporal::load_display_gamma};
 
-namespace temporal {
+namespace temporal::morph {
 namespace {
 
 TEST(MorphRegistry, ListsEveryMethodWithWhatItReadsAndItsLatency) {
   std::vector<std::string> names;
-  for (const auto& m : morph_methods()) {
-    names.push_back(m.name);
-    EXPECT_FALSE(m.summary.empty()) << m.name;
-    EXPECT_NE(m.make, nullptr) << m.name;
+  const MorphOptions defaults;
+  for (const MethodEntry* e : registry()) {
+    names.push_back(e->info.name);
+    EXPECT_FALSE(e->info.summary.empty()) << e->info.name;
+    EXPECT_NE(find_implementation(*e, kCpuDevice), nullptr) << e->info.name << " has no CPU implementation";
+    EXPECT_FALSE(e->info.has_state) << e->info.name << ": no morph method keeps a history";
+    EXPECT_TRUE(e->info.latency_frames) << e->info.name << " must say its latency";
   }
   EXPECT_EQ(names, (std::vector<std::string>{"didyk", "repeat", "blend", "warp"}));  // didyk first: the default
-  auto entry = [](const char* name) { return *find_morph_method(name); };
-  EXPECT_EQ(entry("didyk")->gbuffer_layers, (std::vector<std::string>{"motion", "depth"}));
-  EXPECT_EQ(entry("warp")->gbuffer_layers, (std::vector<std::string>{"motion", "depth"}));
-  EXPECT_TRUE(entry("repeat")->gbuffer_layers.empty());
-  EXPECT_TRUE(entry("blend")->gbuffer_layers.empty());
+  auto layers = [&](const char* name) {
+    std::vector<std::string> l;
+    for (const LayerNeed& n : find_entry(name)->layers(defaults)) l.push_back(n.layer);
+    return l;
+  };
+  EXPECT_EQ(layers("didyk"), (std::vector<std::string>{"motion", "depth"}));
+  EXPECT_EQ(layers("warp"), (std::vector<std::string>{"motion", "depth"}));
+  EXPECT_TRUE(layers("repeat").empty());
+  EXPECT_TRUE(layers("blend").empty());
   // Only blend looks one rendered frame ahead, and so adds one rendered frame of latency.
-  for (const auto& m : morph_methods()) {
-    EXPECT_EQ(m.lookahead, m.name == "blend" ? 1 : 0) << m.name;
-    EXPECT_EQ(m.latency_frames, m.name == "blend" ? 1 : 0) << m.name;
+  for (const MethodEntry* e : registry()) {
+    EXPECT_EQ(e->lookahead, e->info.name == "blend" ? 1 : 0) << e->info.name;
+    EXPECT_EQ(e->info.latency_frames.value_or(-1), e->info.name == "blend" ? 1 : 0) << e->info.name;
   }
-  EXPECT_EQ(MorphOptions{}.method, "didyk");
+  EXPECT_EQ(defaults.method, "didyk");
+  EXPECT_EQ(find_entry("bilinear"), nullptr);
 }
 
 TEST(MorphRegistry, UnknownMethodIsAUsageErrorListingTheNames) {
-  auto m = find_morph_method("bilinear");
-  ASSERT_FALSE(m);
-  EXPECT_EQ(m.error().kind, ErrorKind::Usage);
-  EXPECT_NE(m.error().message.find("didyk, repeat, blend, warp"), std::string::npos) << m.error().message;
   MorphOptions o;
+  o.method = "bilinear";
+  const Status c = check(o);
+  ASSERT_FALSE(c);
+  EXPECT_EQ(c.error().kind, ErrorKind::Usage);
+  EXPECT_NE(c.error().message.find("didyk, repeat, blend, warp"), std::string::npos) << c.error().message;
+  EXPECT_EQ(c.error().message.find("did you mean"), std::string::npos) << "bilinear is no typo of a method";
+  o.method = "didy";
+  EXPECT_NE(check(o).error().message.find("(did you mean 'didyk'?)"), std::string::npos) << check(o).error().message;
+
   o.method = "bilinear";
   std::vector<Image> out;
   Image color = test::make_color(8, 8, [](float, float, int) { return 0.5f; });
@@ -62,19 +75,20 @@ TEST(MorphRegistry, EveryMethodReproducesAStaticFrameExactly) {
     mx = my = 0.0f;
     d = 3.0f;
   });
-  for (const auto& m : morph_methods()) {
+  for (const MethodEntry* e : registry()) {
+    const std::string& name = e->info.name;
     MorphOptions o;
-    o.method = m.name;
+    o.method = name;
     o.debug_layers = true;
     Morpher morpher(o);
     std::vector<Image> out;
-    ASSERT_TRUE(morpher.process(color, &gb, &color, out)) << m.name;
-    ASSERT_EQ(out.size(), 3u) << m.name;
+    ASSERT_TRUE(morpher.process(color, &gb, &color, out)) << name;
+    ASSERT_EQ(out.size(), 3u) << name;
     for (std::size_t k = 0; k < out.size(); ++k) {
       for (const char* ch : {"R", "G", "B"})
         for (std::size_t i = 0; i < color.pixel_count(); ++i)
-          ASSERT_NEAR(out[k].plane(ch)[i], color.plane(ch)[i], 1e-6f) << m.name << " slot " << k << " " << ch << " pixel " << i;
-      for (const char* ch : kMorphDebugLayers) EXPECT_TRUE(out[k].has_channel(ch)) << m.name << " " << ch;
+          ASSERT_NEAR(out[k].plane(ch)[i], color.plane(ch)[i], 1e-6f) << name << " slot " << k << " " << ch << " pixel " << i;
+      for (const char* ch : kMorphDebugLayers) EXPECT_TRUE(out[k].has_channel(ch)) << name << " " << ch;
     }
   }
 }
@@ -102,16 +116,17 @@ TEST(MorphStageParams, EveryFlagOnceBoundToTheLibraryDefaults) {
   EXPECT_EQ(value("--window"), "3");
   // Inverted flags read "off" while the feature they turn off is on.
   EXPECT_EQ(value("--no-snap"), "off");
-  o.morph.grid.snap = false;
+  ASSERT_TRUE(apply_args(params, {"--no-snap"}));
   EXPECT_EQ(value("--no-snap"), "on");
   // Range checks come from the list: factor 1, a blur floor above 1 and a NaN gamma are usage errors.
   o.morph.factor = 1;
   EXPECT_FALSE(check_params(params));
   o.morph.factor = 3;
   EXPECT_TRUE(check_params(params));
-  o.morph.min_blur = 1.5f;
+  EXPECT_FALSE(apply_args(params, {"--min-blur", "1.5"}));
   EXPECT_FALSE(check_params(params));
-  o.morph.min_blur = 0.0f;
+  ASSERT_TRUE(apply_args(params, {"--min-blur", "0"}));
+  EXPECT_TRUE(check_params(params));
   o.morph.gamma = std::numeric_limits<float>::quiet_NaN();
   const Status s = check_params(params);
   ASSERT_FALSE(s);
@@ -135,12 +150,12 @@ TEST(MorphStage, InvalidOptionsAreRefusedBeforeAnyFrameIsRead) {
   o.morph.method = "nope";
   EXPECT_FALSE(make_morph_stage(o, kMorphIO));
   o.morph.method = "didyk";
-  o.morph.grid.cell = 6;
+  ASSERT_TRUE(apply_args(morph_stage_params(o), {"--grid", "6"}));
   auto s = make_morph_stage(o, kMorphIO);
   ASSERT_FALSE(s);
   EXPECT_EQ(s.error().kind, ErrorKind::Usage);
   EXPECT_NE(s.error().message.find("power of two"), std::string::npos);
-  o.morph.grid.cell = 8;
+  ASSERT_TRUE(apply_args(morph_stage_params(o), {"--grid", "8"}));
   o.display = "no_such_display";
   EXPECT_FALSE(make_morph_stage(o, kMorphIO));
   o.display.clear();
@@ -163,4 +178,4 @@ TEST(MorphStage, InvalidOptionsAreRefusedBeforeAnyFrameIsRead) {
 }
 
 }  // namespace
-}  // namespace temporal
+}  // namespace temporal::morph

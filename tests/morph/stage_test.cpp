@@ -15,9 +15,9 @@
 #include <limits>
 
 // The tool's file and colour services (morph-120hz passes the same).
-static const temporal::MorphStageIO kMorphIO{&temporal::read_exr_rgb, &temporal::load_display_gamma};
+static const temporal::morph::MorphStageIO kMorphIO{&temporal::read_exr_rgb, &temporal::load_display_gamma};
 
-namespace temporal {
+namespace temporal::morph {
 namespace {
 
 class MorphStageRun : public ::testing::Test {
@@ -236,4 +236,4 @@ TEST_F(MorphStageRun, ClearErrors) {
 }
 
 }  // namespace
-}  // namespace temporal
+}  // namespace temporal::morph

@@ -13,6 +13,7 @@
 namespace {
 
 using namespace temporal;
+using namespace temporal::phlm;
 const std::vector<std::string> kRgb = {"R", "G", "B"};
 
 Image make_frame(int w, int h, const std::function<float(int, int, int)>& f) {

@@ -1,6 +1,7 @@
 // filter-phlm's command line: every method on a tiny synthetic sequence, --state-out / --state-in resume,
 // errors and exit codes.
 #include "temporal/io/exr.h"
+#include "temporal/phlm/filters.h"
 
 #include "test_support.h"
 
@@ -15,6 +16,7 @@
 namespace {
 
 using namespace temporal;
+using namespace temporal::phlm;
 namespace fs = std::filesystem;
 
 // Writes frames 0..n-1 of a noisy 12x10 colour sequence with a G-buffer (motion 0.5 px right).
@@ -145,6 +147,10 @@ TEST(FilterPhlmCli, ErrorsAndExitCodes) {
   EXPECT_EQ(test::run_command(tool() + in + " --out " + (dir / "o.####.exr").string() + " --method fxaa --state-out " +
                                   (dir / "s.exr").string(), &out), 1) << out;
   EXPECT_EQ(test::run_command(tool() + in + " --out " + (dir / "o.####.exr").string() + " --method nope", &out), 1);
+  // The wording every method tool shares, with the closest name (temporal/core/suggest.h).
+  EXPECT_EQ(test::run_command(tool() + in + " --out " + (dir / "o.####.exr").string() + " --method phml", &out), 1);
+  EXPECT_NE(out.find("--method 'phml' is not one of: phlm, taa, ema, fxaa (did you mean 'phlm'?)"), std::string::npos)
+      << out;
   // A G-buffer without motion.
   Image g(12, 10);
   g.add_channel("depth.Z", 1.0f);
@@ -194,6 +200,23 @@ TEST(FilterPhlmCli, BadRunsLoseNothing) {
                                   " --state-in " + (dir / "bad_state.exr").string(), &out), 2) << out;
   EXPECT_NE(out.find("positive definite"), std::string::npos) << out;
   EXPECT_EQ(checksum(), before);
+}
+
+// --list-methods and --list-methods-json print the registry (pipelines/filter-phlm.sh and the workflow read them).
+TEST(FilterPhlmCli, ListMethodsPrintsTheRegistry) {
+  std::string out;
+  ASSERT_EQ(test::run_command(tool() + " --list-methods 2>/dev/null", &out), 0) << out;
+  std::string expected;
+  for (const MethodEntry* e : registry())
+    expected += e->info.name + "\t--method " + e->info.name + "\t" + e->info.summary + "\n";
+  EXPECT_EQ(out, expected);
+  ASSERT_EQ(test::run_command(tool() + " --list-methods-json 2>/dev/null", &out), 0) << out;
+  EXPECT_NE(out.find("{\"name\": \"phlm\", \"method\": \"phlm\", \"args\": [], \"summary\": "), std::string::npos)
+      << out;
+  EXPECT_NE(out.find("\"stateful\": true, \"implementations\": [\"cpu\"]}"), std::string::npos) << out;
+  EXPECT_NE(out.find("{\"name\": \"fxaa\""), std::string::npos) << out;
+  EXPECT_NE(out.find("\"stateful\": false, \"implementations\": [\"cpu\"]}"), std::string::npos)
+      << "fxaa is spatial: " << out;
 }
 
 }  // namespace

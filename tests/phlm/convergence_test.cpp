@@ -26,6 +26,7 @@
 namespace {
 
 using namespace temporal;
+using namespace temporal::phlm;
 
 constexpr float kLo = 0.1f, kHi = 0.9f;
 constexpr int kW = 32, kH = 24;

@@ -14,6 +14,7 @@
 namespace {
 
 using namespace temporal;
+using namespace temporal::phlm;
 
 const std::vector<std::string> kRgb = {"R", "G", "B"};
 

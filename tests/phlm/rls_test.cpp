@@ -9,6 +9,7 @@
 namespace {
 
 using namespace temporal;
+using namespace temporal::phlm;
 
 // Direct eq. 6-7 on a full double matrix.
 void direct_step(double P[4][4], double beta[3][4], const double x[4], const double y[3], double lambda) {

@@ -139,7 +139,7 @@ TEST(UpsampleCli, StateFilesResumeBitIdentically) {
     const fs::path whole = dir / (v.name + "_whole"), parts = dir / (v.name + "_parts");
     const std::string state = (dir / (v.name + ".state.exr")).string();
     const std::string first = base + args + " --out " + (parts / "o.####.exr").string() + " --frames 0-2";
-    if (!temporal::upsample::find_method(v.method)->has_state) {
+    if (!temporal::upsample::find_entry(v.method)->info.has_state) {
       EXPECT_EQ(temporal::test::run_command(first + " --state-out " + state, &output), 1) << output;
       EXPECT_NE(output.find("no state"), std::string::npos) << output;
       continue;
@@ -191,4 +191,29 @@ TEST(UpsampleCli, ListMethods) {
     EXPECT_NE(output.find(v.name + "\t--method " + v.method), std::string::npos) << output;
   EXPECT_NE(output.find("herzog-lagged\t--method herzog --lagged-wf\t"), std::string::npos) << output;
   EXPECT_NE(output.find("*-demod\t--demodulate\t"), std::string::npos) << output;
+  // The machine-readable form (temporal/core/method.h, apps/common/method_list.h): one object per method and
+  // variant with its statefulness and implementations, then the name suffixes.
+  ASSERT_EQ(temporal::test::run_command(tool() + " --list-methods-json", &output), 0) << output;
+  EXPECT_NE(output.find("{\"name\": \"spatial\", \"method\": \"spatial\", \"args\": [], \"summary\": "),
+            std::string::npos)
+      << output;
+  EXPECT_NE(output.find("\"stateful\": false, \"implementations\": [\"cpu\"]}"), std::string::npos) << output;
+  EXPECT_NE(output.find("{\"name\": \"herzog-lagged\", \"method\": \"herzog\", \"args\": [\"--lagged-wf\"]"),
+            std::string::npos)
+      << output;
+  EXPECT_NE(output.find("{\"suffix\": \"-demod\", \"args\": [\"--demodulate\"]"), std::string::npos) << output;
+  EXPECT_EQ(output.find("latency_frames"), std::string::npos) << "upsample-st has no notion of latency";
+}
+
+// An unknown method names the choices and the closest one (the same wording in every method tool).
+TEST(UpsampleCli, UnknownMethodSuggestsTheClosest) {
+  std::string output;
+  EXPECT_EQ(temporal::test::run_command(tool() + " --gbuffer g.####.exr --input s.####.exr --out o.####.exr "
+                                                 "--method herzg",
+                                        &output),
+            1);
+  EXPECT_NE(output.find("--method 'herzg' is not one of: spatial, temporal, herzog, drobot, taau (did you mean "
+                        "'herzog'?)"),
+            std::string::npos)
+      << output;
 }

@@ -72,7 +72,7 @@ Image saved_state(const up::Options& o, int frames, const std::string& name) {
 TEST(UpsampleState, ResumedRunIsBitIdentical) {
   const int split = 5, frames = 12;  // split inside the first pattern cycle, end in the second
   for (const up::MethodVariant& v : up::method_variants()) {
-    if (!up::find_method(v.method)->has_state) continue;
+    if (!up::find_entry(v.method)->info.has_state) continue;
     const up::Options o = options(v);
     up::Upsampler whole(o);
     std::vector<Image> expected;

@@ -1,6 +1,8 @@
 // Method parameters (temporal/core/params.h): text forms and range checks.
 #include "temporal/core/params.h"
 
+#include "temporal/core/suggest.h"
+
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
@@ -66,7 +68,7 @@ Status check_param(const Param& p) {
     if (p.choices.empty()) return Status::ok();
     for (const auto& c : p.choices)
       if (**s == c) return Status::ok();
-    return Error::usage(p.flag + " '" + **s + "' is not " + param_range_text(p));
+    return not_one_of(p.flag, **s, p.choices);
   }
   if (std::holds_alternative<bool*>(p.value)) return Status::ok();
   const double v = std::visit(
@@ -95,7 +97,7 @@ Status apply_args(const ParamList& params, const std::vector<std::string>& args)
       if (candidate.flag == args[i]) p = &candidate;
     if (!p) return Error::usage("unknown parameter '" + args[i] + "'");
     if (auto* b = std::get_if<bool*>(&p->value)) {
-      **b = true;
+      **b = !p->inverted;  // an inverted flag (--no-snap) clears its field
       continue;
     }
     if (i + 1 == args.size()) return Error::usage(p->flag + " needs a value");

@@ -6,10 +6,10 @@
 
 #include <algorithm>
 
-namespace temporal {
+namespace temporal::morph {
 namespace {
 
-using namespace morph_detail;
+using namespace detail;
 
 class Blend final : public MorphMethod {
  public:
@@ -35,14 +35,18 @@ class Blend final : public MorphMethod {
 
 }  // namespace
 
-MorphMethodInfo blend_method() {
-  MorphMethodInfo m;
-  m.name = "blend";
-  m.summary = "linear-light blend of frames n and n+1 (sees the next frame: one rendered frame of latency)";
-  m.lookahead = 1;
-  m.latency_frames = 1;
-  m.make = [](const MorphOptions&) -> std::unique_ptr<MorphMethod> { return std::make_unique<Blend>(); };
-  return m;
+const MethodEntry& blend_method() {
+  static const MethodEntry entry{
+      .info = {.name = "blend",
+               .summary = "linear-light blend of frames n and n+1 (sees the next frame: one rendered frame of latency)",
+               .latency_frames = 1},
+      .layers = [](const MorphOptions&) { return std::vector<LayerNeed>{}; },
+      .implementations = {{kCpuDevice, [](const MorphOptions&) -> std::unique_ptr<MorphMethod> {
+                             return std::make_unique<Blend>();
+                           }}},
+      .lookahead = 1,
+  };
+  return entry;
 }
 
-}  // namespace temporal
+}  // namespace temporal::morph

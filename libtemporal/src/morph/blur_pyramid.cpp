@@ -11,7 +11,7 @@
 #include <cmath>
 #include <cstring>
 
-namespace temporal {
+namespace temporal::morph {
 
 namespace {
 
@@ -161,4 +161,4 @@ void BlurPyramid::reconstruct(float level, std::span<float* const> out) const {
   reconstruct_level(l0 + 1, out.data(), w1, true);
 }
 
-}  // namespace temporal
+}  // namespace temporal::morph

@@ -21,16 +21,15 @@
 #include "temporal/morph/blur_pyramid.h"
 #include "temporal/morph/grid_warp.h"
 #include "temporal/morph/methods.h"
-#include "temporal/morph/morph_stage.h"
 
 #include <algorithm>
 #include <cmath>
 #include <limits>
 
-namespace temporal {
+namespace temporal::morph {
 namespace {
 
-using namespace morph_detail;
+using namespace detail;
 
 // Section 5.1 on pixels [i0, i1) of one channel, in linear light: o = original (= v^g), v and l = display
 // values of the original and its low-pass, bs = blur sum B. Writes the rendered frame's value (L + H')^g and the
@@ -71,9 +70,52 @@ inline float smoothstep(float lo, float hi, float x) {
   return t * t * (3.0f - 2.0f * t);
 }
 
+// didyk's own parameters (the display's gamma and the viewer's pixels per degree are the run's, MorphOptions).
+struct DidykOptions {
+  GridOptions grid;         // cell size and snapping (the eye-tracking limit's fields come from MorphOptions)
+  float blur_level = 2.0f;  // pyramid level read for the low-pass layer L (fractional allowed)
+  // Smooth-step from cell distortion to blur strength of the in-between frames: 0 below distortion_low,
+  // 1 above distortion_high (section 5.1, "Selective Blur").
+  float distortion_low = 0.05f;
+  float distortion_high = 0.5f;
+  float min_blur = 0.0f;   // blur strength floor in [0, 1] (1: blur every in-between frame fully, as [CKL*05])
+  bool compensate = true;  // high-frequency compensation of the rendered frame (section 5.1)
+
+  ParamList params() {
+    const double inf = std::numeric_limits<double>::infinity();
+    return {
+        Param::integer("--grid", "Grid cell size in pixels, a power of two (seed 004: 8)", &grid.cell, 2, 32),
+        Param::real("--snap-threshold", "Smallest motion difference (px per input frame) a vertex snaps to",
+                    &grid.snap_threshold, 0, inf),
+        Param::flag_off("--no-snap", "Keep the grid regular (no snapping to motion discontinuities)", &grid.snap),
+        Param::real("--blur-level", "Blur pyramid level read for the low-pass layer (fractional allowed)", &blur_level,
+                    0, 8),
+        Param::real("--distortion-low", "Cell distortion (fraction of a cell) where the in-between blur starts",
+                    &distortion_low, 0, inf),
+        Param::real("--distortion-high", "Cell distortion where the in-between frame is fully blurred",
+                    &distortion_high, 0, inf),
+        Param::real("--min-blur", "Blur strength floor of the in-between frames (1: blur everywhere, [CKL*05])",
+                    &min_blur, 0, 1),
+        Param::flag_off("--no-compensation", "Do not add compensating high frequencies to the rendered frame",
+                        &compensate),
+    };
+  }
+  // What a range cannot say (the pyramid and the snapping work on power-of-two cells).
+  Status check() const {
+    const int c = grid.cell;
+    if (c < 2 || c > 32 || (c & (c - 1)) != 0)
+      return Error::usage("--grid must be a power of two from 2 to 32 (got " + std::to_string(c) + ")");
+    if (!(blur_level >= 0.0f && blur_level <= 8.0f)) return Error::usage("--blur-level must be in [0, 8]");
+    return Status::ok();
+  }
+};
+
 class Didyk final : public MorphMethod {
  public:
-  explicit Didyk(const MorphOptions& options) : options_(options) {}
+  Didyk(const MorphOptions& options, const DidykOptions& didyk) : options_(options), didyk_(didyk) {
+    didyk_.grid.pixels_per_degree = options.pixels_per_degree;
+    didyk_.grid.fps = options.fps;
+  }
 
   void run(const Image& color, const Image* gbuffer, const Image*, std::vector<Image>& out, MorphTimings& t) override {
     using clock = std::chrono::steady_clock;
@@ -84,7 +126,7 @@ class Didyk final : public MorphMethod {
     // --- flow: snapped grid and damped vertex motion (section 6).
     auto t0 = clock::now();
     grid_builder_.build(gbuffer->plane("motion.X"), gbuffer->plane("motion.Y"), depth, color.width(), color.height(),
-                        options_.grid, grid_);
+                        didyk_.grid, grid_);
     t.flow_ms = ms_since(t0);
     // --- morph (part 1): warped vertices, distortion and blur strength of each in-between slot.
     t0 = clock::now();
@@ -123,7 +165,7 @@ class Didyk final : public MorphMethod {
       auto& b = vblur_[k];
       b.resize(nv);
       for (std::size_t v = 0; v < nv; ++v) {
-        b[v] = std::max(options_.min_blur, smoothstep(options_.distortion_low, options_.distortion_high, vdist_[k][v]));
+        b[v] = std::max(didyk_.min_blur, smoothstep(didyk_.distortion_low, didyk_.distortion_high, vdist_[k][v]));
         blur_sum_[v] += b[v];
       }
     }
@@ -144,8 +186,8 @@ class Didyk final : public MorphMethod {
     }
     const float* vplanes[3] = {P(kV), P(kV + 1), P(kV + 2)};
     float* lplanes[3] = {P(kL), P(kL + 1), P(kL + 2)};
-    pyramid_.build(vplanes, w, h, std::max(1, int(std::ceil(options_.blur_level))));
-    pyramid_.reconstruct(options_.blur_level, lplanes);
+    pyramid_.build(vplanes, w, h, std::max(1, int(std::ceil(didyk_.blur_level))));
+    pyramid_.reconstruct(didyk_.blur_level, lplanes);
     // N_eff - 1 = sum_k b_k at every source pixel: the per-vertex sums drawn on the unwarped (snapped) grid.
     const float* attrs[1] = {blur_sum_.data()};
     float* attr_out[1] = {P(kBSum)};
@@ -156,7 +198,7 @@ class Didyk final : public MorphMethod {
     rasterizer_.draw(grid_, grid_.x, grid_.y, r);
     // Section 5.1 per channel, in linear light where possible: with o = v^g and Lg = L^g the rendered frame's
     // (L + H')^g is (1 + B) o - B Lg, so only L^g needs a power. Branch-free: the loop vectorises.
-    const bool comp = options_.compensate;
+    const bool comp = didyk_.compensate;
     for (int c = 0; c < 3; ++c) {
       const float* o = color.plane(kRGB[c]);
       const float* v = P(kV + c);
@@ -224,6 +266,7 @@ class Didyk final : public MorphMethod {
   }
 
   MorphOptions options_;
+  DidykOptions didyk_;  // with the eye-tracking limit of options_
   GridBuilder grid_builder_;
   GridRasterizer rasterizer_;
   BlurPyramid pyramid_;
@@ -233,53 +276,20 @@ class Didyk final : public MorphMethod {
   std::vector<float> cells_, blur_sum_;                 // per cell; per vertex
 };
 
-ParamList didyk_params(MorphStageOptions& o) {
-  MorphOptions& m = o.morph;
-  ViewingOptions& v = o.viewing;
-  const double inf = std::numeric_limits<double>::infinity();
-  return {
-      Param::real("--gamma", "Display gamma g of the compensation H' (displayed light = value^g)", &m.gamma, 0.1, 10),
-      {.flag = "--display",
-       .help = "Display colour space whose gamma to use (e.g. gamma22_display, srgb_display); excludes --gamma",
-       .value = &o.display},
-      {.flag = "--ocio",
-       .help = "OpenColorIO config for --display (default: $OCIO, else the built-in config)",
-       .value = &o.ocio},
-      Param::integer("--grid", "Grid cell size in pixels, a power of two (seed 004: 8)", &m.grid.cell, 2, 32),
-      Param::real("--snap-threshold", "Smallest motion difference (px per input frame) a vertex snaps to",
-                  &m.grid.snap_threshold, 0, inf),
-      Param::flag_off("--no-snap", "Keep the grid regular (no snapping to motion discontinuities)", &m.grid.snap),
-      Param::real("--blur-level", "Blur pyramid level read for the low-pass layer (fractional allowed)", &m.blur_level,
-                  0, 8),
-      Param::real("--distortion-low", "Cell distortion (fraction of a cell) where the in-between blur starts",
-                  &m.distortion_low, 0, inf),
-      Param::real("--distortion-high", "Cell distortion where the in-between frame is fully blurred",
-                  &m.distortion_high, 0, inf),
-      Param::real("--min-blur", "Blur strength floor of the in-between frames (1: blur everywhere, [CKL*05])",
-                  &m.min_blur, 0, 1),
-      Param::flag_off("--no-compensation", "Do not add compensating high frequencies to the rendered frame",
-                      &m.compensate),
-      Param::real("--ppd", "Pixels per degree of visual angle; 0 derives it from the screen geometry", &v.ppd, 0, 1e4),
-      Param::real("--screen-width-m", "Screen width in metres (default: the paper's 22\" Samsung 2233RZ)",
-                  &v.screen_width_m, 0.01, 100),
-      Param::real("--distance-m", "Viewing distance in metres", &v.distance_m, 0.01, 100),
-      Param::integer("--pixels-x", "Pixels across the screen (images are shown 1:1); 0: the image fills the screen width",
-                     &v.pixels_x, 0, 1 << 20),
-      Param::flag_off("--no-tracking-limit", "Disable the 70-90 deg/s eye-tracking damping (section 6)",
-                      &v.tracking_limit),
-  };
-}
-
 }  // namespace
 
-MorphMethodInfo didyk_method() {
-  MorphMethodInfo m;
-  m.name = "didyk";
-  m.summary = "seed 004: snapped grid morph along the motion, selective blur, high-frequency compensation";
-  m.gbuffer_layers = {"motion", "depth"};
-  m.params = didyk_params;
-  m.make = [](const MorphOptions& o) -> std::unique_ptr<MorphMethod> { return std::make_unique<Didyk>(o); };
-  return m;
+const MethodEntry& didyk_method() {
+  static const MethodEntry entry{
+      .info = {.name = "didyk",
+               .summary = "seed 004: snapped grid morph along the motion, selective blur, high-frequency compensation",
+               .latency_frames = 0},
+      .make_options = OptionsOf<DidykOptions>::make,
+      .layers = [](const MorphOptions&) { return std::vector<LayerNeed>{{"motion"}, {"depth"}}; },
+      .implementations = {{kCpuDevice, [](const MorphOptions& o) -> std::unique_ptr<MorphMethod> {
+                             return std::make_unique<Didyk>(o, method_options<DidykOptions>(o.per_method, "didyk"));
+                           }}},
+  };
+  return entry;
 }
 
-}  // namespace temporal
+}  // namespace temporal::morph

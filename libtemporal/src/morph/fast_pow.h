@@ -6,7 +6,7 @@
 #include <bit>
 #include <cstdint>
 
-namespace temporal::morph_detail {
+namespace temporal::morph::detail {
 
 // log2(x) for x > 0 (normal floats): exponent from the bits, mantissa m in [sqrt(1/2), sqrt(2)) through the
 // atanh series 2/ln2 * (t + t^3/3 + t^5/5 + t^7/7 + t^9/9), t = (m-1)/(m+1), |t| <= 0.172.
@@ -42,4 +42,4 @@ inline float fast_pow(float x, float p) {
   return x > 1e-30f ? r : 0.0f;
 }
 
-}  // namespace temporal::morph_detail
+}  // namespace temporal::morph::detail

@@ -14,7 +14,7 @@
 #include <cmath>
 #include <limits>
 
-namespace temporal {
+namespace temporal::morph {
 
 float eye_tracking_factor(float degrees_per_second) {
   // Section 6: f(70) = 1 (perfect tracking), f(90) = 0 (no tracking), cubic with f'(70) = f'(90) = 0.
@@ -435,4 +435,4 @@ void draw_grid_lines(const SnappedGrid& grid, std::span<const float> tx, std::sp
   }
 }
 
-}  // namespace temporal
+}  // namespace temporal::morph

@@ -8,7 +8,7 @@
 #include <algorithm>
 #include <cmath>
 
-namespace temporal {
+namespace temporal::morph {
 
 Expected<Image> perceive_hold(std::span<const Image* const> frames, const std::vector<std::string>& channels,
                               const float* motion_x, const float* motion_y, const HoldBlurOptions& options) {
@@ -153,4 +153,4 @@ Expected<LagAlignment> align_lag(const Image& perceived, const Image& reference,
   return result;
 }
 
-}  // namespace temporal
+}  // namespace temporal::morph

@@ -8,7 +8,7 @@
 #include <algorithm>
 #include <limits>
 
-namespace temporal {
+namespace temporal::morph {
 
 namespace {
 constexpr float kNone = -std::numeric_limits<float>::infinity();
@@ -106,4 +106,4 @@ MaxPyramid::Entry MaxPyramid::at(int level, int i, int j) const {
   return e;
 }
 
-}  // namespace temporal
+}  // namespace temporal::morph

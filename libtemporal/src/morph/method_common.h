@@ -3,7 +3,7 @@
 
 #include <chrono>
 
-namespace temporal::morph_detail {
+namespace temporal::morph::detail {
 
 inline constexpr const char* kRGB[3] = {"R", "G", "B"};
 
@@ -11,4 +11,4 @@ inline double ms_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
 }
 
-}  // namespace temporal::morph_detail
+}  // namespace temporal::morph::detail

@@ -1,31 +1,57 @@
-// The registry of morph-120hz's methods (temporal/morph/methods.h): one line per method.
+// The registry of morph-120hz's methods (temporal/morph/methods.h), and what is derived from it: the options of
+// every method and the parameter list the command line binds.
 #include "temporal/morph/methods.h"
 
-namespace temporal {
+namespace temporal::morph {
 
-// Each method's entry, defined in its own source file.
-MorphMethodInfo didyk_method();   // didyk.cpp: seed 004
-MorphMethodInfo repeat_method();  // repeat.cpp
-MorphMethodInfo blend_method();   // blend.cpp
-MorphMethodInfo warp_method();    // warp.cpp
+// Every method, in the order of --help, --list-methods and the docs (didyk first: the default). Adding a method:
+// its source file defines `const MethodEntry& NAME_method()` (temporal/core/method.h: info, options, layers,
+// implementations, lookahead), declared here and listed in the table.
+const MethodEntry& didyk_method();   // didyk.cpp: seed 004
+const MethodEntry& repeat_method();  // repeat.cpp
+const MethodEntry& blend_method();   // blend.cpp
+const MethodEntry& warp_method();    // warp.cpp
 
-std::span<const MorphMethodInfo> morph_methods() {
-  static const std::vector<MorphMethodInfo> table = {
-      didyk_method(),
-      repeat_method(),
-      blend_method(),
-      warp_method(),
-  };
+const std::vector<const MethodEntry*>& registry() {
+  static const std::vector<const MethodEntry*> table = {&didyk_method(), &repeat_method(), &blend_method(),
+                                                        &warp_method()};
   return table;
 }
 
-Expected<const MorphMethodInfo*> find_morph_method(std::string_view name) {
-  std::string names;
-  for (const auto& m : morph_methods()) {
-    if (m.name == name) return &m;
-    names += (names.empty() ? "" : ", ") + m.name;
-  }
-  return Error::usage("unknown method '" + std::string(name) + "': use one of " + names);
+const MethodEntry* find_entry(std::string_view name) { return find_entry_in(registry(), name); }
+
+const std::vector<MethodVariant>& method_variants() {
+  static const std::vector<MethodVariant> list = method_variants_of(registry());
+  return list;
+}
+
+const MethodVariant* find_variant(std::string_view name) {
+  for (const MethodVariant& v : method_variants())
+    if (v.name == name) return &v;
+  return nullptr;
+}
+
+MethodOptionSet default_method_options() { return method_option_set(registry()); }
+
+ParamList params(MorphOptions& o) {
+  ParamList list = {
+      Param::choice("--method", "Method (the registry's: morph-120hz --list-methods)", &o.method,
+                    method_names(registry())),
+      Param::integer("--factor", "Output frames per input frame (40 Hz -> 120 Hz: 3)", &o.factor, 2, 32),
+      Param::real("--gamma", "Display gamma g of the compensation H' (displayed light = value^g)", &o.gamma, 0.1, 10),
+      Param::flag_on("--debug-layers", "Add debug.grid, debug.distortion, debug.blur, debug.H, debug.Hprime (didyk)",
+                     &o.debug_layers),
+  };
+  for (Param& p : method_params(registry(), o.per_method)) list.push_back(std::move(p));
+  return list;
+}
+
+Expected<MorphOptions> make_options(const std::string& method, const std::vector<std::string>& args) {
+  MorphOptions o;
+  o.method = method;
+  if (Status s = apply_args(params(o), args); !s) return s.error();
+  if (Status s = check(o); !s) return s.error();
+  return o;
 }
 
 std::vector<std::string> morph_gbuffer_channels(const std::string& layer) {
@@ -34,4 +60,4 @@ std::vector<std::string> morph_gbuffer_channels(const std::string& layer) {
   return {layer};
 }
 
-}  // namespace temporal
+}  // namespace temporal::morph

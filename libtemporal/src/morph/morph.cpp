@@ -11,7 +11,7 @@
 #include <cmath>
 #include <numbers>
 
-namespace temporal {
+namespace temporal::morph {
 
 float compensated_high_frequency(float high, float low, float frames, float gamma) {
   // Section 5.1: N (H + L)^g = (L + H')^g + (N - 1) L^g.
@@ -38,13 +38,14 @@ CompensatedValue compensate_value(float original, float low, float blurred, floa
 Morpher::Morpher(MorphOptions options) : options_(std::move(options)) {}
 
 Status Morpher::check(const Image& color, const Image* gbuffer, const Image* next) const {
-  if (Status s = check_morph_options(options_); !s) return s;
+  if (Status s = morph::check(options_); !s) return s;
   for (const char* ch : {"R", "G", "B"})
     if (!color.plane(ch))
       return Error::input({}, std::string("the colour input has no float channel '") + ch +
                                   "': pass an image with R, G, B (render-gbuffer --outputs color)");
   if (color.empty()) return Error::input({}, "the colour input is empty");
-  const auto& layers = info_->gbuffer_layers;
+  std::vector<std::string> layers;
+  for (const LayerNeed& need : entry_->layers(options_)) layers.push_back(need.layer);
   if (!layers.empty()) {
     std::string list;
     for (std::size_t i = 0; i < layers.size(); ++i) list += (i == 0 ? "" : i + 1 == layers.size() ? " and " : ", ") + layers[i];
@@ -65,7 +66,7 @@ Status Morpher::check(const Image& color, const Image* gbuffer, const Image* nex
                                   " but the colour is " + std::to_string(color.width()) + "x" +
                                   std::to_string(color.height()) + ": render both at the same size");
   }
-  if (next && info_->lookahead > 0) {
+  if (next && entry_->lookahead > 0) {
     for (const char* ch : {"R", "G", "B"})
       if (!next->plane(ch)) return Error::input({}, std::string("the next colour frame has no channel '") + ch + "'");
     if (next->width() != color.width() || next->height() != color.height())
@@ -78,26 +79,23 @@ Morpher::~Morpher() = default;
 Morpher::Morpher(Morpher&&) noexcept = default;
 Morpher& Morpher::operator=(Morpher&&) noexcept = default;
 
-Status check_morph_options(const MorphOptions& options) {
-  if (auto m = find_morph_method(options.method); !m) return m.error();
+Status check(const MorphOptions& options) {
+  if (Status s = check_method_name(registry(), options.method); !s) return s;
   if (options.factor < 2)
     return Error::usage("--factor must be at least 2 (got " + std::to_string(options.factor) + ")");
-  const int c = options.grid.cell;
-  if (c < 2 || c > 32 || (c & (c - 1)) != 0)
-    return Error::usage("--grid must be a power of two from 2 to 32 (got " + std::to_string(c) + ")");
   if (!(options.gamma > 0.0f)) return Error::usage("--gamma must be positive");
-  if (!(options.blur_level >= 0.0f && options.blur_level <= 8.0f)) return Error::usage("--blur-level must be in [0, 8]");
-  return Status::ok();
+  return check_method_options(registry(), options.per_method);
 }
 
 Status Morpher::process(const Image& color, const Image* gbuffer, const Image* next, std::vector<Image>& out,
                         MorphTimings* timings) {
   if (!method_) {
-    auto info = find_morph_method(options_.method);
-    if (!info) return info.error();
-    info_ = *info;
-    if (Status s = check_morph_options(options_); !s) return s;
-    method_ = info_->make(options_);
+    if (Status s = morph::check(options_); !s) return s;
+    entry_ = find_entry(options_.method);
+    // The CPU implementation: every method has one (a device option will choose among several).
+    const auto* implementation = find_implementation(*entry_, kCpuDevice);
+    if (!implementation) return Error::internal("--method " + options_.method + " has no CPU implementation");
+    method_ = implementation->make(options_);
   }
   if (Status s = check(color, gbuffer, next); !s) return s;
   const int w = color.width(), h = color.height();
@@ -109,10 +107,11 @@ Status Morpher::process(const Image& color, const Image* gbuffer, const Image* n
       for (const char* ch : kMorphDebugLayers) o.add_channel(ch);
   }
   MorphTimings t;
-  method_->run(color, info_->gbuffer_layers.empty() ? nullptr : gbuffer, info_->lookahead > 0 ? next : nullptr, out, t);
+  method_->run(color, entry_->layers(options_).empty() ? nullptr : gbuffer, entry_->lookahead > 0 ? next : nullptr,
+               out, t);
   if (Status s = method_->run_status(); !s) return s;
   if (timings) *timings = t;
   return Status::ok();
 }
 
-}  // namespace temporal
+}  // namespace temporal::morph

@@ -14,10 +14,10 @@
 #include <cstdlib>
 #include <optional>
 
-namespace temporal {
+namespace temporal::morph {
 namespace {
 
-using namespace morph_detail;
+using namespace detail;
 
 // NaN/Inf policy of the morph stage (conventions: counted, reported, never propagated): the runner counts and
 // reports them; here they become 0. Returns `image` itself when its `channels` are finite (the common case, no
@@ -46,6 +46,12 @@ std::vector<std::string> gbuffer_channels(const std::vector<std::string>& layers
   return channels;
 }
 
+std::vector<std::string> layer_names(const std::vector<LayerNeed>& needs) {
+  std::vector<std::string> names;
+  for (const LayerNeed& n : needs) names.push_back(n.layer);
+  return names;
+}
+
 std::string layer_list(const std::vector<std::string>& layers) {
   std::string s;
   for (std::size_t i = 0; i < layers.size(); ++i) s += (i == 0 ? "" : i + 1 == layers.size() ? " and " : ", ") + layers[i];
@@ -53,15 +59,16 @@ std::string layer_list(const std::vector<std::string>& layers) {
 }
 
 // Frame-rate conversion with a method of the registry: `factor` outputs per input frame.
-class UpsampleStage final : public FrameStage {
+class FrameRateStage final : public FrameStage {
  public:
-  UpsampleStage(const MorphStageOptions& options, const MorphMethodInfo& info)
-      : options_(options), info_(info), gbuffer_channels_(gbuffer_channels(info.gbuffer_layers)) {
+  FrameRateStage(const MorphStageOptions& options, const MethodEntry& entry)
+      : options_(options), entry_(entry), layers_(layer_names(entry.layers(options.morph))),
+        gbuffer_channels_(gbuffer_channels(layers_)) {
     inputs_.input_layers = {"rgb"};
-    for (const auto& l : info.gbuffer_layers) inputs_.gbuffer_layers.push_back({l, true});
-    inputs_.gbuffer_required = !info.gbuffer_layers.empty();
-    inputs_.gbuffer_purpose = "--method " + info.name + " reads its " + layer_list(info.gbuffer_layers);
-    inputs_.lookahead = info.lookahead;
+    for (const auto& l : layers_) inputs_.gbuffer_layers.push_back({l, true});
+    inputs_.gbuffer_required = !layers_.empty();
+    inputs_.gbuffer_purpose = "--method " + entry.info.name + " reads its " + layer_list(layers_);
+    inputs_.lookahead = entry.lookahead;
     inputs_.lookahead_past_range = false;  // the last selected frame repeats, as at the end of the sequence
     inputs_.outputs_per_frame = options.morph.factor;
   }
@@ -91,8 +98,8 @@ class UpsampleStage final : public FrameStage {
                                             "the input frames from 0");
     if (!morpher_) {  // the viewing geometry and rate of the first frame set the eye-tracking limit
       MorphOptions mo = options_.morph;
-      mo.grid.pixels_per_degree = tracking_pixels_per_degree(options_.viewing, color->width());
-      mo.grid.fps = fps;
+      mo.pixels_per_degree = tracking_pixels_per_degree(options_.viewing, color->width());
+      mo.fps = fps;
       morpher_.emplace(mo);
     }
     const auto t0 = std::chrono::steady_clock::now();
@@ -122,11 +129,11 @@ class UpsampleStage final : public FrameStage {
       o.image = &img;
       o.compute_ms = total_ms_ / n;  // the rendered frame's work produces all its slots: each gets an equal share
       o.timings_ms = {{"flow", timings_.flow_ms}, {"morph", timings_.morph_ms}, {"blur", timings_.blur_ms}};
-      o.extra = {{"method", info_.name},
+      o.extra = {{"method", entry_.info.name},
                  // In frames of the output sequence: slot k of rendered frame n can be shown only once the
                  // method's lookahead has been rendered, latency_frames rendered frames = latency_frames * n
                  // display frames later (docs/conventions.md, "Latency").
-                 {"latencyFrames", std::to_string(info_.latency_frames * n)},
+                 {"latencyFrames", std::to_string(entry_.info.latency_frames.value_or(0) * n)},
                  {"sourceFrame", std::to_string(f.frame)},
                  {"slot", std::to_string(k)}};
       o.keep_input_metadata = false;
@@ -139,15 +146,16 @@ class UpsampleStage final : public FrameStage {
     char line[200];
     std::snprintf(line, sizeof line,
                   "%s, %d slots, %.2f ms (flow %.2f, morph %.2f, blur %.2f), gamma %.3g, %.2f pixels/degree",
-                  info_.name.c_str(), options_.morph.factor, total_ms_, timings_.flow_ms, timings_.morph_ms,
+                  entry_.info.name.c_str(), options_.morph.factor, total_ms_, timings_.flow_ms, timings_.morph_ms,
                   timings_.blur_ms, double(options_.morph.gamma),
-                  double(morpher_ ? morpher_->options().grid.pixels_per_degree : 0.0f));
+                  double(morpher_ ? morpher_->options().pixels_per_degree : 0.0f));
     return line;
   }
 
  private:
   MorphStageOptions options_;
-  const MorphMethodInfo& info_;
+  const MethodEntry& entry_;
+  std::vector<std::string> layers_;  // the G-buffer layers the method reads
   std::vector<std::string> gbuffer_channels_;
   StageInputs inputs_;
   std::optional<Morpher> morpher_;
@@ -261,15 +269,25 @@ float tracking_pixels_per_degree(const ViewingOptions& v, int image_width) {
 }
 
 ParamList morph_stage_params(MorphStageOptions& o) {
-  std::vector<std::string> names;
-  for (const auto& m : morph_methods()) names.push_back(m.name);
-  ParamList params = {
-      Param::choice("--method", "Method (the registry's: morph-120hz --list-methods)", &o.morph.method, names),
-      Param::integer("--factor", "Output frames per input frame (40 Hz -> 120 Hz: 3)", &o.morph.factor, 2, 32),
+  ViewingOptions& v = o.viewing;
+  ParamList params = morph::params(o.morph);
+  const ParamList stage = {
       {.flag = "--fps", .help = "Input frame rate; 0 reads temporal:fps from the input header", .value = &o.fps,
        .min = 0.0, .max = 1e4},
-      Param::flag_on("--debug-layers", "Add debug.grid, debug.distortion, debug.blur, debug.H, debug.Hprime (didyk)",
-                     &o.morph.debug_layers),
+      {.flag = "--display",
+       .help = "Display colour space whose gamma to use (e.g. gamma22_display, srgb_display); excludes --gamma",
+       .value = &o.display},
+      {.flag = "--ocio",
+       .help = "OpenColorIO config for --display (default: $OCIO, else the built-in config)",
+       .value = &o.ocio},
+      Param::real("--ppd", "Pixels per degree of visual angle; 0 derives it from the screen geometry", &v.ppd, 0, 1e4),
+      Param::real("--screen-width-m", "Screen width in metres (default: the paper's 22\" Samsung 2233RZ)",
+                  &v.screen_width_m, 0.01, 100),
+      Param::real("--distance-m", "Viewing distance in metres", &v.distance_m, 0.01, 100),
+      Param::integer("--pixels-x", "Pixels across the screen (images are shown 1:1); 0: the image fills the screen width",
+                     &v.pixels_x, 0, 1 << 20),
+      Param::flag_off("--no-tracking-limit", "Disable the 70-90 deg/s eye-tracking damping (section 6)",
+                      &v.tracking_limit),
       Param::flag_on("--perceive",
                      "Instead of upsampling: write the image perceived on a hold-type display under smooth pursuit "
                      "(--input at its display rate, --gbuffer its display-rate motion)",
@@ -283,13 +301,7 @@ ParamList morph_stage_params(MorphStageOptions& o) {
       Param::real("--max-lag", "--perceive --lag-reference: largest lag searched, display frames", &o.lag.max_lag_frames,
                   0, 64),
   };
-  for (const auto& m : morph_methods()) {
-    if (!m.params) continue;
-    for (auto& p : m.params(o)) {
-      const bool listed = std::any_of(params.begin(), params.end(), [&](const Param& q) { return q.flag == p.flag; });
-      if (!listed) params.push_back(std::move(p));
-    }
-  }
+  params.insert(params.end(), stage.begin(), stage.end());
   return params;
 }
 
@@ -308,8 +320,7 @@ Expected<std::unique_ptr<FrameStage>> make_morph_stage(const MorphStageOptions& 
   }
   if (!options.lag_reference.empty())  // an option that would do nothing is an error, not silence
     return Error::usage("--lag-reference measures the lag of a --perceive run: add --perceive, or drop it");
-  auto info = find_morph_method(options.morph.method);
-  if (!info) return info.error();
+  if (Status s = check(options.morph); !s) return s.error();
   MorphStageOptions resolved = options;
   if (!options.display.empty()) {
     if (!io.display_gamma) return Error::usage("--display needs colour management (MorphStageIO::display_gamma)");
@@ -317,8 +328,9 @@ Expected<std::unique_ptr<FrameStage>> make_morph_stage(const MorphStageOptions& 
     if (!gamma) return gamma.error();
     resolved.morph.gamma = *gamma;
   }
-  if (Status s = check_morph_options(resolved.morph); !s) return s.error();
-  return std::unique_ptr<FrameStage>(std::make_unique<UpsampleStage>(resolved, **info));
+  if (Status s = check(resolved.morph); !s) return s.error();
+  return std::unique_ptr<FrameStage>(
+      std::make_unique<FrameRateStage>(resolved, *find_entry(resolved.morph.method)));
 }
 
-}  // namespace temporal
+}  // namespace temporal::morph

@@ -4,10 +4,10 @@
 
 #include <algorithm>
 
-namespace temporal {
+namespace temporal::morph {
 namespace {
 
-using namespace morph_detail;
+using namespace detail;
 
 class Repeat final : public MorphMethod {
  public:
@@ -22,12 +22,17 @@ class Repeat final : public MorphMethod {
 
 }  // namespace
 
-MorphMethodInfo repeat_method() {
-  MorphMethodInfo m;
-  m.name = "repeat";
-  m.summary = "every slot shows the rendered frame (the low rate held on a high-rate display)";
-  m.make = [](const MorphOptions&) -> std::unique_ptr<MorphMethod> { return std::make_unique<Repeat>(); };
-  return m;
+const MethodEntry& repeat_method() {
+  static const MethodEntry entry{
+      .info = {.name = "repeat",
+               .summary = "every slot shows the rendered frame (the low rate held on a high-rate display)",
+               .latency_frames = 0},
+      .layers = [](const MorphOptions&) { return std::vector<LayerNeed>{}; },
+      .implementations = {{kCpuDevice, [](const MorphOptions&) -> std::unique_ptr<MorphMethod> {
+                             return std::make_unique<Repeat>();
+                           }}},
+  };
+  return entry;
 }
 
-}  // namespace temporal
+}  // namespace temporal::morph

@@ -12,10 +12,10 @@
 #include <cstdint>
 #include <limits>
 
-namespace temporal {
+namespace temporal::morph {
 namespace {
 
-using namespace morph_detail;
+using namespace detail;
 
 class Warp final : public MorphMethod {
  public:
@@ -85,13 +85,17 @@ class Warp final : public MorphMethod {
 
 }  // namespace
 
-MorphMethodInfo warp_method() {
-  MorphMethodInfo m;
-  m.name = "warp";
-  m.summary = "per-pixel forward splat along the motion with a depth test, holes left black";
-  m.gbuffer_layers = {"motion", "depth"};
-  m.make = [](const MorphOptions& o) -> std::unique_ptr<MorphMethod> { return std::make_unique<Warp>(o.debug_layers); };
-  return m;
+const MethodEntry& warp_method() {
+  static const MethodEntry entry{
+      .info = {.name = "warp",
+               .summary = "per-pixel forward splat along the motion with a depth test, holes left black",
+               .latency_frames = 0},
+      .layers = [](const MorphOptions&) { return std::vector<LayerNeed>{{"motion"}, {"depth"}}; },
+      .implementations = {{kCpuDevice, [](const MorphOptions& o) -> std::unique_ptr<MorphMethod> {
+                             return std::make_unique<Warp>(o.debug_layers);
+                           }}},
+  };
+  return entry;
 }
 
-}  // namespace temporal
+}  // namespace temporal::morph

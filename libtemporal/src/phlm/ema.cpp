@@ -2,6 +2,7 @@
 #include "temporal/phlm/ema.h"
 
 #include "filter_common.h"
+#include "temporal/phlm/filters.h"
 #include "temporal/core/parallel.h"
 #include "temporal/core/reproject.h"
 
@@ -9,7 +10,7 @@
 #include <atomic>
 #include <cmath>
 
-namespace temporal {
+namespace temporal::phlm {
 
 EmaFilter::EmaFilter(EmaParams params) : params_(params) {}
 
@@ -118,4 +119,42 @@ Status EmaFilter::set_state(const Image& state, int channels) {
   return Status::ok();
 }
 
-}  // namespace temporal
+// --- Registry entry (temporal/phlm/filters.h) ------------------------------------------------------------------
+
+namespace {
+
+// ema's parameters on the command line: the fields of EmaParams (ema.h).
+struct EmaOptions : EmaParams {
+  ParamList params() {
+    return {
+        Param::real("--ema-alpha", "history weight alpha of seed 003 eq. 1", &alpha, 0.0, 1.0),
+        Param::positive("--ema-depth-tolerance",
+                        "relative depth difference of the disocclusion test (temporal/core/reproject.h)",
+                        &depth_tolerance),
+        Param::positive("--ema-warped-depth-tolerance",
+                        "the same when the G-buffer has prevDepth.Z (the warped depth, temporal/core/reproject.h)",
+                        &warped_depth_tolerance),
+    };
+  }
+};
+
+}  // namespace
+
+const MethodEntry& ema_method() {
+  static const MethodEntry entry{
+      .info = {.name = "ema",
+               .summary = "weak reference: the exponential history of seed 003 eq. 1, disocclusion by depth and id",
+               .has_state = true},
+      .make_options = OptionsOf<EmaOptions>::make,
+      .layers =
+          [](const FilterOptions&) {
+            return std::vector<LayerNeed>{{"motion"}, {"depth"}, {"id"}, {"prevDepth", false}};
+          },
+      .implementations = {{kCpuDevice, [](const FilterOptions& o) -> std::unique_ptr<FrameFilter> {
+                             return std::make_unique<EmaFilter>(method_options<EmaOptions>(o.per_method, "ema"));
+                           }}},
+  };
+  return entry;
+}
+
+}  // namespace temporal::phlm

@@ -7,7 +7,7 @@
 #include <atomic>
 #include <cmath>
 
-namespace temporal {
+namespace temporal::phlm {
 
 Status validate_filter_input(const FilterInput& in) {
   if (!in.color || in.color->empty()) return Error::input({}, "empty input image");
@@ -104,4 +104,4 @@ Status load_history(const Image& state, int channels, const char* method, Image&
 }
 
 }  // namespace detail
-}  // namespace temporal
+}  // namespace temporal::phlm

@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-namespace temporal::detail {
+namespace temporal::phlm::detail {
 
 // Marks the finite pixels of the input (valid = 1 when every filtered channel is finite) and, when
 // `want_ycgco`, converts the three channels to YCgCo planes (temporal/core/color.h). Buffers are resized only
@@ -44,4 +44,4 @@ struct TaaConfig {
 Expected<TaaConfig> resolve_taa(const TaaParams& p);
 // The frame-dependent check: `nearest` velocity needs depth when there is motion (a usage error naming the fix).
 Status check_taa_input(const TaaConfig& cfg, const FilterInput& in);
-}  // namespace temporal::detail
+}  // namespace temporal::phlm::detail

@@ -4,7 +4,7 @@
 
 #include <chrono>
 
-namespace temporal {
+namespace temporal::phlm {
 namespace {
 
 std::string dims(int w, int h) { return std::to_string(w) + "x" + std::to_string(h); }
@@ -23,30 +23,31 @@ Expected<std::vector<std::string>> layer_channels(const Image& img, const std::s
 
 class FilterStage final : public FrameStage {
  public:
-  FilterStage(const FilterOptions& options, const FilterMethod& method)
-      : options_(options), method_(method), filter_(method.create(options)) {
+  FilterStage(const FilterOptions& options, const MethodEntry& method, std::unique_ptr<FrameFilter> filter)
+      : options_(options), method_(method), filter_(std::move(filter)) {
     inputs_.input_layers = {options.layer};
-    inputs_.gbuffer_layers = method.gbuffer_layers;
+    inputs_.gbuffer_layers = method.layers(options);
     // Every parameter of the method with its value (ablation switches included), for the output headers.
     FilterOptions copy = options;
-    for (const Param& p : method.params(copy)) {
-      if (!parameters_.empty()) parameters_ += ' ';
-      parameters_ += p.flag + "=" + param_value_text(p);
-    }
+    if (MethodOptions* m = copy.per_method.find(method.info.name))
+      for (const Param& p : m->params()) {
+        if (!parameters_.empty()) parameters_ += ' ';
+        parameters_ += p.flag + "=" + param_value_text(p);
+      }
   }
   const StageInputs& inputs() const override { return inputs_; }
-  bool has_state() const override { return filter_->has_state(); }
+  bool has_state() const override { return method_.info.has_state; }
 
   Expected<Image> save_state() const override {
     Image state = filter_->saved_state();
-    state.metadata().extra["phlmStateOf"] = method_.name;
+    state.metadata().extra["phlmStateOf"] = method_.info.name;
     return state;
   }
   // The channel count is known at the first frame: the state is applied there.
   Status load_state(const Image& state) override {
     auto of = state.metadata().extra.find("phlmStateOf");
-    if (of != state.metadata().extra.end() && of->second != method_.name)
-      return Error::usage("the state was written by --method " + of->second + ", not " + method_.name +
+    if (of != state.metadata().extra.end() && of->second != method_.info.name)
+      return Error::usage("the state was written by --method " + of->second + ", not " + method_.info.name +
                           ": resume with the same method");
     pending_state_ = state;
     return Status::ok();
@@ -85,7 +86,7 @@ class FilterStage final : public FrameStage {
     o.image = &output_;
     o.compute_ms = ms_;
     o.timings_ms = {{"filter", ms_}};
-    o.extra = {{"method", method_.name}, {"methodParameters", parameters_}};
+    o.extra = {{"method", method_.info.name}, {"methodParameters", parameters_}};
     out.push_back(std::move(o));
     return Status::ok();
   }
@@ -97,7 +98,7 @@ class FilterStage final : public FrameStage {
 
  private:
   FilterOptions options_;
-  const FilterMethod& method_;
+  const MethodEntry& method_;
   std::unique_ptr<FrameFilter> filter_;
   StageInputs inputs_;
   std::optional<Image> pending_state_;
@@ -110,11 +111,10 @@ class FilterStage final : public FrameStage {
 }  // namespace
 
 Expected<std::unique_ptr<FrameStage>> make_filter_stage(const FilterOptions& options) {
-  const FilterMethod* method = find_filter_method(options.method);
-  if (!method) return Error::usage("--method must be " + filter_method_names() + " (got " + options.method + ")");
-  FilterOptions copy = options;
-  if (Status s = check_params(method->params(copy)); !s) return s.error();
-  return std::unique_ptr<FrameStage>(std::make_unique<FilterStage>(options, *method));
+  auto filter = make_filter(options);  // checks the options
+  if (!filter) return filter.error();
+  return std::unique_ptr<FrameStage>(
+      std::make_unique<FilterStage>(options, *find_entry(options.method), std::move(*filter)));
 }
 
-}  // namespace temporal
+}  // namespace temporal::phlm

@@ -3,7 +3,9 @@
 #include "temporal/phlm/taa.h"
 
 #include "filter_common.h"
+#include "temporal/phlm/filters.h"
 #include "temporal/core/color.h"
+#include "temporal/core/minmax.h"
 #include "temporal/core/parallel.h"
 #include "temporal/core/reproject.h"
 
@@ -11,29 +13,8 @@
 #include <atomic>
 #include <cmath>
 
-namespace temporal {
+namespace temporal::phlm {
 namespace {
-
-// Plain comparisons instead of std::fmin / std::fmax: those honour NaN operands and are not inlined by GCC
-// (a libm call per use, measured 11% of the PHLM frame); every operand here is finite.
-inline float min_(float a, float b) { return b < a ? b : a; }
-inline float max_(float a, float b) { return a < b ? b : a; }
-
-
-template <int C>
-inline void to_box(const float* v, float* b) {
-  if constexpr (C == 3)
-    rgb_to_ycgco(v[0], v[1], v[2], b[0], b[1], b[2]);
-  else
-    b[0] = v[0];
-}
-template <int C>
-inline void from_box(const float* b, float* v) {
-  if constexpr (C == 3)
-    ycgco_to_rgb(b[0], b[1], b[2], v[0], v[1], v[2]);
-  else
-    v[0] = b[0];
-}
 
 using detail::TaaConfig;
 
@@ -54,6 +35,114 @@ inline std::size_t closest_neighbour(const float* depth, int xx, int yy, int w, 
   return best;
 }
 
+// The 3x3 input samples around a pixel (edges repeat; NaN/Inf samples left out): their min/max box and first moment
+// in box space (YCgCo for colour), the samples themselves for the variance, and the current colour filtered with
+// Karis' reconstruction weights (step 1 of taa.h).
+template <int C>
+struct Neighbourhood {
+  float bmin[C], bmax[C], cur[C], m1[C], samples[9][C];
+  float wsum = 0.0f;
+  int count = 0;
+  bool any_valid() const { return wsum > 0.0f; }
+};
+
+template <int C>
+Neighbourhood<C> gather_neighbourhood(const float* const y[C], const float* const box[C], const std::uint8_t* valid,
+                                      const float weight[9], int xx, int yy, int w, int h) {
+  Neighbourhood<C> nb;
+  const int rows[3] = {std::max(yy - 1, 0), yy, std::min(yy + 1, h - 1)};
+  const int cols[3] = {std::max(xx - 1, 0), xx, std::min(xx + 1, w - 1)};
+  for (int c = 0; c < C; ++c) {
+    nb.bmin[c] = INFINITY;
+    nb.bmax[c] = -INFINITY;
+    nb.cur[c] = 0.0f;
+    nb.m1[c] = 0.0f;
+  }
+  for (int j = 0; j < 3; ++j)
+    for (int k = 0; k < 3; ++k) {
+      const std::size_t n = std::size_t(rows[j]) * std::size_t(w) + std::size_t(cols[k]);
+      if (!valid[n]) continue;
+      const float wt = weight[j * 3 + k];
+      nb.wsum += wt;
+      for (int c = 0; c < C; ++c) {
+        const float b = box[c][n];
+        nb.bmin[c] = fast_min(nb.bmin[c], b);
+        nb.bmax[c] = fast_max(nb.bmax[c], b);
+        nb.m1[c] += b;
+        nb.samples[nb.count][c] = b;
+        nb.cur[c] += wt * y[c][n];
+      }
+      ++nb.count;
+    }
+  for (int c = 0; c < C; ++c) nb.cur[c] = nb.any_valid() ? nb.cur[c] / nb.wsum : 0.0f;
+  return nb;
+}
+
+// Step 3: the previous output at p + velocity with the configured filter (temporal/core/reproject.h).
+template <int C>
+void fetch_history(HistoryFetch fetch, const float* const hist[C], float fx, float fy, int w, int h, float* hv) {
+  if (fetch == HistoryFetch::CatmullRom) {
+    const reproject::CatmullRom cr = reproject::catmull_rom(fx, fy, w, h);
+    for (int c = 0; c < C; ++c) hv[c] = cr(hist[c]);
+  } else if (fetch == HistoryFetch::Bilinear) {
+    const reproject::Bilinear bl = reproject::bilinear(fx, fy, w, h);
+    for (int c = 0; c < C; ++c) hv[c] = bl(hist[c]);
+  } else {
+    const std::size_t q = reproject::nearest(fx, fy, w, h);
+    for (int c = 0; c < C; ++c) hv[c] = hist[c][q];
+  }
+}
+
+// Step 4: clips the history hb (box space) along the segment towards an origin inside the box: the filtered current
+// colour cb for the min/max box (a convex combination of its samples, UE4's HistoryClip), the mean mu for the
+// variance box mu +- gamma sigma (Salvi 2016). Returns true when hb was moved.
+template <int C>
+bool clip_history(Neighbourhood<C>& nb, const TaaConfig& cfg, const float* cb, float* hb) {
+  float origin[C];
+  if (cfg.clip == TaaClip::Variance) {
+    // Two passes over the samples (mean, then squared deviations): identical samples give sigma = 0 exactly, where
+    // E[v^2] - mu^2 would leave a rounding residue.
+    const float inv_n = 1.0f / float(nb.count);
+    for (int c = 0; c < C; ++c) {
+      const float mu = nb.m1[c] * inv_n;
+      float m2 = 0.0f;
+      for (int k = 0; k < nb.count; ++k) m2 += (nb.samples[k][c] - mu) * (nb.samples[k][c] - mu);
+      const float sigma = std::sqrt(m2 * inv_n);
+      nb.bmin[c] = mu - cfg.gamma * sigma;
+      nb.bmax[c] = mu + cfg.gamma * sigma;
+      origin[c] = mu;
+    }
+  } else {
+    for (int c = 0; c < C; ++c) origin[c] = cb[c];
+  }
+  float t = 1.0f;
+  for (int c = 0; c < C; ++c) {
+    const float d = hb[c] - origin[c];
+    if (d > 0.0f && origin[c] + d > nb.bmax[c]) t = fast_min(t, fast_max(nb.bmax[c] - origin[c], 0.0f) / d);
+    if (d < 0.0f && origin[c] + d < nb.bmin[c]) t = fast_min(t, fast_min(nb.bmin[c] - origin[c], 0.0f) / d);
+  }
+  if (t >= 1.0f) return false;
+  for (int c = 0; c < C; ++c) hb[c] = origin[c] + t * (hb[c] - origin[c]);
+  return true;
+}
+
+// Steps 4-5 for a pixel with history hv and at least one valid sample: the clipped history, blended exponentially
+// with the current colour, with Karis' luminance weights 1 / (1 + Y) (anti-flicker for HDR values).
+template <int C>
+bool clip_and_blend(Neighbourhood<C>& nb, const TaaConfig& cfg, float* hv, float* result) {
+  float hb[C], cb[C];
+  to_ycgco_box(hv, hb, C);
+  to_ycgco_box(nb.cur, cb, C);
+  const bool clipped = clip_history<C>(nb, cfg, cb, hb);
+  if (clipped) from_ycgco_box(hb, hv, C);
+  const float lc = fast_max(cb[0], 0.0f), lh = fast_max(hb[0], 0.0f);
+  const float wc = cfg.alpha / (1.0f + lc), wh = (1.0f - cfg.alpha) / (1.0f + lh);
+  const float inv = 1.0f / (wc + wh);
+  for (int c = 0; c < C; ++c) result[c] = (wc * nb.cur[c] + wh * hv[c]) * inv;
+  return clipped;
+}
+
+// One frame of TAA (taa.h, steps 1-5) into `out` and the next history.
 template <int C>
 void run_taa(const FilterInput& in, const TaaParams& params, const TaaConfig& cfg, bool have_history,
              const float* const hist[C], float* const next[C], const float* const box[C], const std::uint8_t* valid,
@@ -70,123 +159,44 @@ void run_taa(const FilterInput& in, const TaaParams& params, const TaaConfig& cf
       const float dx = float(k - 1) + in.jitter.x, dy = float(j - 1) + in.jitter.y;
       weight[j * 3 + k] = std::exp(-params.filter_sharpness * (dx * dx + dy * dy));
     }
-  const float alpha = cfg.alpha;
-  const bool variance = cfg.clip == TaaClip::Variance;
   const bool dilate = cfg.velocity == TaaVelocity::Nearest && in.motion_x && in.depth;
   parallel_rows(h, [&](int y0, int y1) {
     std::size_t local_resets = 0, local_clips = 0;
-    for (int yy = y0; yy < y1; ++yy) {
-      const int rows[3] = {std::max(yy - 1, 0), yy, std::min(yy + 1, h - 1)};
+    for (int yy = y0; yy < y1; ++yy)
       for (int xx = 0; xx < w; ++xx) {
         const std::size_t i = std::size_t(yy) * std::size_t(w) + std::size_t(xx);
-        const int cols[3] = {std::max(xx - 1, 0), xx, std::min(xx + 1, w - 1)};
-        float bmin[C], bmax[C], cur[C], m1[C], samples[9][C];
-        for (int c = 0; c < C; ++c) {
-          bmin[c] = INFINITY;
-          bmax[c] = -INFINITY;
-          cur[c] = 0.0f;
-          m1[c] = 0.0f;
-        }
-        float wsum = 0.0f;
-        int count = 0;
-        for (int j = 0; j < 3; ++j)
-          for (int k = 0; k < 3; ++k) {
-            const std::size_t n = std::size_t(rows[j]) * std::size_t(w) + std::size_t(cols[k]);
-            if (!valid[n]) continue;
-            const float wt = weight[j * 3 + k];
-            wsum += wt;
-            for (int c = 0; c < C; ++c) {
-              const float b = box[c][n];
-              bmin[c] = min_(bmin[c], b);
-              bmax[c] = max_(bmax[c], b);
-              m1[c] += b;
-              samples[count][c] = b;
-              cur[c] += wt * y[c][n];
-            }
-            ++count;
-          }
-        const bool any_valid = wsum > 0.0f;
-        for (int c = 0; c < C; ++c) cur[c] = any_valid ? cur[c] / wsum : 0.0f;
-
-        // Velocity: the pixel's own motion, or that of the closest surface of the 3x3 neighbourhood.
+        Neighbourhood<C> nb = gather_neighbourhood<C>(y, box, valid, weight, xx, yy, w, h);
+        // Step 2, velocity: the pixel's own motion, or that of the closest surface of the 3x3 neighbourhood.
         const std::size_t vi = dilate ? closest_neighbour(in.depth, xx, yy, w, h) : i;
         const float mvx = in.motion_x ? in.motion_x[vi] : 0.0f;
         const float mvy = in.motion_y ? in.motion_y[vi] : 0.0f;
         const float fx = float(xx) + mvx, fy = float(yy) + mvy;
         const bool no_history = in.reset || !have_history || !reproject::on_screen(fx, fy, w, h);
         float result[C];
-        float clipped = 0.0f;
+        bool clipped = false;
         if (no_history) {
-          for (int c = 0; c < C; ++c) result[c] = cur[c];
+          for (int c = 0; c < C; ++c) result[c] = nb.cur[c];
           ++local_resets;
         } else {
           float hv[C];
-          if (cfg.history == HistoryFetch::CatmullRom) {
-            const reproject::CatmullRom cr = reproject::catmull_rom(fx, fy, w, h);
-            for (int c = 0; c < C; ++c) hv[c] = cr(hist[c]);
-          } else if (cfg.history == HistoryFetch::Bilinear) {
-            const reproject::Bilinear bl = reproject::bilinear(fx, fy, w, h);
-            for (int c = 0; c < C; ++c) hv[c] = bl(hist[c]);
-          } else {
-            const std::size_t q = reproject::nearest(fx, fy, w, h);
-            for (int c = 0; c < C; ++c) hv[c] = hist[c][q];
-          }
-          if (!any_valid) {
+          fetch_history<C>(cfg.history, hist, fx, fy, w, h, hv);
+          if (!nb.any_valid())
             for (int c = 0; c < C; ++c) result[c] = hv[c];  // nothing valid to blend in: keep the history
-          } else {
-            // Clip the history in YCgCo along the segment towards an origin inside the box: the filtered current
-            // colour for the min/max box (a convex combination of its samples, UE4's HistoryClip), the mean mu
-            // for the variance box mu +- gamma sigma (Salvi 2016).
-            float hb[C], cb[C], origin[C];
-            to_box<C>(hv, hb);
-            to_box<C>(cur, cb);
-            if (variance) {
-              // Two passes over the samples (mean, then squared deviations): identical samples give sigma = 0
-              // exactly, where E[v^2] - mu^2 would leave a rounding residue.
-              const float inv_n = 1.0f / float(count);
-              for (int c = 0; c < C; ++c) {
-                const float mu = m1[c] * inv_n;
-                float m2 = 0.0f;
-                for (int k = 0; k < count; ++k) m2 += (samples[k][c] - mu) * (samples[k][c] - mu);
-                const float sigma = std::sqrt(m2 * inv_n);
-                bmin[c] = mu - cfg.gamma * sigma;
-                bmax[c] = mu + cfg.gamma * sigma;
-                origin[c] = mu;
-              }
-            } else {
-              for (int c = 0; c < C; ++c) origin[c] = cb[c];
-            }
-            float t = 1.0f;
-            for (int c = 0; c < C; ++c) {
-              const float d = hb[c] - origin[c];
-              if (d > 0.0f && origin[c] + d > bmax[c]) t = min_(t, max_(bmax[c] - origin[c], 0.0f) / d);
-              if (d < 0.0f && origin[c] + d < bmin[c]) t = min_(t, min_(bmin[c] - origin[c], 0.0f) / d);
-            }
-            if (t < 1.0f) {
-              for (int c = 0; c < C; ++c) hb[c] = origin[c] + t * (hb[c] - origin[c]);
-              from_box<C>(hb, hv);
-              clipped = 1.0f;
-              ++local_clips;
-            }
-            // Exponential blend with Karis' luminance weights 1 / (1 + Y) (anti-flicker for HDR values).
-            const float lc = max_(cb[0], 0.0f), lh = max_(hb[0], 0.0f);
-            const float wc = alpha / (1.0f + lc), wh = (1.0f - alpha) / (1.0f + lh);
-            const float inv = 1.0f / (wc + wh);
-            for (int c = 0; c < C; ++c) result[c] = (wc * cur[c] + wh * hv[c]) * inv;
-          }
+          else
+            clipped = clip_and_blend<C>(nb, cfg, hv, result);
+          local_clips += clipped ? 1 : 0;
         }
         for (int c = 0; c < C; ++c) {
           out[c][i] = result[c];
           next[c][i] = result[c];
         }
         if (dbg[0]) {
-          dbg[0][i] = clipped;
+          dbg[0][i] = clipped ? 1.0f : 0.0f;
           dbg[1][i] = no_history ? 1.0f : 0.0f;
           dbg[2][i] = mvx;
           dbg[3][i] = mvy;
         }
       }
-    }
     resets += local_resets;
     clips += local_clips;
   });
@@ -285,4 +295,45 @@ Status TaaFilter::set_state(const Image& state, int channels) {
   return Status::ok();
 }
 
-}  // namespace temporal
+// --- Registry entry (temporal/phlm/filters.h) ------------------------------------------------------------------
+
+namespace {
+
+// taa's parameters on the command line: the fields of TaaParams (taa.h).
+struct TaaOptions : TaaParams {
+  ParamList params() {
+    return {
+        Param::real("--taa-alpha", "weight of the current frame (chosen on the tuning set, docs/filter-phlm.md)",
+                    &alpha, 0.0, 1.0),
+        Param::choice("--taa-velocity",
+                      "motion of the closest surface of the 3x3 neighbourhood (nearest, UE4) or of the pixel",
+                      &velocity, {"nearest", "centre"}),
+        Param::choice("--taa-clip",
+                      "history clipping in YCoCg to mu +- gamma sigma (variance, Salvi 2016) or to the 3x3 min/max "
+                      "box (minmax, Karis 2014)",
+                      &clip, {"variance", "minmax"}),
+        Param::positive("--taa-gamma", "gamma of variance clipping (Salvi 2016: 1)", &gamma, 0.0, 8.0),
+        Param::choice("--taa-history", "history fetch (Karis 2014: catmull-rom)", &history,
+                      {"catmull-rom", "bilinear", "nearest"}),
+    };
+  }
+};
+
+}  // namespace
+
+const MethodEntry& taa_method() {
+  static const MethodEntry entry{
+      .info = {.name = "taa",
+               .summary = "engine-strength TAA: Karis 2014 with nearest-depth velocity, Catmull-Rom history, variance "
+                          "clipping (Salvi 2016)",
+               .has_state = true},
+      .make_options = OptionsOf<TaaOptions>::make,
+      .layers = [](const FilterOptions&) { return std::vector<LayerNeed>{{"motion"}, {"depth", false}}; },
+      .implementations = {{kCpuDevice, [](const FilterOptions& o) -> std::unique_ptr<FrameFilter> {
+                             return std::make_unique<TaaFilter>(method_options<TaaOptions>(o.per_method, "taa"));
+                           }}},
+  };
+  return entry;
+}
+
+}  // namespace temporal::phlm

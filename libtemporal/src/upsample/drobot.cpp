@@ -57,7 +57,7 @@ struct DrobotOptions {
   }
 };
 
-const DrobotOptions& drobot_options(const Options& o) { return method_options<DrobotOptions>(o, "drobot"); }
+const DrobotOptions& drobot_options(const Options& o) { return method_options<DrobotOptions>(o.per_method, "drobot"); }
 
 // Everything drobot keeps between frames: the low-resolution cache (cache mode, ping-pong) or the full-resolution
 // history and depth (refresh mode), and the per-frame scratch of the filter and the cache grid.
@@ -583,19 +583,21 @@ std::string state_layout(const Options& o) { return "mode " + drobot_options(o).
 
 const MethodEntry& drobot_method() {
   static const MethodEntry entry{
-      {"drobot",
-       "spatiotemporal coherence framework (seed 002, Listings 7.1-7.3): low-resolution reprojection cache with "
-       "convergence, bilateral filter, bilateral upsampling",
-       true,
-       {{"drobot-refresh", "drobot", {"--mode", "refresh"}, "the refresh-buffer reconstruction of Figure 7.12"}}},
-      OptionsOf<DrobotOptions>::make,
-      history_method_layers,
-      [](const Options& o, const Geometry& g) -> std::unique_ptr<MethodState> {
-        return std::make_unique<DrobotState>(o, g);
-      },
-      streamed_bytes,
-      state_layout,
-      [](const Options& o) { return "drobot-" + drobot_options(o).mode; }};
+      .info = {.name = "drobot",
+               .summary = "spatiotemporal coherence framework (seed 002, Listings 7.1-7.3): low-resolution "
+                          "reprojection cache with convergence, bilateral filter, bilateral upsampling",
+               .has_state = true,
+               .variants = {{"drobot-refresh", "drobot", {"--mode", "refresh"},
+                             "the refresh-buffer reconstruction of Figure 7.12"}}},
+      .make_options = OptionsOf<DrobotOptions>::make,
+      .layers = history_method_layers,
+      .implementations = {{kCpuDevice,
+                           [](const Options& o, const Geometry& g) -> std::unique_ptr<MethodState> {
+                             return std::make_unique<DrobotState>(o, g);
+                           }}},
+      .streamed_bytes = streamed_bytes,
+      .state_layout = state_layout,
+      .header_name = [](const Options& o) { return "drobot-" + drobot_options(o).mode; }};
   return entry;
 }
 

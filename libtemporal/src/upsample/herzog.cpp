@@ -261,7 +261,7 @@ struct HerzogOptions {
   }
 };
 
-const HerzogOptions& herzog_options(const Options& o) { return method_options<HerzogOptions>(o, "herzog"); }
+const HerzogOptions& herzog_options(const Options& o) { return method_options<HerzogOptions>(o.per_method, "herzog"); }
 
 // --- State -----------------------------------------------------------------------------------------------------
 
@@ -971,19 +971,22 @@ std::string state_layout(const Options& o) { return "gradient-scale " + std::to_
 
 const MethodEntry& herzog_method() {
   static const MethodEntry entry{
-      {"herzog",
-       "spatio-temporal upsampling (seed 000 sections 3.3-3.5): exponential history (eq. 6-7), adaptive image "
-       "kernel, w_f from the filtered relative gradient (eq. 8)",
-       true,
-       {{"herzog-lagged", "herzog", {"--lagged-wf"}, "eq. 7 with the previous frame's w_f: one fused pass"},
-        {"herzog-favor-spatial", "herzog", {"--favor-spatial"}, "a = 0.7 (the paper's elephant scene)"}}},
-      OptionsOf<HerzogOptions>::make,
-      history_method_layers,
-      [](const Options& o, const Geometry& g) -> std::unique_ptr<MethodState> {
-        return std::make_unique<HerzogState>(o, g);
-      },
-      streamed_bytes,
-      state_layout};
+      .info = {.name = "herzog",
+               .summary = "spatio-temporal upsampling (seed 000 sections 3.3-3.5): exponential history (eq. 6-7), "
+                          "adaptive image kernel, w_f from the filtered relative gradient (eq. 8)",
+               .has_state = true,
+               .variants = {{"herzog-lagged", "herzog", {"--lagged-wf"},
+                             "eq. 7 with the previous frame's w_f: one fused pass"},
+                            {"herzog-favor-spatial", "herzog", {"--favor-spatial"},
+                             "a = 0.7 (the paper's elephant scene)"}}},
+      .make_options = OptionsOf<HerzogOptions>::make,
+      .layers = history_method_layers,
+      .implementations = {{kCpuDevice,
+                           [](const Options& o, const Geometry& g) -> std::unique_ptr<MethodState> {
+                             return std::make_unique<HerzogState>(o, g);
+                           }}},
+      .streamed_bytes = streamed_bytes,
+      .state_layout = state_layout};
   return entry;
 }
 

@@ -1,5 +1,6 @@
-// A method of the upsampling stage as a unit (not installed): its registry entry, its per-method state object,
-// and the helpers its state files use. Each method's source file defines one MethodEntry; registry.cpp lists them.
+// A method of the upsampling stage as a unit (not installed): its per-method state object and the helpers its
+// state files use. Each method's source file defines one MethodEntry (temporal/upsample/methods.h); registry.cpp
+// lists them.
 #pragma once
 
 #include "temporal/core/stage.h"
@@ -48,50 +49,7 @@ inline std::vector<LayerNeed> history_method_layers(const Options& o) {
   return l;
 }
 
-// One row of the registry (docs/upsample-st.md, "Methods as units").
-struct MethodEntry {
-  MethodInfo info;
-  // The method's own parameters with their defaults (nullptr: none).
-  std::unique_ptr<MethodOptions> (*make_options)() = nullptr;
-  // G-buffer layers it reads (albedo for demodulation is added by the Upsampler).
-  std::vector<LayerNeed> (*layers)(const Options&) = nullptr;
-  // A new state for frames of this geometry (nullptr: the method keeps nothing between frames except its output).
-  std::unique_ptr<MethodState> (*make_state)(const Options&, const Geometry&) = nullptr;
-  // Bytes per frame it must at least read and write (the benchmark's streaming bound): G-buffer planes, payload in
-  // and out, histories read and written once. W, H full resolution, k the factor, C payload channels.
-  std::size_t (*streamed_bytes)(const Options&, int W, int H, int k, int C) = nullptr;
-  // Header attributes of a state that must match the options of the run that loads it ("mode=cache"); empty when
-  // the state does not depend on the options.
-  std::string (*state_layout)(const Options&) = nullptr;
-  // The `temporal:method` header value when it is more than the name ("drobot-refresh"); nullptr: the name.
-  std::string (*header_name)(const Options&) = nullptr;
-};
-
-// The table (registry.cpp), and the entry called `name` (nullptr when unknown).
-const std::vector<const MethodEntry*>& registry();
-const MethodEntry* find_entry(const std::string& name);
-
-// A method's options struct T (fields with defaults, `ParamList params()`, optionally `Status check() const`)
-// as MethodOptions, and the typed view of it inside Options.
-template <typename T>
-class OptionsOf : public MethodOptions, public T {
- public:
-  std::unique_ptr<MethodOptions> clone() const override { return std::make_unique<OptionsOf>(*this); }
-  ParamList params() override { return T::params(); }
-  Status check() const override {
-    if constexpr (requires(const T& t) { t.check(); })
-      return T::check();
-    else
-      return Status::ok();
-  }
-  static std::unique_ptr<MethodOptions> make() { return std::make_unique<OptionsOf>(); }
-};
-template <typename T>
-const T& method_options(const Options& o, const std::string& name) {
-  static const OptionsOf<T> defaults;
-  const MethodOptions* m = o.per_method.find(name);
-  return m ? static_cast<const OptionsOf<T>&>(*m) : defaults;
-}
+// The registry entry (MethodEntry) is public: temporal/upsample/methods.h.
 
 // --- State files -------------------------------------------------------------------------------------------
 

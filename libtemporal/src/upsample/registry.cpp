@@ -11,7 +11,8 @@ constexpr double kUnbounded = std::numeric_limits<double>::infinity();
 }  // namespace
 
 // Every method, in the order of --help, --list-methods and the docs. Adding a method: its source file defines
-// `const MethodEntry& NAME_method()` (options, state, run, streamed bytes), and one line here lists it.
+// `const MethodEntry& NAME_method()` (temporal/core/method.h: info, options, layers, implementations, streamed
+// bytes), declared here and listed in the table.
 const MethodEntry& spatial_method();   // spatial.cpp
 const MethodEntry& temporal_method();  // temporal.cpp
 const MethodEntry& herzog_method();    // herzog.cpp
@@ -24,40 +25,14 @@ const std::vector<const MethodEntry*>& registry() {
   return table;
 }
 
-const MethodEntry* find_entry(const std::string& name) {
-  for (const MethodEntry* e : registry())
-    if (e->info.name == name) return e;
-  return nullptr;
-}
-
-const std::vector<MethodInfo>& methods() {
-  static const std::vector<MethodInfo> list = [] {
-    std::vector<MethodInfo> v;
-    for (const MethodEntry* e : registry()) v.push_back(e->info);
-    return v;
-  }();
-  return list;
-}
-
-const MethodInfo* find_method(const std::string& name) {
-  for (const MethodInfo& m : methods())
-    if (m.name == name) return &m;
-  return nullptr;
-}
+const MethodEntry* find_entry(std::string_view name) { return find_entry_in(registry(), name); }
 
 const std::vector<MethodVariant>& method_variants() {
-  static const std::vector<MethodVariant> list = [] {
-    std::vector<MethodVariant> v;
-    for (const MethodInfo& m : methods()) {
-      v.push_back({m.name, m.name, {}, m.summary});
-      v.insert(v.end(), m.variants.begin(), m.variants.end());
-    }
-    return v;
-  }();
+  static const std::vector<MethodVariant> list = method_variants_of(registry());
   return list;
 }
 
-const MethodVariant* find_variant(const std::string& name) {
+const MethodVariant* find_variant(std::string_view name) {
   for (const MethodVariant& v : method_variants())
     if (v.name == name) return &v;
   return nullptr;
@@ -71,33 +46,12 @@ const std::vector<VariantSuffix>& variant_suffixes() {
 
 // --- Options --------------------------------------------------------------------------------------------------
 
-MethodOptionSet::MethodOptionSet() {
-  for (const MethodEntry* e : registry())
-    if (e->make_options) entries_.emplace_back(e->info.name, e->make_options());
-}
-MethodOptionSet::MethodOptionSet(const MethodOptionSet& other) { *this = other; }
-MethodOptionSet& MethodOptionSet::operator=(const MethodOptionSet& other) {
-  if (this == &other) return *this;
-  entries_.clear();
-  for (const auto& [name, options] : other.entries_) entries_.emplace_back(name, options->clone());
-  return *this;
-}
-MethodOptionSet::~MethodOptionSet() = default;
-
-MethodOptions* MethodOptionSet::find(const std::string& name) {
-  for (auto& [n, options] : entries_)
-    if (n == name) return options.get();
-  return nullptr;
-}
-const MethodOptions* MethodOptionSet::find(const std::string& name) const {
-  return const_cast<MethodOptionSet*>(this)->find(name);
-}
+MethodOptionSet default_method_options() { return method_option_set(registry()); }
 
 ParamList params(Options& o) {
-  std::vector<std::string> names;
-  for (const MethodInfo& m : methods()) names.push_back(m.name);
   ParamList list = {
-      Param::choice("--method", "Upsampling method (upsample-st --list-methods describes each)", &o.method, names),
+      Param::choice("--method", "Upsampling method (upsample-st --list-methods describes each)", &o.method,
+                    method_names(registry())),
       Param::text("--layer", "Payload layers to upsample: rgb (bare R,G,B) or layer names, comma-separated", &o.layer),
       Param::flag_on("--debug-layers",
                      "Add debug.* layers: confidence, disocclusion, gradient, wf, historyWeight, convergence",
@@ -119,12 +73,7 @@ ParamList params(Options& o) {
       Param::flag_on("--no-ids", "Disocclusion test on depth only (no material-id comparison, seed 000 Figure 3)",
                      &o.no_ids),
   };
-  for (const MethodEntry* e : registry())
-    if (MethodOptions* m = o.per_method.find(e->info.name))
-      for (Param p : m->params()) {
-        p.help = e->info.name + ": " + p.help;
-        list.push_back(std::move(p));
-      }
+  for (Param& p : method_params(registry(), o.per_method)) list.push_back(std::move(p));
   list.push_back(Param::flag_on("--demodulate",
                                 "Upsample lighting only: divide R,G,B by the G-buffer albedo, multiply the result "
                                 "back (seed 000 section 4); needs `albedo` in the G-buffer",
@@ -137,17 +86,10 @@ ParamList params(Options& o) {
 }
 
 Status check(const Options& options) {
-  if (!find_entry(options.method)) {
-    std::string names;
-    for (const MethodInfo& m : methods()) names += (names.empty() ? "" : ", ") + m.name;
-    return Error::usage("unknown method '" + options.method + "': use one of " + names);
-  }
+  if (Status s = check_method_name(registry(), options.method); !s) return s;
   Options copy = options;  // params() points at the fields it is given
   if (Status s = check_params(params(copy)); !s) return s;
-  for (const MethodEntry* e : registry())
-    if (const MethodOptions* m = options.per_method.find(e->info.name))
-      if (Status s = m->check(); !s) return s;
-  return Status::ok();
+  return check_method_options(registry(), options.per_method);
 }
 
 Expected<Options> make_options(const std::string& method, const std::vector<std::string>& args) {

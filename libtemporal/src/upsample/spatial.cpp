@@ -105,13 +105,15 @@ std::size_t streamed_bytes(const Options&, int W, int H, int k, int C) {
 
 const MethodEntry& spatial_method() {
   static const MethodEntry entry{
-      {"spatial", "joint-bilateral upsampling of this frame's samples (seed 000 section 3.1, eq. 1-3, hat kernel)",
-       false, {}},
-      nullptr,
-      layers,
-      [](const Options&, const Geometry& g) -> std::unique_ptr<MethodState> { return std::make_unique<SpatialState>(g); },
-      streamed_bytes,
-      nullptr};
+      .info = {.name = "spatial",
+               .summary = "joint-bilateral upsampling of this frame's samples (seed 000 section 3.1, eq. 1-3, hat "
+                          "kernel)"},
+      .layers = layers,
+      .implementations = {{kCpuDevice,
+                           [](const Options&, const Geometry& g) -> std::unique_ptr<MethodState> {
+                             return std::make_unique<SpatialState>(g);
+                           }}},
+      .streamed_bytes = streamed_bytes};
   return entry;
 }
 

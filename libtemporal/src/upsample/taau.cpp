@@ -85,33 +85,11 @@ struct TaauOptions {
   }
 };
 
-const TaauOptions& taau_options(const Options& o) { return method_options<TaauOptions>(o, "taau"); }
+const TaauOptions& taau_options(const Options& o) { return method_options<TaauOptions>(o.per_method, "taau"); }
 
-// The payload in the space the method filters in: R, G, B triples as YCoCg (Malvar & Sullivan 2003, core/color.h;
-// Karis 2014 and FSR 2 clamp there), other channels as they are. Linear, so blends are the same in either space.
-struct ColorSpace {
-  int C = 0, triples = 0;
-  void to(float* v) const {
-    for (int t = 0; t < triples; ++t) {
-      float* p = v + 3 * t;
-      float y, cg, co;
-      rgb_to_ycgco(p[0], p[1], p[2], y, cg, co);
-      p[0] = y;
-      p[1] = cg;
-      p[2] = co;
-    }
-  }
-  void from(float* v) const {
-    for (int t = 0; t < triples; ++t) {
-      float* p = v + 3 * t;
-      float r, g, b;
-      ycgco_to_rgb(p[0], p[1], p[2], r, g, b);
-      p[0] = r;
-      p[1] = g;
-      p[2] = b;
-    }
-  }
-};
+// The payload is filtered in the box space of core/color.h (to_ycgco_box): R, G, B triples as YCoCg (Malvar &
+// Sullivan 2003; Karis 2014 and FSR 2 clamp there), other channels as they are. Linear, so blends are the same in
+// either space.
 
 // FSR 2 ComputeThinFeatureConfidence on the low-resolution luminance: sample (x, y) is a thin feature when its
 // luminance is outside the range of its dissimilar 3x3 neighbours (a ridge) and no 2x2 quad containing it is all
@@ -156,8 +134,11 @@ class TaauState : public MethodState {
   }
 
   Image& run(const FrameContext& f, bool history, FrameStats& stats) override;
-  void update_lock(const FrameContext& f, const TaauOptions& to, const ColorSpace& cs, bool hit, const float* result,
-                   int X, int Y, float w_new, float lifetime_per_weight, float& lock, float& lock_luma) const;
+  void find_thin_features(const FrameContext& f, const TaauOptions& to);
+  void fetch_history_row(const FrameContext& f, bool history, int prv, const std::vector<const float*>& prev_planes,
+                         int Y, HistoryRow& hist, std::vector<float>& fetched) const;
+  void update_lock(const FrameContext& f, const TaauOptions& to, bool hit, const float* result, int X, int Y,
+                   float w_new, float lifetime_per_weight, float& lock, float& lock_luma) const;
 
   void save(Image& state) const override {
     const int c = out_.index();
@@ -188,7 +169,7 @@ class TaauState : public MethodState {
 };
 
 // Step 2 for one output pixel (X, Y): the 3x3 low-resolution samples around the nearest one (xn, yn), in filter
-// space (cs): their Lanczos-2 sum (FSR 2's approximation, kernel `bias`), and the box of step 3: the weighted mean
+// space (to_ycgco_box): their Lanczos-2 sum (FSR 2's approximation, kernel `bias`), and the box of step 3: the weighted mean
 // (weights exp(curve d^2), FSR 2's fRectificationCurveBias), spread, min and max.
 struct SampleBox {
   float sum[16] = {}, bsum[16] = {}, bsq[16] = {}, lo[16] = {}, hi[16] = {};
@@ -196,8 +177,7 @@ struct SampleBox {
   int samples = 0;
 };
 
-SampleBox gather_samples(const FrameContext& f, const ColorSpace& cs, int xn, int yn, int X, int Y, float bias,
-                         float curve) {
+SampleBox gather_samples(const FrameContext& f, int xn, int yn, int X, int Y, float bias, float curve) {
   const int C = f.C, lw = f.lw, lh = f.lh, k = f.grid.k, sx = f.grid.sx, sy = f.grid.sy;
   const float inv_k = 1.0f / float(k);
   SampleBox b;
@@ -225,7 +205,7 @@ SampleBox gather_samples(const FrameContext& f, const ColorSpace& cs, int xn, in
       float* v = vals[samples];
       wbs[samples] = wb;
       for (int c = 0; c < C; ++c) v[c] = f.low[c][s];
-      cs.to(v);
+      to_ycgco_box(v, v, C);
       for (int c = 0; c < C; ++c) {
         sum[c] += wl * v[c];
         bsum[c] += wb * v[c];
@@ -246,6 +226,29 @@ SampleBox gather_samples(const FrameContext& f, const ColorSpace& cs, int xn, in
     }
   return b;
 }
+
+// What one frame's pixels share, from the factor k.
+struct TaauConstants {
+  float scale_influence;      // step 3's box scale: FSR 2.2 RectifyHistory, fScaleFactorInfluence = min(20, k^6)
+  float bias_history;         // kernel bias with history (FSR 2 ComputeMaxKernelWeight, fKernelSizeBias = 1)
+  float lifetime_per_weight;  // lock lifetime spent per unit of accumulated weight (FSR 2 FinalizeLockStatus)
+};
+
+TaauConstants taau_constants(int k) {
+  TaauConstants t;
+  t.scale_influence = std::min(20.0f, std::pow(float(k) * float(k), 3.0f));  // (1 / (1/k * 1/k))^3
+  t.bias_history = std::min(1.99f, 1.0f + (float(k) - 1.0f));
+  t.lifetime_per_weight = 1.0f / (float(k * k) * kAverageLanczosWeight);  // a jitter cycle of average weight takes 1
+  return t;
+}
+
+// One pixel's outcome of steps 2-4, in filter space.
+struct PixelResult {
+  float result[16];
+  float w_new = 0.0f;      // this frame's accumulation weight (debug.confidence)
+  float alpha = 0.0f;      // this frame's share of the result (1 - debug.wf)
+  float rectified = 0.0f;  // how much of the history was cut (debug.gradient)
+};
 
 // Steps 3 and 4 for a pixel with history (FSR 2.2 RectifyHistory, FSR 2 Accumulate): the history `hv` (filter
 // space) clipped towards the box of `b` as far as it left it, the accumulation weight `acc` cut as much, then the
@@ -300,9 +303,8 @@ float rectify_and_accumulate(const TaauOptions& to, const SampleBox& b, int C, f
 // Step 5 for one pixel (FSR 2 locks): a lock ends when the luminance of this frame's result moved more than
 // --lock-luma-change from the one it was made with; a thin-feature sample at this pixel makes (or renews) one; its
 // lifetime is spent by the weight accumulated.
-void TaauState::update_lock(const FrameContext& f, const TaauOptions& to, const ColorSpace& cs, bool hit,
-                            const float* result, int X, int Y, float w_new, float lifetime_per_weight, float& lock,
-                            float& lock_luma) const {
+void TaauState::update_lock(const FrameContext& f, const TaauOptions& to, bool hit, const float* result, int X,
+                            int Y, float w_new, float lifetime_per_weight, float& lock, float& lock_luma) const {
   const int C = f.C, lw = f.lw, lh = f.lh, k = f.grid.k, sx = f.grid.sx, sy = f.grid.sy;
   // Step 5: locks. Luminance of this frame's reconstruction where it has weight (else the result's).
   if (to.locks) {
@@ -311,7 +313,7 @@ void TaauState::update_lock(const FrameContext& f, const TaauOptions& to, const 
     {
       float rgb[16];
       for (int c = 0; c < C; ++c) rgb[c] = result[c];
-      cs.from(rgb);
+      from_ycgco_box(rgb, rgb, C);
       for (int c = 0; c < C; ++c) yr += f.luma[c] * rgb[c];
     }
     if (lock > 0) {
@@ -332,6 +334,80 @@ void TaauState::update_lock(const FrameContext& f, const TaauOptions& to, const 
   }
 }
 
+// The history of one row (step 1): the reprojection taps of row Y (temporal/core/reproject.h) and, gathered through
+// them, the previous output, accumulation weight, lock lifetime and lock luminance: plane q of `fetched` (W values
+// each) is payload channel q < C, then C the weight, C + 1 the lifetime, C + 2 the luminance. Without history every
+// pixel is a miss.
+void TaauState::fetch_history_row(const FrameContext& f, bool history, int prv,
+                                  const std::vector<const float*>& prev_planes, int Y, HistoryRow& hist,
+                                  std::vector<float>& fetched) const {
+  const int C = f.C, W = f.W;
+  const int nf = C + 3;  // colour, weight, lock lifetime, lock luminance
+  fetched.resize(std::size_t(nf) * W);
+  if (!history) {
+    hist.resize(W);
+    std::fill(hist.hit.begin(), hist.hit.end(), 0.0f);
+    return;
+  }
+  history_row(f, prev_, Y, hist);
+  const float* src[16];
+  float* dst[16];
+  for (int q0 = 0; q0 < nf; q0 += 16) {
+    const int n = std::min(16, nf - q0);
+    for (int i = 0; i < n; ++i) {
+      const int q = q0 + i;
+      src[i] = q < C ? prev_planes[q] : q == C ? acc_[prv].data() : q == C + 1 ? lock_[prv].data()
+                                                                              : lock_luma_[prv].data();
+      dst[i] = fetched.data() + std::size_t(q) * W;
+    }
+    reproject::gather_row(hist, src, dst, n, W);
+  }
+}
+
+// Step 1's colour filter: UE4 TAAU's bicubic (Catmull-Rom) history (Karis 2014: the bilinear fetch blurs a little more
+// every frame), only where the module's fetch kept the four bilinear taps at their plain weights (no tap of another
+// surface, none outside), so the disocclusion test still decides. The module's 4x4 fetch replaces hv (C channels,
+// the payload's space) there.
+void catmull_rom_history(const FrameContext& f, const HistoryRow& hist, const std::vector<const float*>& prev_planes,
+                         int X, int Y, float* hv) {
+  const std::size_t i = std::size_t(Y) * f.W + X;
+  const float u = float(X) + f.mx[i], v = float(Y) + f.my[i];
+  const float ax = u - std::floor(u), ay = v - std::floor(v);
+  const float raw[4] = {(1 - ax) * (1 - ay), ax * (1 - ay), (1 - ax) * ay, ax * ay};
+  bool full = true;
+  for (int j = 0; j < 4; ++j) full = full && std::abs(hist.w[j][X] - raw[j]) <= 1e-5f;
+  if (!full) return;
+  const reproject::CatmullRom cr = reproject::catmull_rom(u, v, f.W, f.H);
+  for (int c = 0; c < f.C; ++c) hv[c] = cr(prev_planes[c]);
+}
+
+// Steps 2-4 for one pixel, all values in filter space: this frame's reconstruction from the samples `b` and, with a
+// history hit, the rectified history blended with it. Without a sample near p the history is kept as it is (or 0).
+// Fills `px` (result, w_new, alpha, rectified) and updates `acc`.
+void accumulate_pixel(const TaauOptions& to, const TaauConstants& k, const SampleBox& b, int C, bool hit,
+                      float velocity, float lock, float* hv, float& acc, PixelResult& px) {
+  if (b.samples == 0) {
+    for (int c = 0; c < C; ++c) px.result[c] = hv[c];
+    return;
+  }
+  float recon[16];
+  // FSR 2: weights below FSR2_EPSILON count as none; the normalised result is deringed.
+  if (b.wsum > kEpsilon) {
+    for (int c = 0; c < C; ++c) recon[c] = std::clamp(b.sum[c] / b.wsum, b.lo[c], b.hi[c]);
+    px.w_new = b.wsum * kLanczosWeightScale;
+  } else {  // our fallback for a new sample without Lanczos weight: the box's weighted mean
+    for (int c = 0; c < C; ++c) recon[c] = b.bsum[c] / b.bw;
+  }
+  if (!hit) {  // a new sample (FSR 2: the history is the upsampled colour)
+    for (int c = 0; c < C; ++c) px.result[c] = recon[c];
+    acc = px.w_new;
+    px.alpha = 1.0f;
+    return;
+  }
+  px.rectified = rectify_and_accumulate(to, b, C, velocity, k.scale_influence, lock, recon, px.w_new, hv, acc,
+                                        px.alpha, px.result);
+}
+
 Image& TaauState::run(const FrameContext& f, bool history, FrameStats& stats) {
   const TaauOptions& to = taau_options(*f.options);
   Image& out = out_.next();
@@ -346,55 +422,18 @@ Image& TaauState::run(const FrameContext& f, bool history, FrameStats& stats) {
   float* dbg_hw = f.debug ? out.add_channel("debug.historyWeight") : nullptr;
   float* dbg_conv = f.debug ? out.add_channel("debug.convergence") : nullptr;
   float* dbg_lock = f.debug ? out.add_channel("debug.lock") : nullptr;
-
-  // This frame's sample luminance (the payload's luma weights) and its thin features (step 5).
-  low_luma_.assign(std::size_t(lw) * lh, 0.0f);
-  for (int c = 0; c < C; ++c)
-    for (std::size_t i = 0; i < low_luma_.size(); ++i)
-      low_luma_[i] += f.luma[c] * (f.lvalid[i] > 0 ? f.low[c][i] : 0.0f);
-  thin_.assign(low_luma_.size(), 0);
-  if (to.locks)
-    parallel_rows(lh, [&](int y0, int y1) {
-      for (int y = y0; y < y1; ++y)
-        for (int x = 0; x < lw; ++x) thin_[std::size_t(y) * lw + x] = char(thin_feature(low_luma_, lw, lh, x, y));
-    });
-
-  ColorSpace cs{C, C / 3};
-  // Step 3's box scale: FSR 2.2 RectifyHistory, fScaleFactorInfluence = min(20, (1 / (1/k * 1/k))^3).
-  const float scale_influence = std::min(20.0f, std::pow(float(k) * float(k), 3.0f));
-  // Kernel bias with history (FSR 2 ComputeMaxKernelWeight, fKernelSizeBias = 1).
-  const float bias_history = std::min(1.99f, 1.0f + (float(k) - 1.0f));
-  // Lock lifetime spent per unit of accumulated weight (FSR 2 FinalizeLockStatus): a jitter cycle of average weight.
-  const float lifetime_per_weight = 1.0f / (float(k * k) * kAverageLanczosWeight);
+  find_thin_features(f, to);
+  const TaauConstants constants = taau_constants(k);
   const bool catmull_rom = to.history == "catmull-rom";
 
   std::atomic<std::size_t> hits{0};
   parallel_rows(H, [&](int y0, int y1) {
     thread_local HistoryRow hist;
     thread_local std::vector<float> fetched;
-    const int nf = C + 3;  // colour, weight, lock lifetime, lock luminance
-    fetched.resize(std::size_t(nf) * W);
     std::size_t band_hits = 0;
     for (int Y = y0; Y < y1; ++Y) {
       const std::size_t row = std::size_t(Y) * W;
-      if (history) {
-        history_row(f, prev_, Y, hist);
-        const float* src[16];
-        float* dst[16];
-        for (int q0 = 0; q0 < nf; q0 += 16) {
-          const int n = std::min(16, nf - q0);
-          for (int i = 0; i < n; ++i) {
-            const int q = q0 + i;
-            src[i] = q < C ? prev_planes[q] : q == C ? acc_[prv].data() : q == C + 1 ? lock_[prv].data()
-                                                                                    : lock_luma_[prv].data();
-            dst[i] = fetched.data() + std::size_t(q) * W;
-          }
-          reproject::gather_row(hist, src, dst, n, W);
-        }
-      } else {
-        hist.resize(W);
-        std::fill(hist.hit.begin(), hist.hit.end(), 0.0f);
-      }
+      fetch_history_row(f, history, prv, prev_planes, Y, hist, fetched);
       const int yn = std::clamp(JitterGrid::floor_div(2 * (Y - sy) + k, 2 * k), 0, lh - 1);
       for (int X = 0; X < W; ++X) {
         const std::size_t i = row + X;
@@ -404,69 +443,32 @@ Image& TaauState::run(const FrameContext& f, bool history, FrameStats& stats) {
         const float velocity = std::isfinite(mxv) && std::isfinite(myv) ? std::hypot(mxv, myv) : 0.0f;
         // Step 2: the 3x3 samples around the nearest one.
         const int xn = std::clamp(JitterGrid::floor_div(2 * (X - sx) + k, 2 * k), 0, lw - 1);
-        const float bias = hit ? bias_history : 1.0f;  // FSR 2: lerp(bias max, bias min, new sample) = 1 when new
+        // FSR 2: lerp(bias max, bias min, new sample) = 1 when new.
+        const float bias = hit ? constants.bias_history : 1.0f;
         const float curve = -2.0f - std::min(1.0f, velocity / 50.0f);  // fRectificationCurveBias
-        const SampleBox b = gather_samples(f, cs, xn, yn, X, Y, bias, curve);
-        const float* sum = b.sum;
-        const float* bsum = b.bsum;
-        const float* lo = b.lo;
-        const float* hi = b.hi;
-        const float wsum = b.wsum, bw = b.bw;
-        const int samples = b.samples;
-        float hv[16], recon[16];
+        const SampleBox b = gather_samples(f, xn, yn, X, Y, bias, curve);
+        float hv[16];
         for (int c = 0; c < C; ++c) hv[c] = hit ? fetched[std::size_t(c) * W + X] : 0.0f;
-        if (hit && catmull_rom) {
-          // UE4 TAAU's bicubic (Catmull-Rom) history (Karis 2014: the bilinear fetch blurs a little more every
-          // frame); only where the module's fetch kept the four bilinear taps at their plain weights (no tap of
-          // another surface, none outside), so the disocclusion test still decides. The module's 4x4 fetch.
-          const float u = float(X) + mxv, v = float(Y) + myv;
-          const float ax = u - std::floor(u), ay = v - std::floor(v);
-          const float raw[4] = {(1 - ax) * (1 - ay), ax * (1 - ay), (1 - ax) * ay, ax * ay};
-          bool full = true;
-          for (int j = 0; j < 4; ++j) full = full && std::abs(hist.w[j][X] - raw[j]) <= 1e-5f;
-          if (full) {
-            const reproject::CatmullRom cr = reproject::catmull_rom(u, v, W, H);
-            for (int c = 0; c < C; ++c) hv[c] = cr(prev_planes[c]);
-          }
-        }
-        cs.to(hv);
+        if (hit && catmull_rom) catmull_rom_history(f, hist, prev_planes, X, Y, hv);
+        to_ycgco_box(hv, hv, C);
         float acc = hit ? fetched[std::size_t(C) * W + X] : 0.0f;
         float lock = hit ? fetched[std::size_t(C + 1) * W + X] : 0.0f;
         float lock_luma = hit ? fetched[std::size_t(C + 2) * W + X] : 0.0f;
-        float result[16];
-        float w_new = 0.0f, alpha = 0.0f, rectified = 0.0f;
-        if (samples == 0) {  // no sample of this frame near p: the history as it is (or 0)
-          for (int c = 0; c < C; ++c) result[c] = hv[c];
-        } else {
-          // FSR 2: weights below FSR2_EPSILON count as none; the normalised result is deringed.
-          if (wsum > kEpsilon) {
-            for (int c = 0; c < C; ++c) recon[c] = std::clamp(sum[c] / wsum, lo[c], hi[c]);
-            w_new = wsum * kLanczosWeightScale;
-          } else {  // our fallback for a new sample without Lanczos weight: the box's weighted mean
-            for (int c = 0; c < C; ++c) recon[c] = bsum[c] / bw;
-          }
-          if (!hit) {  // a new sample (FSR 2: the history is the upsampled colour)
-            for (int c = 0; c < C; ++c) result[c] = recon[c];
-            acc = w_new;
-            alpha = 1.0f;
-          } else {
-            rectified = rectify_and_accumulate(to, b, C, velocity, scale_influence, lock, recon, w_new, hv, acc, alpha,
-                                               result);
-          }
-        }
-        update_lock(f, to, cs, hit, result, X, Y, w_new, lifetime_per_weight, lock, lock_luma);
-        cs.from(result);
+        PixelResult px;
+        accumulate_pixel(to, constants, b, C, hit, velocity, lock, hv, acc, px);
+        update_lock(f, to, hit, px.result, X, Y, px.w_new, constants.lifetime_per_weight, lock, lock_luma);
+        from_ycgco_box(px.result, px.result, C);
         bool ok = true;
-        for (int c = 0; c < C; ++c) ok = ok && std::abs(result[c]) <= 3.0e38f;  // false for NaN and Inf
-        for (int c = 0; c < C; ++c) planes[c][i] = ok ? result[c] : 0.0f;
+        for (int c = 0; c < C; ++c) ok = ok && std::abs(px.result[c]) <= 3.0e38f;  // false for NaN and Inf
+        for (int c = 0; c < C; ++c) planes[c][i] = ok ? px.result[c] : 0.0f;
         acc_[cur][i] = ok ? acc : 0.0f;
         lock_[cur][i] = ok ? lock : 0.0f;
         lock_luma_[cur][i] = lock_luma;
         if (f.debug) {
-          dbg_conf[i] = w_new;
+          dbg_conf[i] = px.w_new;
           dbg_disocc[i] = hit ? 0.0f : 1.0f;
-          dbg_grad[i] = rectified;
-          dbg_wf[i] = 1.0f - alpha;
+          dbg_grad[i] = px.rectified;
+          dbg_wf[i] = 1.0f - px.alpha;
           dbg_hw[i] = acc_[cur][i];
           dbg_conv[i] = acc_[cur][i] / kMaxAccumulation;
           dbg_lock[i] = lock_[cur][i];
@@ -481,6 +483,21 @@ Image& TaauState::run(const FrameContext& f, bool history, FrameStats& stats) {
   return out;
 }
 
+// This frame's sample luminance (the payload's luma weights) and its thin features (step 5).
+void TaauState::find_thin_features(const FrameContext& f, const TaauOptions& to) {
+  const int lw = f.lw, lh = f.lh;
+  low_luma_.assign(std::size_t(lw) * lh, 0.0f);
+  for (int c = 0; c < f.C; ++c)
+    for (std::size_t i = 0; i < low_luma_.size(); ++i)
+      low_luma_[i] += f.luma[c] * (f.lvalid[i] > 0 ? f.low[c][i] : 0.0f);
+  thin_.assign(low_luma_.size(), 0);
+  if (to.locks)
+    parallel_rows(lh, [&](int y0, int y1) {
+      for (int y = y0; y < y1; ++y)
+        for (int x = 0; x < lw; ++x) thin_[std::size_t(y) * lw + x] = char(thin_feature(low_luma_, lw, lh, x, y));
+    });
+}
+
 // depth + N (the frame context's sample validity), payload in and out; motion, id; the previous depth and id read
 // and written; the history read; weight, lock lifetime and lock luminance read and written.
 std::size_t streamed_bytes(const Options&, int W, int H, int k, int C) {
@@ -492,18 +509,18 @@ std::size_t streamed_bytes(const Options&, int W, int H, int k, int C) {
 
 const MethodEntry& taau_method() {
   static const MethodEntry entry{
-      {"taau",
-       "engine-class temporal upscaler after FSR 2 / UE4 TAAU: Lanczos-2 reconstruction of the jittered samples, "
-       "depth disocclusion, YCoCg history clamp, per-pixel accumulation weight, thin-feature locks",
-       true,
-       {}},
-      OptionsOf<TaauOptions>::make,
-      history_method_layers,
-      [](const Options& o, const Geometry& g) -> std::unique_ptr<MethodState> {
-        return std::make_unique<TaauState>(o, g);
-      },
-      streamed_bytes,
-      nullptr};
+      .info = {.name = "taau",
+               .summary = "engine-class temporal upscaler after FSR 2 / UE4 TAAU: Lanczos-2 reconstruction of the "
+                          "jittered samples, depth disocclusion, YCoCg history clamp, per-pixel accumulation "
+                          "weight, thin-feature locks",
+               .has_state = true},
+      .make_options = OptionsOf<TaauOptions>::make,
+      .layers = history_method_layers,
+      .implementations = {{kCpuDevice,
+                           [](const Options& o, const Geometry& g) -> std::unique_ptr<MethodState> {
+                             return std::make_unique<TaauState>(o, g);
+                           }}},
+      .streamed_bytes = streamed_bytes};
   return entry;
 }
 

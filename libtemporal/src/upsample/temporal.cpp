@@ -151,15 +151,16 @@ std::size_t streamed_bytes(const Options&, int W, int H, int k, int C) {
 
 const MethodEntry& temporal_method() {
   static const MethodEntry entry{
-      {"temporal",
-       "temporally-amortised upsampling (seed 000 section 3.2, eq. 4): new samples kept, the previous output at "
-       "p + motion elsewhere, holes filled spatially",
-       true, {}},
-      nullptr,
-      history_method_layers,
-      [](const Options&, const Geometry& g) -> std::unique_ptr<MethodState> { return std::make_unique<TemporalState>(g); },
-      streamed_bytes,
-      nullptr};
+      .info = {.name = "temporal",
+               .summary = "temporally-amortised upsampling (seed 000 section 3.2, eq. 4): new samples kept, the "
+                          "previous output at p + motion elsewhere, holes filled spatially",
+               .has_state = true},
+      .layers = history_method_layers,
+      .implementations = {{kCpuDevice,
+                           [](const Options&, const Geometry& g) -> std::unique_ptr<MethodState> {
+                             return std::make_unique<TemporalState>(g);
+                           }}},
+      .streamed_bytes = streamed_bytes};
   return entry;
 }
 

@@ -209,7 +209,10 @@ Status Upsampler::Impl::prepare_state(std::span<const std::string> channels, con
   const Geometry g{f.W, f.H, f.grid.k, f.lw, f.lh, std::vector<std::string>(channels.begin(), channels.end())};
   if (!state || !(g == geometry)) {
     geometry = g;
-    state = entry->make_state(options, geometry);
+    // The CPU implementation: every method has one (a device option will choose among several).
+    const auto* implementation = find_implementation(*entry, kCpuDevice);
+    if (!implementation) return Error::internal("--method " + options.method + " has no CPU implementation");
+    state = implementation->make(options, geometry);
     have_history = false;
   }
   if (!pending) return Status::ok();

@@ -14,6 +14,7 @@
 namespace {
 
 using namespace temporal;
+using namespace temporal::morph;
 
 // A panning camera over a textured plane with eight occluders moving in different directions.
 struct Scene {
@@ -90,8 +91,8 @@ void BM_PerceiveHold1024(benchmark::State& state) {
 }
 
 [[maybe_unused]] const bool registered = [] {
-  for (const auto& m : morph_methods())
-    benchmark::RegisterBenchmark(("BM_" + m.name + "1024x3").c_str(), run_method, m.name)
+  for (const MethodEntry* e : registry())
+    benchmark::RegisterBenchmark(("BM_" + e->info.name + "1024x3").c_str(), run_method, e->info.name)
         ->Arg(0)
         ->Arg(1)
         ->Unit(benchmark::kMillisecond)

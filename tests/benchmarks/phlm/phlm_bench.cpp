@@ -18,6 +18,7 @@
 namespace {
 
 using namespace temporal;
+using namespace temporal::phlm;
 constexpr int kW = 1920, kH = 1080;
 
 struct Scene {

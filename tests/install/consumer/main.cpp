@@ -38,16 +38,15 @@ int main(int argc, char** argv) {
   auto list = resolve_frames(*pattern, std::nullopt);
   if (!list) return std::fprintf(stderr, "%s\n", list.error().message.c_str()), 1;
   // Any method of filter-phlm by name, from the registry (temporal/phlm/filters.h), with its default parameters.
-  FilterOptions options;
-  const FilterMethod* method = find_filter_method("phlm");
-  if (!method) return std::fprintf(stderr, "no method phlm\n"), 1;
-  std::unique_ptr<FrameFilter> filter = method->create(options);
+  auto made = phlm::make_filter(phlm::FilterOptions{.method = "phlm"});
+  if (!made) return std::fprintf(stderr, "%s\n", made.error().message.c_str()), 1;
+  std::unique_ptr<phlm::FrameFilter> filter = std::move(*made);
   Image output;
   double psnr_in = 0, psnr_out = 0;
   for (const int f : *list) {
     auto frame = read_exr(pattern->path(f), ExrSelection{{"rgb"}});
     if (!frame) return std::fprintf(stderr, "%s\n", frame.error().message.c_str()), 1;
-    FilterInput in;
+    phlm::FilterInput in;
     in.color = &*frame;
     in.channels = {"R", "G", "B"};
     in.reset = f == list->front();

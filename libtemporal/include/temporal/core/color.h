@@ -22,4 +22,19 @@ inline void ycgco_to_rgb(float y, float cg, float co, float& r, float& g, float&
   b = t - co;
 }
 
+// The space the temporal methods clip their histories in, against the box of a 3x3 neighbourhood (Karis 2014: a
+// tighter box around chroma; FSR 2 RectifyHistory): each R,G,B triple of a pixel's `channels` values as YCgCo, the
+// channels left over (a one-channel payload such as ssao.Y, a fourth channel) as they are. `in` and `out` may be the
+// same array. Used by phlm's box test, taa's clipping and taau's rectification.
+inline void to_ycgco_box(const float* in, float* out, int channels) {
+  int c = 0;
+  for (; c + 3 <= channels; c += 3) rgb_to_ycgco(in[c], in[c + 1], in[c + 2], out[c], out[c + 1], out[c + 2]);
+  for (; c < channels; ++c) out[c] = in[c];
+}
+inline void from_ycgco_box(const float* in, float* out, int channels) {
+  int c = 0;
+  for (; c + 3 <= channels; c += 3) ycgco_to_rgb(in[c], in[c + 1], in[c + 2], out[c], out[c + 1], out[c + 2]);
+  for (; c < channels; ++c) out[c] = in[c];
+}
+
 }  // namespace temporal

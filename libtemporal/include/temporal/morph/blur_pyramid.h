@@ -14,7 +14,7 @@
 #include <span>
 #include <vector>
 
-namespace temporal {
+namespace temporal::morph {
 
 class BlurPyramid {
  public:
@@ -43,4 +43,4 @@ class BlurPyramid {
   mutable std::vector<float> scratch_;
 };
 
-}  // namespace temporal
+}  // namespace temporal::morph

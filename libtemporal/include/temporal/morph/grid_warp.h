@@ -13,7 +13,7 @@
 #include <span>
 #include <vector>
 
-namespace temporal {
+namespace temporal::morph {
 
 struct GridOptions {
   int cell = 8;                 // cell size in pixels, a power of two in [2, 32] (paper: 8x8)
@@ -112,4 +112,4 @@ class GridRasterizer {
 // `debug.grid` layer.
 void draw_grid_lines(const SnappedGrid& grid, std::span<const float> tx, std::span<const float> ty, float* plane);
 
-}  // namespace temporal
+}  // namespace temporal::morph

@@ -22,7 +22,7 @@
 #include <string>
 #include <vector>
 
-namespace temporal {
+namespace temporal::morph {
 
 struct HoldBlurOptions {
   int window = 3;             // displayed frames integrated by the eye (>= 1)
@@ -72,4 +72,4 @@ struct LagAlignment {
 Expected<LagAlignment> align_lag(const Image& perceived, const Image& reference, const std::vector<std::string>& channels,
                                  const float* motion_x, const float* motion_y, const LagSearchOptions& options = {});
 
-}  // namespace temporal
+}  // namespace temporal::morph

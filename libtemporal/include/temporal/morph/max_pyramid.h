@@ -13,7 +13,7 @@
 #include <cstdint>
 #include <vector>
 
-namespace temporal {
+namespace temporal::morph {
 
 class MaxPyramid {
  public:
@@ -43,4 +43,4 @@ class MaxPyramid {
   std::vector<int> widths_, heights_;
 };
 
-}  // namespace temporal
+}  // namespace temporal::morph

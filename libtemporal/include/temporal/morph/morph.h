@@ -8,7 +8,7 @@
 // slots k >= 1 are extrapolated from frame n and its motion, with no added latency (except `blend`).
 //
 // Methods are units listed in one registry (temporal/morph/methods.h: name, what each reads, its parameters and
-// latency, its factory); docs/morph-120hz.md has the details and every choice the paper leaves open:
+// latency, its implementations); docs/morph-120hz.md has the details and every choice the paper leaves open:
 //  - didyk:  snapped grid morph + depth test + selective blur + high-frequency compensation (sections 5-6).
 //  - repeat: every slot shows frame n (a 40 Hz stream on a 120 Hz hold-type display).
 //  - blend:  slot k = (1 - k/N) frame n + (k/N) frame n+1 in linear light; needs frame n+1, so it adds one
@@ -18,6 +18,7 @@
 #pragma once
 
 #include "temporal/core/error.h"
+#include "temporal/core/method.h"
 #include "temporal/morph/grid_warp.h"
 #include "temporal/core/image.h"
 #include "temporal/core/viewing.h"  // pixels_per_degree (eye-tracking limit)
@@ -29,31 +30,33 @@
 #include <string>
 #include <vector>
 
-namespace temporal {
+namespace temporal::morph {
 
-class MorphMethod;       // temporal/morph/methods.h
-struct MorphMethodInfo;  // temporal/morph/methods.h
+class MorphMethod;  // temporal/morph/methods.h
+struct MethodEntry;
 
-// The options of every method; each method reads the fields it needs (its parameters, methods.h).
+// Every registered method's own parameters (temporal/morph/methods.h), with their defaults.
+MethodOptionSet default_method_options();
+
+// The options of a run: the method, what every method shares, and each method's own parameters (didyk's grid,
+// blur and compensation: src/morph/didyk.cpp, DidykOptions).
 struct MorphOptions {
-  std::string method = "didyk";  // a name of the registry, morph_methods() (temporal/morph/methods.h)
-  int factor = 3;             // displayed frames per rendered frame, >= 2 (40 Hz -> 120 Hz: 3)
-  float gamma = 2.2f;         // display gamma g: displayed light = value^g, value in [0, 1]
-  GridOptions grid;           // cell size, snapping, eye-tracking limit (pixels per degree and fps: the sequence
-                              // stage sets them from ViewingOptions and the input's rate, morph_stage.h)
-  float blur_level = 2.0f;    // pyramid level read for the low-pass layer L (fractional allowed)
-  // Smooth-step from cell distortion to blur strength of the in-between frames: 0 below distortion_low,
-  // 1 above distortion_high (section 5.1, "Selective Blur").
-  float distortion_low = 0.05f;
-  float distortion_high = 0.5f;
-  float min_blur = 0.0f;      // blur strength floor in [0, 1] (1: blur every in-between frame fully, as [CKL*05])
-  bool compensate = true;     // high-frequency compensation of the rendered frame (section 5.1)
+  std::string method = "didyk";  // a name of the registry (temporal/morph/methods.h)
+  int factor = 3;                // displayed frames per rendered frame, >= 2 (40 Hz -> 120 Hz: 3)
+  float gamma = 2.2f;            // display gamma g: displayed light = value^g, value in [0, 1]
+  // The eye-tracking limit (seed 004 section 6): pixels per degree of the viewing geometry (<= 0: no limit) and the
+  // rendered sequence's frame rate. The sequence stage sets both from ViewingOptions and the input's rate
+  // (morph_stage.h).
+  float pixels_per_degree = 0.0f;
+  double fps = 40.0;
   bool debug_layers = false;  // add debug.grid, debug.distortion, debug.blur, debug.H, debug.Hprime
+  MethodOptionSet per_method = default_method_options();
 };
 
-// Usage error unless the options are valid for any input: a known method, factor >= 2, a grid cell that is a
-// power of two in [2, 32], gamma > 0, blur level in [0, 8]. Morpher::process checks them too.
-Status check_morph_options(const MorphOptions& options);
+// Usage error unless the options are valid for any input: a known method, factor >= 2, gamma > 0, and every
+// method's own parameters (didyk: a grid cell that is a power of two in [2, 32], blur level in [0, 8]).
+// Morpher::process checks them too.
+Status check(const MorphOptions& options);
 
 // The debug layers every output carries with MorphOptions::debug_layers (zero where a method has nothing to show).
 inline constexpr const char* kMorphDebugLayers[5] = {"debug.grid", "debug.distortion", "debug.blur", "debug.H",
@@ -112,8 +115,8 @@ class Morpher {
   Status check(const Image& color, const Image* gbuffer, const Image* next) const;
 
   MorphOptions options_;
-  const MorphMethodInfo* info_ = nullptr;  // registry entry of options_.method (set on first use)
+  const MethodEntry* entry_ = nullptr;  // registry entry of options_.method (set on first use)
   std::unique_ptr<MorphMethod> method_;    // its state (buffers kept between frames)
 };
 
-}  // namespace temporal
+}  // namespace temporal::morph

@@ -25,7 +25,7 @@
 #include <memory>
 #include <string>
 
-namespace temporal {
+namespace temporal::morph {
 
 // Where the viewer sits: the eye-tracking limit of didyk (seed 004 section 6) needs pixels per degree. Defaults:
 // the paper's display (Samsung 2233RZ, 0.473 m wide, 1680 pixels) seen from 0.6 m, images shown 1:1.
@@ -58,8 +58,9 @@ struct MorphStageOptions {
   LagSearchOptions lag;
 };
 
-// Every parameter of the tool: the method (its choices and help from the registry), factor, fps, debug layers,
-// perceive and its window, then each registered method's own parameters (a flag listed by several methods once).
+// Every parameter of the tool: those of MorphOptions (params(), temporal/morph/methods.h: the method, factor,
+// gamma, debug layers, each registered method's own), then the input rate, the display and viewing geometry,
+// perceive and its window.
 ParamList morph_stage_params(MorphStageOptions& options);
 
 // The file and colour-management services the stage needs for two options, given by the caller so that the
@@ -76,4 +77,4 @@ struct MorphStageIO {
 // option needs a service that `io` lacks.
 Expected<std::unique_ptr<FrameStage>> make_morph_stage(const MorphStageOptions& options, const MorphStageIO& io = {});
 
-}  // namespace temporal
+}  // namespace temporal::morph

@@ -16,7 +16,7 @@
 #include <string>
 #include <vector>
 
-namespace temporal {
+namespace temporal::phlm {
 
 struct EmaParams {
   float alpha = 0.5f;            // history weight of eq. 1, chosen on the tuning set (docs/filter-phlm.md)
@@ -47,4 +47,4 @@ class EmaFilter final : public FrameFilter {
   std::vector<std::uint8_t> valid_;  // 1 where the input pixel is finite
 };
 
-}  // namespace temporal
+}  // namespace temporal::phlm

@@ -1,56 +1,72 @@
-// The methods of `filter-phlm` as units: one registry line per method (src/phlm/registry.cpp), each with its
-// parameters, the G-buffer layers it reads and a factory; adding a method is one source file, one registry line and
-// its section in docs/filter-phlm.md. The tool binds every method's parameters to its command line from here, and
-// runs the chosen method through the sequence runner (temporal/io/runner.h).
+// The methods of `filter-phlm` as units, in the pattern every stage shares (temporal/core/method.h): each method's
+// source file (src/phlm/phlm.cpp, taa.cpp, ema.cpp, fxaa.cpp) defines its MethodEntry (what it is, its own
+// parameters with their defaults, the G-buffer layers it reads, its implementations), and src/phlm/registry.cpp
+// lists the entries, one line each. Adding a method is one source file, its line in registry.cpp and its section in
+// docs/filter-phlm.md: no public header, no field here. The tool binds every method's parameters to its command
+// line from here (params()), prints --list-methods(-json) from registry(), and runs the chosen method through the
+// sequence runner (temporal/io/runner.h).
 #pragma once
 
+#include "temporal/core/method.h"
 #include "temporal/core/params.h"
 #include "temporal/core/stage.h"
-#include "temporal/phlm/ema.h"
 #include "temporal/phlm/frame_filter.h"
-#include "temporal/phlm/fxaa.h"
-#include "temporal/phlm/phlm.h"
-#include "temporal/phlm/taa.h"
 
 #include <memory>
 #include <string>
 #include <string_view>
 #include <vector>
 
-namespace temporal {
+namespace temporal::phlm {
 
-// Every option of filter-phlm. The defaults are those of each method's parameter struct.
+// Every registered method's own parameters, with their defaults.
+MethodOptionSet default_method_options();
+
+// Every option of filter-phlm: the method, the layer, debug layers, and each method's own parameters.
 struct FilterOptions {
-  std::string method = "phlm";
-  std::string layer = "rgb";  // rgb (R,G,B) or a layer name (ssao, shadow, direct, ...)
+  std::string method = "phlm";  // a name of the registry
+  std::string layer = "rgb";    // rgb (R,G,B) or a layer name (ssao, shadow, direct, ...)
   bool debug_layers = false;
-  PhlmParams phlm;
-  TaaParams taa;
-  EmaParams ema;
-  FxaaParams fxaa;
+  MethodOptionSet per_method = default_method_options();
 };
+
+// A method's filter for these (checked) options, on one device.
+using FilterFactory = std::unique_ptr<FrameFilter> (*)(const FilterOptions&);
 
 // One method of filter-phlm.
-struct FilterMethod {
-  const char* name;     // --method value
-  const char* summary;  // one line for --help and the docs
+struct MethodEntry {
+  MethodInfo info;  // name (--method), summary, has_state (false: spatial, no --state-in / --state-out)
+  // The method's own parameters with their defaults (nullptr: none).
+  std::unique_ptr<MethodOptions> (*make_options)() = nullptr;
   // G-buffer layers it reads when --gbuffer is given (motion always; EMA also depth and id).
-  std::vector<LayerNeed> gbuffer_layers;
-  // Its parameters, bound to the fields of `options` (the CLI and the benchmark use them).
-  ParamList (*params)(FilterOptions& options);
-  std::unique_ptr<FrameFilter> (*create)(const FilterOptions& options);
+  std::vector<LayerNeed> (*layers)(const FilterOptions&) = nullptr;
+  // Its implementations, per device ("cpu").
+  std::vector<Implementation<FilterFactory>> implementations = {};
 };
 
-// The registry, in the order of the docs and --help.
-const std::vector<FilterMethod>& filter_methods();
+// The registry, in the order of the docs, --help and --list-methods.
+const std::vector<const MethodEntry*>& registry();
 // The method called `name`, or nullptr.
-const FilterMethod* find_filter_method(std::string_view name);
-// "phlm | taa | ema | fxaa" (for help texts).
-std::string filter_method_names();
+const MethodEntry* find_entry(std::string_view name);
+// Every method with its defaults followed by its named variants, in table order.
+const std::vector<MethodVariant>& method_variants();
+// The variant (or plain method) called `name`, or nullptr.
+const MethodVariant* find_variant(std::string_view name);
+
+// Every parameter of the tool, pointing at the fields of `options`: --method, --layer, --debug-layers, then each
+// method's own (help prefixed with the method's name). Valid while `options` lives and is not moved.
+ParamList params(FilterOptions& options);
+// Usage error unless the method exists and every parameter is valid.
+Status check(const FilterOptions& options);
+// Options for `method` with parameters set by command-line style arguments, e.g. make_options("taa",
+// {"--taa-clip", "minmax"}). Usage error for an unknown method or parameter, or an invalid value.
+Expected<FilterOptions> make_options(const std::string& method, const std::vector<std::string>& args = {});
+// The CPU filter of options.method with its parameters (check() first).
+Expected<std::unique_ptr<FrameFilter>> make_filter(const FilterOptions& options);
 
 // The runner stage of filter-phlm (temporal/io/runner.h): selects the layer's channels of each frame, feeds the
 // method with the frame's motion (and depth and ids), times it and saves / resumes its state. Usage error for an
 // unknown method or invalid parameters.
 Expected<std::unique_ptr<FrameStage>> make_filter_stage(const FilterOptions& options);
 
-}  // namespace temporal
+}  // namespace temporal::phlm

@@ -12,7 +12,7 @@
 #include <string>
 #include <vector>
 
-namespace temporal {
+namespace temporal::phlm {
 
 // One input frame. Planes are width x height, row-major (the planes of an Image).
 struct FilterInput {
@@ -62,9 +62,8 @@ class FrameFilter {
   virtual ~FrameFilter() = default;
   // Filters one frame into `output` (same size; channels named like the input's; debug.* planes when in.debug).
   virtual Status process(const FilterInput& in, Image& output, FilterStats* stats = nullptr) = 0;
-  // Persistent state for --state-out / --state-in (spatial filters have none).
-  virtual bool has_state() const { return true; }
-  // The state after the last frame as named planes, as --state-out writes it; empty before the first frame.
+  // The state after the last frame as named planes, as --state-out writes it; empty before the first frame (and
+  // always for a spatial filter: its registry entry says has_state = false, temporal/phlm/filters.h).
   virtual Image saved_state() const = 0;
   // Resumes from a state written by state() (the next frame continues bit for bit). `channels`: 1 or 3.
   virtual Status set_state(const Image& state, int channels) = 0;
@@ -72,4 +71,4 @@ class FrameFilter {
   virtual std::string stats_text(const FilterStats& stats) const { return {}; }
 };
 
-}  // namespace temporal
+}  // namespace temporal::phlm

@@ -14,7 +14,7 @@
 #include "temporal/phlm/frame_filter.h"
 #include "temporal/core/image.h"
 
-namespace temporal {
+namespace temporal::phlm {
 
 struct FxaaParams {
   float subpix = 0.75f;              // fxaaQualitySubpix
@@ -33,7 +33,6 @@ class FxaaFilter final : public FrameFilter {
   Status process(const FilterInput& in, Image& output, FilterStats* stats = nullptr) override {
     return fxaa(in, output, params_, stats);
   }
-  bool has_state() const override { return false; }
   Image saved_state() const override { return {}; }
   Status set_state(const Image&, int) override {
     return Error::usage("--method fxaa is spatial and has no state: drop --state-in / --state-out");
@@ -43,4 +42,4 @@ class FxaaFilter final : public FrameFilter {
   FxaaParams params_;
 };
 
-}  // namespace temporal
+}  // namespace temporal::phlm

@@ -22,7 +22,7 @@
 #include <string>
 #include <vector>
 
-namespace temporal {
+namespace temporal::phlm {
 
 struct PhlmParams {
   float lambda = 0.998f;   // RLS forgetting factor (eq. 6-7, section 4)
@@ -99,4 +99,4 @@ class PhlmFilter final : public FrameFilter {
   std::vector<std::uint8_t> valid_;  // 1 where every channel of the input pixel is finite
 };
 
-}  // namespace temporal
+}  // namespace temporal::phlm

@@ -22,14 +22,11 @@
 // all of D is scaled down. Both keep P symmetric positive definite.
 #pragma once
 
+#include "temporal/core/minmax.h"
+
 #include <cmath>
 
-namespace temporal::rls {
-
-// Plain comparisons instead of std::fmin / std::fmax: those honour NaN operands and are not inlined by GCC
-// (a libm call per use, measured 11% of the PHLM frame); every operand here is finite.
-inline float min_(float a, float b) { return b < a ? b : a; }
-inline float max_(float a, float b) { return a < b ? b : a; }
+namespace temporal::phlm::rls {
 
 // Number of strictly-upper entries of an N x N unit upper triangular U.
 template <int N>
@@ -152,14 +149,14 @@ inline float update(Model<N, C>& m, const float x[N], const float y[C], float la
   for (int c = 0; c < C; ++c)
     for (int k = 0; k < N; ++k) m.beta[c][k] += gain[k] * e[c];  // eq. 6
   const float inv_lambda = 1.0f / lambda;                          // eq. 7
-  for (int k = 0; k < N; ++k) m.d[k] = min_(max_(m.d[k] * inv_lambda, kMinD), d_max);
+  for (int k = 0; k < N; ++k) m.d[k] = fast_min(fast_max(m.d[k] * inv_lambda, kMinD), d_max);
   float t = trace<N>(m.u, m.d);
   if (t > trace_max) {
     const float scale = trace_max / t;
-    for (int k = 0; k < N; ++k) m.d[k] = max_(m.d[k] * scale, kMinD);
+    for (int k = 0; k < N; ++k) m.d[k] = fast_max(m.d[k] * scale, kMinD);
     t = trace<N>(m.u, m.d);
   }
   return t;
 }
 
-}  // namespace temporal::rls
+}  // namespace temporal::phlm::rls

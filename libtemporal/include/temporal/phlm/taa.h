@@ -29,7 +29,7 @@
 #include <string>
 #include <vector>
 
-namespace temporal {
+namespace temporal::phlm {
 
 struct TaaParams {
   // Weight of the current frame in the exponential blend. Chosen by pipelines/filter-phlm-tune.sh on the tuning
@@ -71,4 +71,4 @@ class TaaFilter final : public FrameFilter {
   std::vector<std::uint8_t> valid_;  // 1 where the input pixel is finite
 };
 
-}  // namespace temporal
+}  // namespace temporal::phlm

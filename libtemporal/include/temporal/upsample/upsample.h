@@ -11,6 +11,8 @@
 //   drobot    seed 002: reprojection cache at low resolution + exponential history with convergence,
 //             convergence-steered separable bilateral filter, Listing 7.1 bilateral upsampling; or its
 //             refresh-buffer reconstruction (Figure 7.12, `--mode refresh`)                 [drobot.h]
+//   taau      engine-class temporal upscaler after FSR 2 / UE4 TAAU: Lanczos-2 reconstruction, YCoCg history
+//             rectification, per-pixel accumulation weight, thin-feature locks                [src/upsample/taau.cpp]
 //
 // Inputs per frame (docs/conventions.md): the G-buffer at full resolution (`depth.Z`, `N.X/Y/Z`,
 // `motion.X/Y`, `id`; metadata clipNear/clipFar) and the payload at 1/k resolution per axis with
@@ -26,6 +28,7 @@
 
 #include "temporal/core/error.h"
 #include "temporal/core/image.h"
+#include "temporal/core/method.h"
 #include "temporal/core/params.h"
 #include "temporal/core/reproject.h"
 #include "temporal/upsample/joint_bilateral.h"
@@ -39,39 +42,13 @@
 
 namespace temporal::upsample {
 
-// A method's own parameters: an options struct defined in the method's source file (its fields hold the
-// defaults) that lists them as Params pointing at those fields. Options holds one per registered method, so that
-// the command line binds every method's flags before the method is chosen.
-class MethodOptions {
- public:
-  virtual ~MethodOptions() = default;
-  virtual std::unique_ptr<MethodOptions> clone() const = 0;
-  virtual ParamList params() = 0;
-  // Checks that a range cannot express (e.g. a power of two); the ranges themselves are checked by the Params.
-  virtual Status check() const { return Status::ok(); }
-};
-
-// The per-method options of Options: one entry per registered method, copied deeply.
-class MethodOptionSet {
- public:
-  MethodOptionSet();  // every registered method's options, with their defaults
-  MethodOptionSet(const MethodOptionSet& other);
-  MethodOptionSet& operator=(const MethodOptionSet& other);
-  MethodOptionSet(MethodOptionSet&&) noexcept = default;
-  MethodOptionSet& operator=(MethodOptionSet&&) noexcept = default;
-  ~MethodOptionSet();
-  // The options of method `name` (nullptr for a method without parameters or an unknown name).
-  MethodOptions* find(const std::string& name);
-  const MethodOptions* find(const std::string& name) const;
-
- private:
-  std::vector<std::pair<std::string, std::unique_ptr<MethodOptions>>> entries_;
-};
+// Every registered method's own parameters (temporal/core/method.h), with their defaults.
+MethodOptionSet default_method_options();
 
 // Options of the upsampling stage. The defaults are here (shared parameters) and in each method's options struct
 // (MethodOptions); the command line binds to them through params().
 struct Options {
-  std::string method = "herzog";  // a name of methods() (temporal/upsample/methods.h)
+  std::string method = "herzog";  // a name of the registry (temporal/upsample/methods.h)
   std::string layer = "rgb";      // payload layers: `rgb` (bare R,G,B) or layer names, comma-separated
 
   // --- seed 000, section 3.1 (spatial weights, every method) ---
@@ -99,7 +76,7 @@ struct Options {
 
   bool debug_layers = false;  // add debug.* layers to the result
 
-  MethodOptionSet per_method;  // each method's own parameters
+  MethodOptionSet per_method = default_method_options();  // each method's own parameters
 
   // The disocclusion test of the history fetch (with prevDepth.Z, reproject::expect_depth sets the warped
   // tolerance).

@@ -1,0 +1,201 @@
+// The methods of a stage as units, one pattern for every stage (upsample-st's methods, filter-phlm's filters,
+// morph-120hz's methods). A method's source file defines its registry entry: what it is (MethodInfo), its own
+// parameters (an options struct with defaults and `ParamList params()`, wrapped by OptionsOf), the G-buffer
+// layers it reads, and its implementations (one per device: "cpu" today). The stage's registry.cpp lists the
+// entries, one line each. Everything else is derived from that list: the --method choices and --help, each
+// method's options inside the stage's options (MethodOptionSet), --list-methods and --list-methods-json, the
+// variants the benchmarks and tests run, the layers read. A stage's entry type starts with the three members the
+// helpers below read:
+//   struct MethodEntry {
+//     MethodInfo info;
+//     std::unique_ptr<MethodOptions> (*make_options)() = nullptr;  // nullptr: no parameters of its own
+//     std::vector<LayerNeed> (*layers)(const StageOptions&) = nullptr;
+//     std::vector<Implementation<Factory>> implementations = {};
+//     ...  // what only that stage needs
+//   };
+// and each stage offers registry(), find_entry(name) (nullptr when unknown), method_variants(), find_variant().
+#pragma once
+
+#include "temporal/core/error.h"
+#include "temporal/core/params.h"
+#include "temporal/core/suggest.h"
+
+#include <memory>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <utility>
+#include <vector>
+
+namespace temporal {
+
+// The device of the implementations every method has.
+inline constexpr const char* kCpuDevice = "cpu";
+
+// A named way to run a method: the method and the arguments that select the variant, written as on the command
+// line ("herzog-lagged" = --method herzog --lagged-wf).
+struct MethodVariant {
+  std::string name;
+  std::string method;
+  std::vector<std::string> args;
+  std::string summary;
+};
+
+// What a method is, as --help and --list-methods say it.
+struct MethodInfo {
+  std::string name;                     // --method NAME, `temporal:method`
+  std::string summary;                  // one line, with the paper and its equations
+  bool has_state = false;               // keeps anything between frames (--state-in / --state-out)
+  std::vector<MethodVariant> variants = {};  // named variants besides the defaults
+  // Stages with the notion (morph): rendered frames of display latency the method adds.
+  std::optional<int> latency_frames = std::nullopt;
+  // (Every member has a default initializer: entries name only what they set, and GCC's
+  // -Wmissing-field-initializers stays quiet about the rest.)
+};
+
+// One implementation of a method: the device it runs on and its factory (the stage's type: a filter, a state).
+template <typename Factory>
+struct Implementation {
+  const char* device;
+  Factory make;
+};
+
+// A method's own parameters: an options struct defined in the method's source file (its fields hold the defaults)
+// that lists them as Params pointing at those fields. A stage's options hold one per registered method
+// (MethodOptionSet), so that the command line binds every method's flags before the method is chosen.
+class MethodOptions {
+ public:
+  virtual ~MethodOptions() = default;
+  virtual std::unique_ptr<MethodOptions> clone() const = 0;
+  virtual ParamList params() = 0;
+  // Checks that a range cannot express (e.g. a power of two); the ranges themselves are checked by the Params.
+  virtual Status check() const { return Status::ok(); }
+};
+
+// A method's options struct T (fields with defaults, `ParamList params()`, optionally `Status check() const`) as
+// MethodOptions.
+template <typename T>
+class OptionsOf : public MethodOptions, public T {
+ public:
+  std::unique_ptr<MethodOptions> clone() const override { return std::make_unique<OptionsOf>(*this); }
+  ParamList params() override { return T::params(); }
+  Status check() const override {
+    if constexpr (requires(const T& t) { t.check(); })
+      return T::check();
+    else
+      return Status::ok();
+  }
+  static std::unique_ptr<MethodOptions> make() { return std::make_unique<OptionsOf>(); }
+};
+
+// The options of every method of a stage that has parameters, by method name; copied deeply.
+class MethodOptionSet {
+ public:
+  MethodOptionSet() = default;
+  MethodOptionSet(const MethodOptionSet& other);
+  MethodOptionSet& operator=(const MethodOptionSet& other);
+  MethodOptionSet(MethodOptionSet&&) noexcept = default;
+  MethodOptionSet& operator=(MethodOptionSet&&) noexcept = default;
+  ~MethodOptionSet();
+  void add(std::string name, std::unique_ptr<MethodOptions> options);
+  // The options of method `name` (nullptr for a method without parameters or an unknown name).
+  MethodOptions* find(std::string_view name);
+  const MethodOptions* find(std::string_view name) const;
+
+ private:
+  std::vector<std::pair<std::string, std::unique_ptr<MethodOptions>>> entries_;
+};
+
+// The typed view of method `name`'s options T in `set` (T's defaults when the set has none).
+template <typename T>
+const T& method_options(const MethodOptionSet& set, std::string_view name) {
+  static const OptionsOf<T> defaults;
+  const MethodOptions* m = set.find(name);
+  return m ? static_cast<const OptionsOf<T>&>(*m) : defaults;
+}
+
+// --- Helpers every stage's registry.cpp uses on its table (a vector of `const Entry*`) ------------------------
+
+template <typename Entry>
+const Entry* find_entry_in(const std::vector<const Entry*>& registry, std::string_view name) {
+  for (const Entry* e : registry)
+    if (e->info.name == name) return e;
+  return nullptr;
+}
+
+template <typename Entry>
+std::vector<std::string> method_names(const std::vector<const Entry*>& registry) {
+  std::vector<std::string> names;
+  for (const Entry* e : registry) names.push_back(e->info.name);
+  return names;
+}
+
+// Usage error for `--method name` unless the registry has it (not_one_of's wording, with its suggestion).
+template <typename Entry>
+Status check_method_name(const std::vector<const Entry*>& registry, std::string_view name) {
+  if (find_entry_in(registry, name)) return Status::ok();
+  return not_one_of("--method", name, method_names(registry));
+}
+
+// Every method with its defaults (named after the method, no arguments) followed by its named variants, in
+// table order: what --list-methods prints and the benchmarks and tests run.
+template <typename Entry>
+std::vector<MethodVariant> method_variants_of(const std::vector<const Entry*>& registry) {
+  std::vector<MethodVariant> v;
+  for (const Entry* e : registry) {
+    v.push_back({e->info.name, e->info.name, {}, e->info.summary});
+    v.insert(v.end(), e->info.variants.begin(), e->info.variants.end());
+  }
+  return v;
+}
+
+// The options of every method with parameters, with their defaults.
+template <typename Entry>
+MethodOptionSet method_option_set(const std::vector<const Entry*>& registry) {
+  MethodOptionSet set;
+  for (const Entry* e : registry)
+    if (e->make_options) set.add(e->info.name, e->make_options());
+  return set;
+}
+
+// Each method's own parameters, bound to `set`, their help prefixed with the method's name ("taau: ...").
+template <typename Entry>
+ParamList method_params(const std::vector<const Entry*>& registry, MethodOptionSet& set) {
+  ParamList list;
+  for (const Entry* e : registry)
+    if (MethodOptions* m = set.find(e->info.name))
+      for (Param p : m->params()) {
+        p.help = e->info.name + ": " + p.help;
+        list.push_back(std::move(p));
+      }
+  return list;
+}
+
+// The ranges of every method's parameters, then each method's own check().
+template <typename Entry>
+Status check_method_options(const std::vector<const Entry*>& registry, const MethodOptionSet& set) {
+  MethodOptionSet copy = set;  // params() points at the fields it is given
+  if (Status s = check_params(method_params(registry, copy)); !s) return s;
+  for (const Entry* e : registry)
+    if (const MethodOptions* m = set.find(e->info.name))
+      if (Status s = m->check(); !s) return s;
+  return Status::ok();
+}
+
+// The implementation of `entry` for `device`, or nullptr.
+template <typename Entry>
+auto find_implementation(const Entry& entry, std::string_view device) -> decltype(&entry.implementations.front()) {
+  for (const auto& i : entry.implementations)
+    if (device == i.device) return &i;
+  return nullptr;
+}
+
+// The devices `entry` has an implementation for, in its order ({"cpu"}).
+template <typename Entry>
+std::vector<std::string> implementation_devices(const Entry& entry) {
+  std::vector<std::string> devices;
+  for (const auto& i : entry.implementations) devices.emplace_back(i.device);
+  return devices;
+}
+
+}  // namespace temporal
