@@ -210,6 +210,7 @@ Status Run::open() {
   report_.motion_compensated = !setup_.gbuffer.empty();
   report_.warmup_frames = setup_.warmup_frames;
   report_.bootstrap = setup_.bootstrap;
+  report_.speed_metric = setup_.speed_metric;
   report_.peak = setup_.peak;
   report_.peak_from_data = setup_.peak_from_data;
   report_.flip = setup_.flip;
@@ -753,6 +754,50 @@ std::optional<double> mean_compute_ms(const SequenceReport& sequence) {
   return std::nullopt;
 }
 
+std::vector<std::size_t> pareto_front(const std::vector<double>& cost, const std::vector<double>& score) {
+  const std::size_t n = std::min(cost.size(), score.size());
+  std::vector<std::size_t> front;
+  for (std::size_t i = 0; i < n; ++i) {
+    if (!std::isfinite(cost[i]) || !std::isfinite(score[i])) continue;
+    bool dominated = false;
+    for (std::size_t j = 0; j < n && !dominated; ++j)
+      dominated = j != i && std::isfinite(cost[j]) && std::isfinite(score[j]) && cost[j] <= cost[i] &&
+                  score[j] >= score[i] && (cost[j] < cost[i] || score[j] > score[i]);
+    if (!dominated) front.push_back(i);
+  }
+  std::stable_sort(front.begin(), front.end(), [&](std::size_t a, std::size_t b) { return cost[a] < cost[b]; });
+  return front;
+}
+
+std::vector<SpeedPoint> speed_points(const ComparisonReport& report) {
+  const MetricDefinition* d = find_metric(report.speed_metric);
+  const bool higher = d ? d->higher_is_better : true;
+  std::vector<SpeedPoint> points;
+  for (std::size_t i = 0; i < report.sequences.size(); ++i) {
+    const SequenceReport& s = report.sequences[i];
+    if (s.compute_kind != ComputeKind::Method) continue;
+    const auto ms = mean_compute_ms(s);
+    const MetricSummary m = summarize(s, report.speed_metric);
+    if (!ms || !m.count || !std::isfinite(m.mean)) continue;  // +inf PSNR (identical frames) has no place
+    points.push_back({i, *ms, m.mean, false});
+  }
+  std::vector<double> cost, score;  // pareto_front wants a score where higher is better
+  for (const SpeedPoint& p : points) {
+    cost.push_back(p.compute_ms);
+    score.push_back(higher ? p.value : -p.value);
+  }
+  for (const std::size_t k : pareto_front(cost, score)) points[k].on_front = true;
+  return points;
+}
+
+Status check_speed_metric(const ComparisonSetup& setup) {
+  const MetricDefinition* d = find_metric(setup.speed_metric);
+  if (!d) return Error::usage("--speed-metric '" + setup.speed_metric + "' is not a metric (compare --list-metrics)");
+  if (d->enabled && !d->enabled(setup))
+    return Error::usage("--speed-metric " + d->name + " is not measured in this run: " + d->enable_hint);
+  return Status::ok();
+}
+
 const char* compute_kind_name(ComputeKind kind) {
   switch (kind) {
     case ComputeKind::Render: return "render";
@@ -773,11 +818,11 @@ ComputeKind compute_kind_of(const FrameMetadata& header) {
 std::string ThresholdFailure::message() const {
   if (!text.empty()) return sequence + ": " + text;
   const MetricDefinition* d = find_metric(metric);
-  const char* unit = d ? d->unit.c_str() : "";
+  const std::string unit = d ? unit_suffix(*d) : std::string();
   const bool higher = d ? d->higher_is_better : true;
   char text[256];
-  std::snprintf(text, sizeof text, "%s: %s %.6g%s %s limit %.6g%s", sequence.c_str(), metric.c_str(), value, unit,
-                higher ? "<" : ">", limit, unit);
+  std::snprintf(text, sizeof text, "%s: %s %.6g%s %s limit %.6g%s", sequence.c_str(), metric.c_str(), value,
+                unit.c_str(), higher ? "<" : ">", limit, unit.c_str());
   return text;
 }
 

@@ -47,17 +47,13 @@ std::vector<const float*> planes_of(const Image& image, std::span<const std::str
 }  // namespace
 
 std::string metric_label(std::string_view metric) {
-  if (metric == "psnr_rgb") return "PSNR";
-  if (metric == "psnr_y") return "PSNR-Y";
-  if (metric == "ssim") return "SSIM";
-  if (metric == "flicker") return "flicker";
-  if (metric == "flip") return "FLIP";
-  return std::string(metric);
+  const MetricDefinition* d = find_metric(metric);
+  return d && !d->label.empty() ? d->label : std::string(metric);
 }
 
 std::string metric_text(std::string_view metric, double value) {
   const MetricDefinition* d = find_metric(metric);
-  return metric_label(metric) + " " + format_number(value, 4) + (d && std::isfinite(value) ? d->unit : std::string());
+  return metric_label(metric) + " " + format_number(value, 4) + (d && std::isfinite(value) ? unit_suffix(*d) : std::string());
 }
 
 struct ComparisonPictures::Impl {
@@ -450,7 +446,7 @@ Status ComparisonPictures::Impl::finish_sheet(const ComparisonReport& report) {
     std::string line;
     int on_line = 0;
     for (const auto& m : report.metrics) {
-      if (m == "psnr_y") continue;
+      if (const MetricDefinition* d = find_metric(m); d && !d->on_sheet) continue;
       const double v = t.metrics.value(m);
       if (std::isnan(v)) continue;
       line += (on_line ? "  " : "") + metric_text(m, v);
