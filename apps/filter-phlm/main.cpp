@@ -45,7 +45,7 @@ int main(int argc, char** argv) {
   app.add_option("--layer", options.layer, "Layer to filter: rgb (R,G,B) or a layer name (ssao, shadow, direct, ...)");
   app.add_flag("--debug-layers", options.debug_layers, "Add debug.* layers (phlm: feature, alpha, reset, traceP; taa: clip, noHistory, velocity; ema: reject; "
                  "fxaa: edge)");
-  for (const auto& method : filter_methods()) tool.add_params(method.params(options));
+  for (const auto& method : filter_methods()) tool.add_params(method.params(options), method.name);
   return tool.run(argc, argv, [&]() -> Status {
     auto stage = make_filter_stage(options);
     if (!stage) return stage.error();

@@ -70,7 +70,7 @@ Status run(const tool::Tool& tool, const TextOptions& text, RenderOptions render
   std::optional<tool::Progress> progress;
   ReplayHooks hooks;
   hooks.log = [&](const std::string& line) { tool.log(line); };
-  hooks.frame_done = [&](int frame, int total) {
+  hooks.frame_done = [&](int frame, int /*done*/, int total) {
     if (!progress) progress.emplace(tool.name(), total);
     progress->step(frame);
   };

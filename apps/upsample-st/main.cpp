@@ -36,7 +36,7 @@ std::string description() {
       "Upsamples low-resolution jittered shading (the shade sequence of render-gbuffer) to the resolution of the "
       "G-buffer. Methods:\n";
   for (const up::MethodInfo& m : up::methods()) d += "  " + m.name + ": " + m.summary + "\n";
-  return d + "Usage: upsample-st --gbuffer G.####.exr --input shade.####.exr --out up.####.exr --method herzog";
+  return d + "Typical use: upsample-st --gbuffer G.####.exr --input shade.####.exr --out up.####.exr --method herzog";
 }
 
 }  // namespace

@@ -37,9 +37,7 @@ std::string safe_file_name(const std::string& name) {
 }
 
 std::string frame_file(const std::string& dir, const std::string& name, int frame) {
-  char digits[32];
-  std::snprintf(digits, sizeof digits, "%04d", frame);
-  return (fs::path(dir) / (safe_file_name(name) + "." + digits + ".exr")).string();
+  return (fs::path(dir) / (safe_file_name(name) + "." + frame_digits(frame) + ".exr")).string();
 }
 
 // True when the channel list has `name` as a channel or as a layer.
@@ -244,7 +242,7 @@ Status Run::open() {
     for (const auto& t : tests_)
       for (const int f : report_.frames)
         if (auto st = inputs_.check(frame_file(setup_.error_maps, t.report.name, f), "--error-maps"); !st) return st;
-  ref_sel_ = ExrSelection{{report_.reference_layer}};
+  ref_sel_ = ExrSelection{layer_items(report_.reference_layer)};
   if (ref_mask_) ref_sel_.layers.push_back(setup_.mask);
   gbuf_sel_ = ExrSelection{{"motion"}};
   if (gbuf_pattern_) {
@@ -332,9 +330,9 @@ Status Run::reference_frame(std::size_t fi, int frame) {
   ref_path_ = ref_pattern_->path(frame);
   auto ref = read_exr(ref_path_, ref_sel_);
   if (!ref) return ref.error();
-  ref_names_ = compared_channels(*ref, report_.reference_layer);
-  if (ref_names_.empty())
-    return Error::input(ref_path_, "no channels for layer '" + report_.reference_layer + "'; pick another --layer");
+  auto ref_names = select_layers(*ref, report_.reference_layer, ref_path_);
+  if (!ref_names) return ref_names.error();
+  ref_names_ = std::move(*ref_names);
   if (fi == 0) {
     width_ = ref->width();
     height_ = ref->height();
@@ -466,14 +464,16 @@ Expected<const ShownReference*> Run::shown_reference(int frame) {
 // One test frame: checks, the shared inputs (validity, luminance, temporal change), every measure, error maps.
 Status Run::test_frame(TestState& t, std::size_t fi, int frame) {
   const std::string path = t.pattern.path(frame);
-  ExrSelection sel{{report_.layer}};
+  ExrSelection sel{layer_items(report_.layer)};
   if (t.mask_source == "test") sel.layers.push_back(setup_.mask);
   auto img = read_exr(path, sel);
   if (!img) return img.error();
   if (img->width() != width_ || img->height() != height_)
     return Error::input(path, "is " + size_text(img->width(), img->height()) + " but the reference " + ref_path_ +
                                   " is " + size_text(width_, height_) + "; compare images of the same size");
-  const auto names = compared_channels(*img, report_.layer);
+  auto selected = select_layers(*img, report_.layer, path);
+  if (!selected) return selected.error();
+  const std::vector<std::string>& names = *selected;
   if (names.size() != ref_names_.size())
     return Error::input(path, "layer '" + report_.layer + "' has " + std::to_string(names.size()) +
                                   " channels but the reference's '" + report_.reference_layer + "' has " +

@@ -38,6 +38,23 @@ const Image* finite_copy(const Image* image, const std::vector<std::string>& cha
 
 const std::vector<std::string> kColor = {"R", "G", "B"};
 
+// A copy of `image` with channel from[k] called to[k] (the other channels as they are): the morph methods read
+// and write R, G, B, so another --layer is morphed under those names and written back under its own.
+Image renamed(const Image& image, const std::vector<std::string>& from, const std::vector<std::string>& to) {
+  Image out(image.width(), image.height());
+  out.metadata() = image.metadata();
+  for (std::size_t i = 0; i < image.channel_count(); ++i) {
+    const std::string& name = image.channel_name(i);
+    const auto k = std::find(from.begin(), from.end(), name);
+    const std::string& target = k == from.end() ? name : to[std::size_t(k - from.begin())];
+    if (const float* src = image.plane(name))
+      std::copy(src, src + image.pixel_count(), out.add_channel(target));
+    else if (const std::uint32_t* usrc = image.uint_plane(name))
+      std::copy(usrc, usrc + image.pixel_count(), out.add_uint_channel(target));
+  }
+  return out;
+}
+
 std::vector<std::string> gbuffer_channels(const std::vector<std::string>& layers) {
   std::vector<std::string> channels;
   for (const auto& l : layers)
@@ -56,7 +73,7 @@ class UpsampleStage final : public FrameStage {
  public:
   UpsampleStage(const MorphStageOptions& options, const MorphMethodInfo& info)
       : options_(options), info_(info), gbuffer_channels_(gbuffer_channels(info.gbuffer_layers)) {
-    inputs_.input_layers = {"rgb"};
+    inputs_.input_layers = layer_items(options.layer);
     for (const auto& l : info.gbuffer_layers) inputs_.gbuffer_layers.push_back({l, true});
     inputs_.gbuffer_required = !info.gbuffer_layers.empty();
     inputs_.gbuffer_purpose = "--method " + info.name + " reads its " + layer_list(info.gbuffer_layers);
@@ -68,9 +85,25 @@ class UpsampleStage final : public FrameStage {
   const StageInputs& inputs() const override { return inputs_; }
 
   Status process(const StageFrame& f, std::vector<StageOutput>& out) override {
-    const Image* color = finite_copy(f.input, kColor, color_);
+    auto layer = select_layers(*f.input, options_.layer, f.input_path);
+    if (!layer) return layer.error();
+    if (layer->size() != 3)
+      return Error::usage("--layer " + options_.layer + " has " + std::to_string(layer->size()) +
+                          " channels; the morph methods take 3 (a colour layer: rgb, direct, ...)");
+    const bool bare = *layer == kColor;  // rgb: no copies
+    const Image* input = f.input;
+    const Image* following = f.next.empty() ? nullptr : f.next.front();
+    if (!bare) {
+      layer_input_ = renamed(*f.input, *layer, kColor);
+      input = &layer_input_;
+      if (following) {
+        layer_next_ = renamed(*following, *layer, kColor);
+        following = &layer_next_;
+      }
+    }
+    const Image* color = finite_copy(input, kColor, color_);
     const Image* gbuffer = finite_copy(f.gbuffer, gbuffer_channels_, gbuffer_);
-    const Image* next = f.next.empty() ? nullptr : finite_copy(f.next.front(), kColor, next_);
+    const Image* next = following ? finite_copy(following, kColor, next_) : nullptr;
     double fps = options_.fps;
     if (fps <= 0.0) {
       if (!color->metadata().fps)
@@ -103,11 +136,16 @@ class UpsampleStage final : public FrameStage {
         md.jitter.reset();
         md.camera_cut.reset();
       }
-      Image& img = slots_[std::size_t(k)];
-      img.metadata() = std::move(md);
+      Image* img = &slots_[std::size_t(k)];
+      if (!bare) {  // the slots stay the morpher's (it reuses them next frame)
+        layer_slots_.resize(slots_.size());
+        layer_slots_[std::size_t(k)] = renamed(*img, kColor, *layer);
+        img = &layer_slots_[std::size_t(k)];
+      }
+      img->metadata() = std::move(md);
       StageOutput o;
       o.frame = frame;
-      o.image = &img;
+      o.image = img;
       o.compute_ms = total_ms_ / n;  // the rendered frame's work produces all its slots: each gets an equal share
       o.timings_ms = {{"flow", timings_.flow_ms}, {"morph", timings_.morph_ms}, {"blur", timings_.blur_ms}};
       o.extra = {{"method", info_.name},
@@ -141,6 +179,8 @@ class UpsampleStage final : public FrameStage {
   std::optional<Morpher> morpher_;
   std::vector<Image> slots_;
   Image color_, gbuffer_, next_;  // finite copies (only of frames with NaN/Inf)
+  Image layer_input_, layer_next_;  // a --layer other than rgb under the names R, G, B
+  std::vector<Image> layer_slots_;  // the slots under the layer's names
   MorphTimings timings_;
   double total_ms_ = 0.0;
 };
@@ -252,6 +292,8 @@ ParamList morph_stage_params(MorphStageOptions& o) {
   ParamList params = {
       Param::choice("--method", "Method (the registry's: morph-120hz --list-methods)", &o.morph.method, names),
       Param::integer("--factor", "Output frames per input frame (40 Hz -> 120 Hz: 3)", &o.morph.factor, 2, 32),
+      Param::text("--layer", "Colour layer morphed: rgb (the bare R,G,B) or a layer with NAME.R,G,B (docs/conventions.md, "
+                             "Layers); the outputs keep its channel names", &o.layer),
       {.flag = "--fps", .help = "Input frame rate; 0 reads temporal:fps from the input header", .value = &o.fps,
        .min = 0.0, .max = 1e4},
       Param::flag_on("--debug-layers", "Add debug.grid, debug.distortion, debug.blur, debug.H, debug.Hprime (didyk)",
@@ -272,8 +314,14 @@ ParamList morph_stage_params(MorphStageOptions& o) {
   for (const auto& m : morph_methods()) {
     if (!m.params) continue;
     for (auto& p : m.params(o)) {
-      const bool listed = std::any_of(params.begin(), params.end(), [&](const Param& q) { return q.flag == p.flag; });
-      if (!listed) params.push_back(std::move(p));
+      // --help lists a method's parameters under its name; one several methods read, under all of theirs.
+      const auto listed = std::find_if(params.begin(), params.end(), [&](const Param& q) { return q.flag == p.flag; });
+      if (listed == params.end()) {
+        p.group = m.name;
+        params.push_back(std::move(p));
+      } else if (!listed->group.empty()) {
+        listed->group += ", " + m.name;
+      }
     }
   }
   return params;
@@ -281,6 +329,8 @@ ParamList morph_stage_params(MorphStageOptions& o) {
 
 Expected<std::unique_ptr<FrameStage>> make_morph_stage(const MorphStageOptions& options) {
   if (options.perceive) {
+    if (layer_items(options.layer) != std::vector<std::string>{"rgb"})
+      return Error::usage("--perceive reads the colour channels R, G, B: drop --layer " + options.layer);
     if (options.hold.window < 1) return Error::usage("--window must be at least 1");
     std::optional<SequencePattern> lag_reference;
     if (!options.lag_reference.empty()) {

@@ -7,6 +7,7 @@
 #include "temporal/pictures/comparison_pictures.h"
 
 #include "temporal/core/exr.h"
+#include "temporal/core/sequence.h"
 #include "temporal/pictures/colormap.h"
 #include "temporal/pictures/sheet.h"
 #include "temporal/pictures/text.h"
@@ -30,12 +31,6 @@ std::string safe_name(const std::string& name) {
   std::string out;
   for (char c : name) out += (std::isalnum(static_cast<unsigned char>(c)) || c == '-' || c == '_' || c == '.') ? c : '_';
   return out.empty() ? std::string("test") : out;
-}
-
-std::string digits(int frame) {
-  char text[32];
-  std::snprintf(text, sizeof text, "%04d", frame);
-  return text;
 }
 
 std::vector<const float*> planes_of(const Image& image, std::span<const std::string> channels) {
@@ -298,7 +293,7 @@ Status ComparisonPictures::Impl::observe(const ComparedFrame& cf) {
 
   if (png_on) {
     auto write_all = [&]() -> Status {
-      const std::string d = digits(cf.frame);
+      const std::string d = frame_digits(cf.frame);
       if (auto st = write(*ref, (fs::path(o.png_dir) / ("reference." + d + ext)).string(), "--png"); !st) return st;
       for (std::size_t i = 0; i < cf.tests.size(); ++i) {
         const auto& t = cf.tests[i];
@@ -472,7 +467,7 @@ Status ComparisonPictures::Impl::finish_sheet(const ComparisonReport& report) {
       exr.metadata().frame = c.frame;
       exr.metadata().extra["reference"] = c.reference_path;
       exr.metadata().extra["test"] = t.path;
-      const std::string rel_path = maps_dir + "/" + safe_name(t.name) + "." + digits(c.frame) + ".exr";
+      const std::string rel_path = maps_dir + "/" + safe_name(t.name) + "." + frame_digits(c.frame) + ".exr";
       if (auto st = write_exr_file(exr, in_report(rel_path), "--report"); !st) return st;
       link = rel_path;
     }
@@ -517,7 +512,7 @@ Status ComparisonPictures::Impl::finish_sheet(const ComparisonReport& report) {
   auto sheet = compose_sheet(title, rows, *font);
   if (!sheet) return sheet.error();
   if (png_on)
-    if (auto st = write(sheet->picture, (fs::path(o.png_dir) / ("sheet." + digits(c.frame) + ext)).string(), "--png"); !st)
+    if (auto st = write(sheet->picture, (fs::path(o.png_dir) / ("sheet." + frame_digits(c.frame) + ext)).string(), "--png"); !st)
       return st;
   if (!report_on) return {};
   if (auto st = write(sheet->picture, in_report("pictures/sheet.png"), "--report"); !st) return st;

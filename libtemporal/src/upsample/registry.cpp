@@ -122,7 +122,7 @@ ParamList params(Options& o) {
   for (const MethodEntry* e : registry())
     if (MethodOptions* m = o.per_method.find(e->info.name))
       for (Param p : m->params()) {
-        p.help = e->info.name + ": " + p.help;
+        p.group = e->info.name;  // listed under the method's name in --help
         list.push_back(std::move(p));
       }
   list.push_back(Param::flag_on("--demodulate",
