@@ -8,13 +8,14 @@
 
 // X(name): the metric `name`, defined by name##_metric() in its metric_*.cpp. Each line both declares that
 // function and registers it, so a new metric is one line here.
-#define TEMPORAL_METRICS(X) \
-  X(psnr_rgb)   /* metric_psnr.cpp */         \
-  X(psnr_y)     /* metric_psnr.cpp */         \
-  X(ssim)       /* metric_ssim.cpp */         \
-  X(flicker)    /* metric_flicker.cpp */      \
-  X(flip)       /* metric_flip.cpp */         \
-  X(psnr_latency) /* metric_psnr_latency.cpp */
+#define TEMPORAL_METRICS(X)                   \
+  X(psnr_rgb)     /* metric_psnr.cpp */         \
+  X(psnr_y)       /* metric_psnr.cpp */         \
+  X(ssim)         /* metric_ssim.cpp */         \
+  X(flicker)      /* metric_flicker.cpp */      \
+  X(flip)         /* metric_flip.cpp */         \
+  X(psnr_latency) /* metric_psnr_latency.cpp */ \
+  /* a new metric: one line above this one */
 
 namespace temporal {
 
