@@ -53,27 +53,35 @@ Tool::Tool(std::string name, std::string description) : name_(std::move(name)), 
 
 std::string Tool::signature() const { return name_ + " " TEMPORAL_VERSION; }
 
-void Tool::add_params(const ParamList& params) {
+void Tool::add_params(const ParamList& params, const std::string& group) {
   for (const auto& p : params) {
     const std::string range = param_range_text(p);
     const std::string help = p.help + (range.empty() ? "" : " (" + range + ")");
-    std::visit(
-        [&](auto* v) {
+    CLI::Option* option = std::visit(
+        [&](auto* v) -> CLI::Option* {
           using T = std::remove_pointer_t<decltype(v)>;
           if constexpr (std::is_same_v<T, bool>) {
             if (p.inverted)
-              app_.add_flag_callback(p.flag, [v] { *v = false; }, help);  // --no-snap: clears a default-on field
-            else
-              app_.add_flag(p.flag, *v, help);
+              return app_.add_flag_callback(p.flag, [v] { *v = false; }, help);  // --no-snap: clears a default-on field
+            return app_.add_flag(p.flag, *v, help);
+          } else if constexpr (std::is_same_v<T, std::vector<std::string>>) {
+            CLI::Option* o = app_.add_option(p.flag, *v, help);
+            if (p.separator) o->delimiter(p.separator);
+            if (v->empty()) o->default_str("");  // not "[]"
+            return o;
           } else {
             // An empty value (`--flag=` or `--flag ""`) is a usage error naming the option: CLI11 would otherwise
             // convert it to 0 (a valid value of many options) or keep an empty string (issue 26).
-            app_.add_option(p.flag, *v, help)->check(CLI::Validator(
+            return app_.add_option(p.flag, *v, help)->check(CLI::Validator(
                 [](const std::string& value) { return value.empty() ? std::string("needs a value, got an empty one") : std::string(); },
                 "", "non-empty"));
           }
         },
         p.value);
+    // Options are checked after parsing (check_params), so that every range and choice error reads the same; CLI11
+    // only converts the text.
+    for (const auto& other : p.excludes) option->excludes(other);
+    if (const std::string& g = p.group.empty() ? group : p.group; !g.empty()) option->group(g);
     params_.push_back(p);
   }
 }

@@ -42,9 +42,11 @@ class Tool {
   std::string signature() const;
 
   // Adds every parameter of a method (temporal/core/params.h) as an option: the help shows the default (from
-  // the library's option struct) and the valid range; after parsing, out-of-range and non-finite values are
-  // usage errors (exit 1) with the range in the message.
-  void add_params(const ParamList& params);
+  // the library's option struct) and the valid range; after parsing, out-of-range and non-finite values and
+  // values that are not one of the choices are usage errors (exit 1) with the range in the message. `group`: the
+  // --help section of the parameters that do not name their own (Param::group), e.g. a method's name; empty: the
+  // general options.
+  void add_params(const ParamList& params, const std::string& group = {});
 
   // The standard options of a sequence tool (docs/cli.md), bound to `options`. `gbuffer_help` empty: no
   // --gbuffer; `state` adds --state-in / --state-out.

@@ -28,85 +28,140 @@ int main(int argc, char** argv) {
   ComparisonSetup setup;
   CompareOutputs out;
   PictureOptions& pic = out.pictures;
-  std::string frames, peak = "1", fail_on = "mean", profile = "row";
+  std::string frames, peak = "1", fail_on = "mean", profile = "row", flip = flip_mode_name(setup.flip);
   std::vector<std::string> crops;
   std::optional<int> sheet_frame;
-  app.add_option("--reference", setup.reference, "Reference sequence, e.g. ref.####.exr (not with --merge)");
-  app.add_option("tests", setup.tests, "Test sequences (one or more), e.g. taa.####.exr phlm.####.exr");
-  app.add_option("--merge", out.merge,
-                 "Instead of comparing: merge per-shard CSVs of one comparison (disjoint --frames ranges) into "
-                 "--csv/--json/--plot; the means and intervals equal a single run's exactly")
-      ->excludes("--reference");
-  app.add_option("--names", setup.names, "Comma-separated names of the test sequences (default: file names)")
-      ->delimiter(',')->default_str("");
-  app.add_option("--csv", out.csv, "Per-frame metrics CSV to write");
-  app.add_option("--json", out.json, "JSON summary to write (mean with 95% interval per sequence, paired differences)");
-  app.add_option("--plot", out.plot,
-                 "Charts F.EXT, EXT = png, svg or pdf: F (PSNR per frame), F-psnr-y, F-ssim, F-flicker, F-flip (with "
-                 "--flip), F-psnr-latency (with --latency-aware), F-speed (PSNR against the methods' own compute time)");
-  app.add_option("--title", out.title, "Title of the charts, the contact sheet and the report (e.g. the scene)");
-  app.add_option("--report", pic.report_dir,
-                 "Folder for an offline HTML report (index.html): tables, charts, contact sheet, FLIP and error "
-                 "maps, temporal profiles, side-by-side video (ffmpeg)");
-  app.add_option("--png", pic.png_dir,
-                 "Folder for pictures of every frame: reference and tests display-encoded, FLIP and error heat "
-                 "maps, G-buffer; and the contact sheet and profiles");
-  app.add_option("--png-format", pic.png_format, "Format of the --png pictures: png or jpg");
-  app.add_option("--sheet-frame", sheet_frame, "Frame of the contact sheet (default: the last compared frame)");
-  app.add_option("--crop", crops, "Region x,y,w,h (pixels) zoomed on the contact sheet; repeat for more (default: "
-                                  "the two regions of largest FLIP, else error)");
-  app.add_option("--profile", profile, "Line of the temporal profiles: row:Y (x-t image), column:X (y-t), row or "
-                                       "column (the middle)");
-  app.add_option("--exposure", pic.display.exposure, "Exposure of the pictures in stops (values x 2^E before encoding)");
-  app.add_option("--display", pic.display.display, "Display colour space of the pictures (OCIO config: srgb_display, "
-                                                   "gamma22_display, ...)");
-  app.add_option("--ocio", pic.display.ocio, "OpenColorIO config for --display (default: $OCIO, else the built-in one)");
-  app.add_option("--gbuffer", setup.gbuffer,
-                 "G-buffer sequence with `motion` (at the reference's size): motion-compensated flicker");
-  app.add_option("--mask", setup.mask,
-                 "Mask layer or channel (> 0.5 = inside) to report metrics inside and outside it; looked up in each "
-                 "test, then the G-buffer, then the reference");
-  app.add_option("--layer", setup.layer, "Layer compared: rgb (the bare R,G,B) or a layer name (NAME.*)");
-  app.add_option("--reference-layer", setup.reference_layer,
-                 "Layer of the reference to compare with (default: same as --layer), e.g. reference");
-  app.add_option("--error-maps", setup.error_maps,
-                 "Folder for error-map EXRs NAME.####.exr (error.R/G/B/Y, error.ssim, error.flicker, error.flip "
-                 "with --flip, error.invalid)");
-  app.add_option("--frames", frames, "Frames A-B (default: every reference frame on disk)");
-  app.add_flag("--latency-aware", setup.latency_aware,
-               "Also score each test frame t against the reference frame t + L shown at the same instant, L = the "
-               "test's temporal:latencyFrames (psnr_latency; psnr_rgb stays the latency-free score; "
-               "docs/conventions.md, Latency)");
-  app.add_option("--warmup", setup.warmup_frames,
-                 "The first N frames are summarised apart from the steady state (JSON `warmup`, `steady`)")
-      ->check(CLI::Range(0, 1000000));
-  app.add_option("--peak", peak,
-                 "Peak value L for PSNR and SSIM, in pixel units; `max` = idiff's rule per frame (largest value, "
-                 "at least 1)");
-  const std::map<std::string, FlipMode> flip_modes = {{"off", FlipMode::Off}, {"ldr", FlipMode::Ldr}, {"hdr", FlipMode::Hdr}};
-  app.add_option("--flip", setup.flip,
-                 "FLIP per frame: off; ldr = LDR-FLIP of the display-encoded frames (sRGB of the values clamped to "
-                 "[0,1]); hdr = HDR-FLIP of the scene-linear values (ACES, automatic exposures). Off by default: it "
-                 "costs about as much as PSNR and SSIM together (LDR) or more (HDR)")
-      ->transform(CLI::CheckedTransformer(flip_modes).description(""))
-      ->type_name("off|ldr|hdr")
-      ->default_str(flip_mode_name(setup.flip));
-  app.add_option("--ppd", setup.flip_options.pixels_per_degree,
-                 "FLIP's viewing condition in pixels per degree of visual angle (default: 0.7 m from a 0.7 m wide "
-                 "3840-pixel screen)");
+  tool.add_params({Param::list("tests", "Test sequences (one or more), e.g. taa.####.exr phlm.####.exr", &setup.tests)});
+  Param merge = Param::list("--merge",
+                            "Instead of comparing: merge per-shard CSVs of one comparison (disjoint --frames ranges) "
+                            "into --csv/--json/--plot; the means and intervals equal a single run's exactly",
+                            &out.merge);
+  merge.excludes = {"--reference"};
+  tool.add_params(
+      {
+          Param::text("--reference", "Reference sequence, e.g. ref.####.exr (not with --merge)", &setup.reference),
+          merge,
+          Param::list("--names", "Comma-separated names of the test sequences (default: file names)", &setup.names, ','),
+          Param::text("--gbuffer", "G-buffer sequence with `motion` (at the reference's size): motion-compensated flicker",
+                      &setup.gbuffer),
+          Param::text("--mask",
+                      "Mask layer or channel (> 0.5 = inside) to report metrics inside and outside it; looked up in "
+                      "each test, then the G-buffer, then the reference",
+                      &setup.mask),
+          Param::text("--layer", "Layer compared: rgb (the bare R,G,B) or a layer name (NAME.*)", &setup.layer),
+          Param::text("--reference-layer",
+                      "Layer of the reference to compare with (default: same as --layer), e.g. reference",
+                      &setup.reference_layer),
+          Param::text("--frames", "Frames A-B (default: every reference frame on disk)", &frames),
+      },
+      "Inputs");
+  tool.add_params(
+      {
+          Param::flag_on("--latency-aware",
+                         "Also score each test frame t against the reference frame t + L shown at the same instant, L = "
+                         "the test's temporal:latencyFrames (psnr_latency; psnr_rgb stays the latency-free score; "
+                         "docs/conventions.md, Latency)",
+                         &setup.latency_aware),
+          Param::integer("--warmup",
+                         "The first N frames are summarised apart from the steady state (JSON `warmup`, `steady`)",
+                         &setup.warmup_frames, 0, 1000000),
+          Param::text("--peak",
+                      "Peak value L for PSNR and SSIM, in pixel units; `max` = idiff's rule per frame (largest value, "
+                      "at least 1)",
+                      &peak),
+          Param::choice("--flip",
+                        "FLIP per frame: off; ldr = LDR-FLIP of the display-encoded frames (sRGB of the values clamped "
+                        "to [0,1]); hdr = HDR-FLIP of the scene-linear values (ACES, automatic exposures). Off by "
+                        "default: it costs about as much as PSNR and SSIM together (LDR) or more (HDR)",
+                        &flip, {"off", "ldr", "hdr"}),
+          Param::positive("--ppd",
+                          "FLIP's viewing condition in pixels per degree of visual angle (default: 0.7 m from a 0.7 m "
+                          "wide 3840-pixel screen)",
+                          &setup.flip_options.pixels_per_degree),
+          Param::text("--speed-metric",
+                      "Metric judged against compute time: the speed chart's y axis and the JSON's `pareto` flags "
+                      "(compare --list-metrics)",
+                      &setup.speed_metric),
+      },
+      "Metrics");
+  tool.add_params(
+      {
+          Param::text("--csv", "Per-frame metrics CSV to write", &out.csv),
+          Param::text("--json", "JSON summary to write (mean with 95% interval per sequence, paired differences, Pareto "
+                                "front)", &out.json),
+          Param::text("--plot",
+                      "Charts F.EXT, EXT = png, svg or pdf: F (PSNR per frame), F-psnr-y, F-ssim, F-flicker, F-flip "
+                      "(with --flip), F-psnr-latency (with --latency-aware), F-speed (--speed-metric against the "
+                      "methods' own compute time)",
+                      &out.plot),
+          Param::text("--title", "Title of the charts, the contact sheet and the report (e.g. the scene)", &out.title),
+          Param::text("--error-maps",
+                      "Folder for error-map EXRs NAME.####.exr (error.R/G/B/Y, error.ssim, error.flicker, error.flip "
+                      "with --flip, error.invalid)",
+                      &setup.error_maps),
+      },
+      "Outputs");
+  tool.add_params(
+      {
+          Param::text("--report",
+                      "Folder for an offline HTML report (index.html): tables, charts, contact sheet, FLIP and error "
+                      "maps, temporal profiles, side-by-side video (ffmpeg)",
+                      &pic.report_dir),
+          Param::text("--png",
+                      "Folder for pictures of every frame: reference and tests display-encoded, FLIP and error heat "
+                      "maps, G-buffer; and the contact sheet and profiles",
+                      &pic.png_dir),
+          Param::text("--png-format", "Format of the --png pictures: png or jpg", &pic.png_format),
+          Param::optional("--sheet-frame", "Frame of the contact sheet (default: the last compared frame)", &sheet_frame),
+          Param::list("--crop",
+                      "Region x,y,w,h (pixels) zoomed on the contact sheet; repeat for more (default: the two regions "
+                      "of largest FLIP, else error)",
+                      &crops),
+          Param::text("--profile",
+                      "Line of the temporal profiles: row:Y (x-t image), column:X (y-t), row or column (the middle)",
+                      &profile),
+          Param{.flag = "--exposure",
+                .help = "Exposure of the pictures in stops (values x 2^E before encoding)",
+                .value = &pic.display.exposure},
+          Param::text("--display",
+                      "Display colour space of the pictures (OCIO config: srgb_display, gamma22_display, ...)",
+                      &pic.display.display),
+          Param::text("--ocio", "OpenColorIO config for --display (default: $OCIO, else the built-in one)",
+                      &pic.display.ocio),
+      },
+      "Pictures");
   // One --fail-<option> per registry metric that has a threshold.
   std::map<std::string, std::optional<double>> fail;
   std::string fail_list;
+  ParamList thresholds_params;
   for (const auto& d : metric_registry()) {
     if (d.threshold_option.empty()) continue;
-    app.add_option("--fail-" + d.threshold_option, fail[d.name], d.threshold_help);
+    thresholds_params.push_back(Param::optional("--fail-" + d.threshold_option, d.threshold_help, &fail[d.name]));
     fail_list += (fail_list.empty() ? "--fail-" : ", --fail-") + d.threshold_option;
   }
   bool fail_nonfinite = false;
-  app.add_flag("--fail-nonfinite", fail_nonfinite,
-               "Exit 3 when a test frame holds NaN/Inf pixels or values whose squared error overflows (PSNR -inf)");
-  app.add_option("--fail-on", fail_on, "What the thresholds judge: each sequence's mean over frames, or its worst frame")
-      ->check(CLI::IsMember({"mean", "worst"}));
+  thresholds_params.push_back(Param::flag_on(
+      "--fail-nonfinite",
+      "Exit 3 when a test frame holds NaN/Inf pixels or values whose squared error overflows (PSNR -inf)",
+      &fail_nonfinite));
+  thresholds_params.push_back(Param::choice(
+      "--fail-on", "What the thresholds judge: each sequence's mean over frames, or its worst frame", &fail_on,
+      {"mean", "worst"}));
+  tool.add_params(thresholds_params, "Thresholds");
+  auto list = [&app](const char* flag, const char* help, std::string (*text)()) {
+    app.add_flag_callback(
+           flag,
+           [text] {
+             std::fputs(text().c_str(), stdout);
+             throw CLI::Success();
+           },
+           help)
+        ->group("Metrics");
+  };
+  list("--list-metrics", "List the metrics (tab-separated: name, label, unit, better = higher|lower) and exit",
+       metric_list_text);
+  list("--list-metrics-json", "List the metrics as a JSON array (name, label, unit, better, CSV columns, threshold "
+       "option, range) and exit", metric_list_json);
   app.footer("Exit codes: 0 success (thresholds passed), 1 usage error, 2 input error (missing, corrupt or mismatched "
              "files, missing layers), 3 a threshold (" + fail_list + ") failed, 4 output error (including charts, "
              "pictures or a video that cannot be made: CSV and JSON are still written), 5 internal error.\n"
@@ -121,6 +176,7 @@ int main(int argc, char** argv) {
       setup.frames = *range;
     }
     if (auto st = set_peak(peak, setup); !st) return st;
+    setup.flip = flip == "ldr" ? FlipMode::Ldr : flip == "hdr" ? FlipMode::Hdr : FlipMode::Off;  // checked: a choice
     for (const auto& c : crops) {
       auto rect = parse_crop(c);
       if (!rect) return rect.error();

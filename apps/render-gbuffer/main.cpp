@@ -115,7 +115,7 @@ int main(int argc, char** argv) {
     r.warning = [&](const std::string& message) { tool.print_warning("", message); };
     ReplayHooks hooks;
     hooks.log = [&](const std::string& line) { tool.log(line); };
-    hooks.frame_done = [&](int frame, int total) {
+    hooks.frame_done = [&](int frame, int /*done*/, int total) {
       if (!progress) progress.emplace(tool.name(), total);
       progress->step(frame);
     };

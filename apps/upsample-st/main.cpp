@@ -22,7 +22,7 @@ std::string description() {
       "Upsamples low-resolution jittered shading (the shade sequence of render-gbuffer) to the resolution of the "
       "G-buffer. Methods:\n";
   for (const up::MethodEntry* e : up::registry()) d += "  " + e->info.name + ": " + e->info.summary + "\n";
-  return d + "Usage: upsample-st --gbuffer G.####.exr --input shade.####.exr --out up.####.exr --method herzog";
+  return d + "Typical use: upsample-st --gbuffer G.####.exr --input shade.####.exr --out up.####.exr --method herzog";
 }
 
 }  // namespace

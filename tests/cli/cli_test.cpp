@@ -1,8 +1,14 @@
 // Every tool: --help lists each option with its default, --version answers, a bad option exits 1 with
 // `tool: ...`, and the options its doc's "## Usage" section names are exactly the options its parser has
 // (the parser generates --help, so a documented flag that nothing parses, or an undocumented one, fails).
+#include "temporal/io/exr.h"
+#include "temporal/core/image.h"
+
 #include "test_support.h"
 
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
 #include <fstream>
 #include <regex>
 #include <set>
@@ -74,6 +80,83 @@ INSTANTIATE_TEST_SUITE_P(AllTools, ToolCli, ::testing::ValuesIn(kTools), [](cons
     if (c == '-') c = '_';
   return name;
 });
+
+// Issue 21: `--layer` is one rule (select_layers, docs/conventions.md "Layers") in every tool. One multi-layer
+// sequence (render-gbuffer's shade: R,G,B, direct.R,G,B, ssao.Y, ...) goes through all four tools with the same
+// selections; each writes (or compares) exactly the channels the rule selects, and each refuses a missing layer
+// with exit 2 naming it. What differs is only what a tool can take: filter-phlm 1 or 3 channels, morph-120hz 3.
+TEST(LayerRule, EveryToolSelectsTheSameChannels) {
+  const auto dir = test::scratch_dir("layer-rule");
+  const std::string d = dir.string();
+  std::string out;
+  ASSERT_EQ(test::run_command(test::tool_path("render-gbuffer").string() + " " +
+                                  (test::source_dir() / "assets" / "scenes" / "walkers.glb").string() + " --out " + d +
+                                  " --size 64x48 --factor 2 --frames 0-2 --outputs gbuffer,shade",
+                              &out), 0) << out;
+  const std::string shade = d + "/shade.####.exr", gbuffer = d + "/gbuffer.####.exr";
+  auto first = read_exr(d + "/shade.0000.exr");
+  ASSERT_TRUE(first) << first.error().message;
+  ASSERT_TRUE(first->has_channel("direct.R") && first->has_channel("ssao.Y")) << "the shade has no direct or ssao";
+
+  auto tool = [](const char* name) { return test::tool_path(name).string(); };
+  // The channels of `layer` in a tool's first output, or the command's exit code as a string.
+  auto channels_of = [&](const std::string& command, const std::string& output) -> std::vector<std::string> {
+    std::string text;
+    const int code = test::run_command(command, &text);
+    if (code != 0) return {"exit " + std::to_string(code) + ": " + text};
+    auto img = read_exr(output);
+    if (!img) return {img.error().message};
+    std::vector<std::string> names;
+    for (const auto& c : img->channel_names())
+      if (c.rfind("debug.", 0) != 0) names.push_back(c);
+    std::sort(names.begin(), names.end());
+    return names;
+  };
+  auto sorted = [](std::vector<std::string> v) {
+    std::sort(v.begin(), v.end());
+    return v;
+  };
+  for (const std::string layer : {"rgb", "direct", "ssao", "ssao.Y"}) {
+    auto expected = select_layers(*first, layer, "shade.0000.exr");
+    ASSERT_TRUE(expected) << layer;
+    const std::string o = d + "/" + (layer == "ssao.Y" ? std::string("ssaoY") : layer);
+    EXPECT_EQ(channels_of(tool("upsample-st") + " --input " + shade + " --gbuffer " + gbuffer + " --method spatial --out " +
+                              o + "-up.####.exr --layer " + layer, o + "-up.0000.exr"),
+              sorted(*expected)) << "upsample-st --layer " << layer;
+    EXPECT_EQ(channels_of(tool("filter-phlm") + " --input " + shade + " --method fxaa --out " + o +
+                              "-filter.####.exr --layer " + layer, o + "-filter.0000.exr"),
+              sorted(*expected)) << "filter-phlm --layer " << layer;
+    if (expected->size() == 3) {
+      EXPECT_EQ(channels_of(tool("morph-120hz") + " --input " + shade + " --fps 40 --method repeat --out " + o +
+                                "-morph.####.exr --layer " + layer, o + "-morph.0000.exr"),
+                sorted(*expected)) << "morph-120hz --layer " << layer;
+    }
+    ASSERT_EQ(test::run_command(tool("compare") + " --reference " + shade + " " + shade + " --json " + o + ".json --layer " +
+                                    layer, &out), 0) << out;
+    std::ifstream json(o + ".json");
+    EXPECT_EQ(nlohmann::json::parse(json)["channels"].get<std::vector<std::string>>(), *expected)
+        << "compare --layer " << layer;
+  }
+  // A comma list: the same channels wherever the tool takes that many.
+  EXPECT_EQ(channels_of(tool("upsample-st") + " --input " + shade + " --gbuffer " + gbuffer + " --method spatial --out " + d +
+                            "/list-up.####.exr --layer direct,ssao", d + "/list-up.0000.exr"),
+            (std::vector<std::string>{"direct.B", "direct.G", "direct.R", "ssao.Y"}));
+  EXPECT_EQ(test::run_command(tool("compare") + " --reference " + shade + " " + shade + " --layer direct,ssao", &out), 0) << out;
+  EXPECT_EQ(test::run_command(tool("filter-phlm") + " --input " + shade + " --method fxaa --out " + d +
+                                  "/list-f.####.exr --layer direct,ssao", &out), 1) << out;  // 4 channels: 1 or 3
+  EXPECT_EQ(test::run_command(tool("morph-120hz") + " --input " + shade + " --fps 40 --method repeat --out " + d +
+                                  "/list-m.####.exr --layer ssao", &out), 1) << out;  // 1 channel: 3
+  // A missing layer: exit 2 from every tool, naming it.
+  const std::vector<std::string> missing = {
+      tool("upsample-st") + " --input " + shade + " --gbuffer " + gbuffer + " --method spatial --out " + d + "/x.####.exr",
+      tool("filter-phlm") + " --input " + shade + " --method fxaa --out " + d + "/x.####.exr",
+      tool("morph-120hz") + " --input " + shade + " --fps 40 --method repeat --out " + d + "/x.####.exr",
+      tool("compare") + " --reference " + shade + " " + shade};
+  for (const auto& command : missing) {
+    EXPECT_EQ(test::run_command(command + " --layer albdo", &out), 2) << command << "\n" << out;
+    EXPECT_NE(out.find("no layer 'albdo' (have: rgb, direct, "), std::string::npos) << out;
+  }
+}
 
 }  // namespace
 }  // namespace temporal

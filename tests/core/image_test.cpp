@@ -46,7 +46,41 @@ TEST(Image, LayerChannels) {
   for (const char* c : {"R", "G", "B", "N.X", "N.Y", "N.Z", "motion.X", "motion.Y", "id"}) image.add_channel(c);
   EXPECT_EQ(image.layer_channels("N"), (std::vector<std::string>{"N.X", "N.Y", "N.Z"}));
   EXPECT_EQ(image.layer_channels("motion"), (std::vector<std::string>{"motion.X", "motion.Y"}));
-  EXPECT_EQ(image.layer_channels("rgb"), (std::vector<std::string>{"R", "G", "B", "id"}));
+  // `rgb` is the bare colour channels, not every bare channel (before issue 21 it also took `id`).
+  EXPECT_EQ(image.layer_channels("rgb"), (std::vector<std::string>{"R", "G", "B"}));
+}
+
+// The --layer rule of every tool (docs/conventions.md, "Layers").
+TEST(Image, SelectLayers) {
+  Image image(1, 1);
+  for (const char* c : {"B", "A", "G", "R", "albedo.B", "albedo.R", "albedo.G", "ssao", "debug.mask", "N.Z", "N.X", "N.Y"})
+    image.add_channel(c);
+  image.add_uint_channel("id");
+  auto pick = [&](const char* selection) { return select_layers(image, selection, "f.exr"); };
+  EXPECT_EQ(*pick(""), (std::vector<std::string>{"R", "G", "B"}));
+  EXPECT_EQ(*pick("rgb"), (std::vector<std::string>{"R", "G", "B"}));
+  EXPECT_EQ(*pick("rgba"), (std::vector<std::string>{"R", "G", "B", "A"}));
+  EXPECT_EQ(*pick("albedo"), (std::vector<std::string>{"albedo.R", "albedo.G", "albedo.B"}));  // R, G, B order
+  EXPECT_EQ(*pick("N"), (std::vector<std::string>{"N.X", "N.Y", "N.Z"}));
+  EXPECT_EQ(*pick("ssao"), (std::vector<std::string>{"ssao"}));              // a bare channel
+  EXPECT_EQ(*pick("debug.mask"), (std::vector<std::string>{"debug.mask"}));  // one channel of a layer
+  EXPECT_EQ(*pick("albedo,ssao"), (std::vector<std::string>{"albedo.R", "albedo.G", "albedo.B", "ssao"}));
+  EXPECT_EQ(layer_items(""), (std::vector<std::string>{"rgb"}));
+  EXPECT_EQ(layer_items("a,b"), (std::vector<std::string>{"a", "b"}));
+  EXPECT_EQ(layer_names(image), (std::vector<std::string>{"rgb", "albedo", "ssao", "debug", "N", "id"}));
+
+  auto missing = pick("motion");
+  ASSERT_FALSE(missing);
+  EXPECT_EQ(missing.error().kind, ErrorKind::Input);
+  EXPECT_EQ(missing.error().file, "f.exr");
+  EXPECT_EQ(missing.error().message, "no layer 'motion' (have: rgb, albedo, ssao, debug, N, id); pick another with --layer");
+  EXPECT_FALSE(pick("id"));            // uint data
+  EXPECT_FALSE(pick("rgb,R"));         // R twice
+  EXPECT_FALSE(pick("albedo,,ssao"));  // an empty item
+  Image grey(1, 1);
+  grey.add_channel("R");
+  grey.add_channel("G");
+  EXPECT_FALSE(select_layers(grey, "rgb", "g.exr"));  // rgb needs all three
 }
 
 TEST(Image, CropCopiesTheRectangleAndZeroFillsOutside) {

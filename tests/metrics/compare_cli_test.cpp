@@ -168,6 +168,8 @@ TEST_F(CompareCli, FlipOptionErrorsAreUsageErrors) {
   EXPECT_EQ(run("--reference ref.####.exr a.####.exr --fail-flip 0.1", &out), 1) << out;  // FLIP is off
   EXPECT_NE(out.find("--flip ldr"), std::string::npos) << out;
   EXPECT_EQ(run("--reference ref.####.exr a.####.exr --flip sometimes", &out), 1) << out;
+  // A choice names the values it takes (Param tables, not CLI11's "Check ... FAILED").
+  EXPECT_NE(out.find("compare: --flip: 'sometimes' is not one of off, ldr, hdr"), std::string::npos) << out;
   EXPECT_EQ(run("--reference ref.####.exr a.####.exr --flip ldr --ppd 0", &out), 1) << out;
 }
 
@@ -199,12 +201,13 @@ TEST_F(CompareCli, HelpListsEveryOptionAndEachIsAccepted) {
   ASSERT_EQ(run("--version", &version), 0);
   EXPECT_NE(version.find("compare "), std::string::npos);
   // Every option documented in --help, fed to the parser in one run (without --plot to stay fast).
-  const std::array<std::pair<const char*, const char*>, 22> options = {{
+  const std::array<std::pair<const char*, const char*>, 23> options = {{
       {"--reference", "ref.####.exr"}, {"--names", "one"}, {"--csv", "all.csv"}, {"--json", "all.json"},
       {"--gbuffer", "g.####.exr"}, {"--mask", "R"}, {"--layer", "rgb"}, {"--reference-layer", "rgb"},
       {"--error-maps", "maps"}, {"--frames", "1-2"}, {"--peak", "max"}, {"--flip", "ldr"}, {"--ppd", "50"},
       {"--fail-psnr", "1"}, {"--fail-ssim", "0"}, {"--fail-flicker", "100"}, {"--fail-flip", "1"},
-      {"--fail-on", "worst"}, {"--threads", "1"}, {"--verbose", ""}, {"--plot", ""}, {"--help", ""}}};
+      {"--fail-on", "worst"}, {"--threads", "1"}, {"--verbose", ""}, {"--plot", ""}, {"--help", ""},
+      {"--speed-metric", "ssim"}}};
   std::string args;
   for (const auto& [name, value] : options) {
     EXPECT_NE(help.find(name), std::string::npos) << name << " is not in --help";
@@ -215,6 +218,8 @@ TEST_F(CompareCli, HelpListsEveryOptionAndEachIsAccepted) {
   EXPECT_NE(help.find("--peak TEXT=1"), std::string::npos) << "--peak default not shown";
   EXPECT_NE(help.find("=off"), std::string::npos) << "--flip default not shown";
   EXPECT_NE(help.find("67.0206"), std::string::npos) << "--ppd default not shown";
+  for (const char* group : {"\nInputs:\n", "\nMetrics:\n", "\nOutputs:\n", "\nPictures:\n", "\nThresholds:\n"})
+    EXPECT_NE(help.find(group), std::string::npos) << group << "is not a section of --help";
   std::string out;
   EXPECT_EQ(run(args + " a.####.exr", &out), 0) << args << "\n" << out;
   EXPECT_TRUE(fs::exists(dir_ / "maps" / "one.0002.exr"));
@@ -311,6 +316,49 @@ TEST_F(CompareCli, ShardsMergeIntoTheSingleRunExactly) {
   // Without --merge a reference and a test are needed.
   EXPECT_EQ(run("--json never.json", &out), 1) << out;
   EXPECT_NE(out.find("--reference"), std::string::npos) << out;
+}
+
+// Issue 21: the registry is the one list of metrics (--list-metrics), and the JSON flags the Pareto front of compute
+// time against --speed-metric (the speed chart's front), so that scripts read it instead of recomputing it.
+TEST_F(CompareCli, ListsMetricsAndFlagsTheParetoFront) {
+  std::string out;
+  ASSERT_EQ(run("--list-metrics", &out), 0) << out;
+  EXPECT_EQ(out.rfind("psnr_rgb\tPSNR\tdB\thigher\n", 0), 0u) << out;
+  EXPECT_NE(out.find("\nssim\tSSIM\t\thigher\n"), std::string::npos) << out;
+  EXPECT_NE(out.find("\nflicker\tflicker\t\tlower\n"), std::string::npos) << out;
+  ASSERT_EQ(run("--list-metrics-json", &out), 0) << out;
+  const auto list = nlohmann::json::parse(out);
+  ASSERT_TRUE(list.is_array());
+  std::vector<std::string> names;
+  for (const auto& m : list) names.push_back(m["name"]);
+  EXPECT_EQ(names, (std::vector<std::string>{"psnr_rgb", "psnr_y", "ssim", "flicker", "flip", "psnr_latency"}));
+  EXPECT_EQ(list[4]["better"], "lower");
+  EXPECT_EQ(list[4]["highest"], 1.0);
+  EXPECT_EQ(list[0]["threshold_option"], "--fail-psnr");
+
+  // c: as noisy as b (0.1) and slower than a (2 ms against 1.5 ms): a is faster and better, so c is dominated.
+  for (int f = 1; f <= 3; ++f) {
+    char digits[8];
+    std::snprintf(digits, sizeof digits, "%04d", f);
+    auto ref = read_exr((dir_ / (std::string("ref.") + digits + ".exr")).string());
+    ASSERT_TRUE(ref);
+    Image c = noisy(64, 40, unsigned(30 + f), 0.1f, &*ref);
+    c.metadata().compute_ms = 2.0;
+    ASSERT_TRUE(write_exr((dir_ / (std::string("c.") + digits + ".exr")).string(), c));
+  }
+  const std::string tests = "--reference ref.####.exr a.####.exr b.####.exr c.####.exr --gbuffer g.####.exr";
+  for (const std::string metric : {"psnr_rgb", "ssim", "flicker"}) {
+    ASSERT_EQ(run(tests + " --json p.json --speed-metric " + metric, &out), 0) << out;
+    const auto j = nlohmann::json::parse(read_text(dir_ / "p.json"));
+    EXPECT_EQ(j["speed_metric"], metric);
+    EXPECT_EQ(j["sequences"][0]["pareto"], true) << metric;   // a: the best
+    EXPECT_EQ(j["sequences"][1]["pareto"], true) << metric;   // b: the fastest
+    EXPECT_EQ(j["sequences"][2]["pareto"], false) << metric;  // c: slower and worse than a
+  }
+  EXPECT_EQ(run(tests + " --speed-metric flip", &out), 1) << out;  // not measured without --flip
+  EXPECT_NE(out.find("--flip ldr"), std::string::npos) << out;
+  EXPECT_EQ(run(tests + " --speed-metric psnr", &out), 1) << out;
+  EXPECT_NE(out.find("--speed-metric 'psnr' is not a metric"), std::string::npos) << out;
 }
 
 }  // namespace

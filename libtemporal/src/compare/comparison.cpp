@@ -37,9 +37,7 @@ std::string safe_file_name(const std::string& name) {
 }
 
 std::string frame_file(const std::string& dir, const std::string& name, int frame) {
-  char digits[32];
-  std::snprintf(digits, sizeof digits, "%04d", frame);
-  return (fs::path(dir) / (safe_file_name(name) + "." + digits + ".exr")).string();
+  return (fs::path(dir) / (safe_file_name(name) + "." + frame_digits(frame) + ".exr")).string();
 }
 
 // True when the channel list has `name` as a channel or as a layer.
@@ -225,6 +223,7 @@ Status Run::open() {
   report_.motion_compensated = !setup_.gbuffer.empty();
   report_.warmup_frames = setup_.warmup_frames;
   report_.bootstrap = setup_.bootstrap;
+  report_.speed_metric = setup_.speed_metric;
   report_.peak = setup_.peak;
   report_.peak_from_data = setup_.peak_from_data;
   report_.flip = setup_.flip;
@@ -258,7 +257,7 @@ Status Run::open() {
     for (const auto& t : tests_)
       for (const int f : report_.frames)
         if (auto st = inputs_.check(frame_file(setup_.error_maps, t.report.name, f), "--error-maps"); !st) return st;
-  ref_sel_ = ExrSelection{{report_.reference_layer}};
+  ref_sel_ = ExrSelection{layer_items(report_.reference_layer)};
   if (ref_mask_) ref_sel_.layers.push_back(setup_.mask);
   gbuf_sel_ = ExrSelection{{"motion"}};
   if (gbuf_pattern_) {
@@ -346,9 +345,9 @@ Status Run::reference_frame(std::size_t fi, int frame) {
   ref_path_ = ref_pattern_->path(frame);
   auto ref = read_exr(ref_path_, ref_sel_);
   if (!ref) return ref.error();
-  ref_names_ = compared_channels(*ref, report_.reference_layer);
-  if (ref_names_.empty())
-    return Error::input(ref_path_, "no channels for layer '" + report_.reference_layer + "'; pick another --layer");
+  auto ref_names = select_layers(*ref, report_.reference_layer, ref_path_);
+  if (!ref_names) return ref_names.error();
+  ref_names_ = std::move(*ref_names);
   if (fi == 0) {
     width_ = ref->width();
     height_ = ref->height();
@@ -480,14 +479,16 @@ Expected<const ShownReference*> Run::shown_reference(int frame) {
 // One test frame: checks, the shared inputs (validity, luminance, temporal change), every measure, error maps.
 Status Run::test_frame(TestState& t, std::size_t fi, int frame) {
   const std::string path = t.pattern.path(frame);
-  ExrSelection sel{{report_.layer}};
+  ExrSelection sel{layer_items(report_.layer)};
   if (t.mask_source == "test") sel.layers.push_back(setup_.mask);
   auto img = read_exr(path, sel);
   if (!img) return img.error();
   if (img->width() != width_ || img->height() != height_)
     return Error::input(path, "is " + size_text(img->width(), img->height()) + " but the reference " + ref_path_ +
                                   " is " + size_text(width_, height_) + "; compare images of the same size");
-  const auto names = compared_channels(*img, report_.layer);
+  auto selected = select_layers(*img, report_.layer, path);
+  if (!selected) return selected.error();
+  const std::vector<std::string>& names = *selected;
   if (names.size() != ref_names_.size())
     return Error::input(path, "layer '" + report_.layer + "' has " + std::to_string(names.size()) +
                                   " channels but the reference's '" + report_.reference_layer + "' has " +
@@ -768,6 +769,50 @@ std::optional<double> mean_compute_ms(const SequenceReport& sequence) {
   return std::nullopt;
 }
 
+std::vector<std::size_t> pareto_front(const std::vector<double>& cost, const std::vector<double>& score) {
+  const std::size_t n = std::min(cost.size(), score.size());
+  std::vector<std::size_t> front;
+  for (std::size_t i = 0; i < n; ++i) {
+    if (!std::isfinite(cost[i]) || !std::isfinite(score[i])) continue;
+    bool dominated = false;
+    for (std::size_t j = 0; j < n && !dominated; ++j)
+      dominated = j != i && std::isfinite(cost[j]) && std::isfinite(score[j]) && cost[j] <= cost[i] &&
+                  score[j] >= score[i] && (cost[j] < cost[i] || score[j] > score[i]);
+    if (!dominated) front.push_back(i);
+  }
+  std::stable_sort(front.begin(), front.end(), [&](std::size_t a, std::size_t b) { return cost[a] < cost[b]; });
+  return front;
+}
+
+std::vector<SpeedPoint> speed_points(const ComparisonReport& report) {
+  const MetricDefinition* d = find_metric(report.speed_metric);
+  const bool higher = d ? d->higher_is_better : true;
+  std::vector<SpeedPoint> points;
+  for (std::size_t i = 0; i < report.sequences.size(); ++i) {
+    const SequenceReport& s = report.sequences[i];
+    if (s.compute_kind != ComputeKind::Method) continue;
+    const auto ms = mean_compute_ms(s);
+    const MetricSummary m = summarize(s, report.speed_metric);
+    if (!ms || !m.count || !std::isfinite(m.mean)) continue;  // +inf PSNR (identical frames) has no place
+    points.push_back({i, *ms, m.mean, false});
+  }
+  std::vector<double> cost, score;  // pareto_front wants a score where higher is better
+  for (const SpeedPoint& p : points) {
+    cost.push_back(p.compute_ms);
+    score.push_back(higher ? p.value : -p.value);
+  }
+  for (const std::size_t k : pareto_front(cost, score)) points[k].on_front = true;
+  return points;
+}
+
+Status check_speed_metric(const ComparisonSetup& setup) {
+  const MetricDefinition* d = find_metric(setup.speed_metric);
+  if (!d) return Error::usage("--speed-metric '" + setup.speed_metric + "' is not a metric (compare --list-metrics)");
+  if (d->enabled && !d->enabled(setup))
+    return Error::usage("--speed-metric " + d->name + " is not measured in this run: " + d->enable_hint);
+  return Status::ok();
+}
+
 const char* compute_kind_name(ComputeKind kind) {
   switch (kind) {
     case ComputeKind::Render: return "render";
@@ -788,11 +833,11 @@ ComputeKind compute_kind_of(const FrameMetadata& header) {
 std::string ThresholdFailure::message() const {
   if (!text.empty()) return sequence + ": " + text;
   const MetricDefinition* d = find_metric(metric);
-  const char* unit = d ? d->unit.c_str() : "";
+  const std::string unit = d ? unit_suffix(*d) : std::string();
   const bool higher = d ? d->higher_is_better : true;
   char text[256];
-  std::snprintf(text, sizeof text, "%s: %s %.6g%s %s limit %.6g%s", sequence.c_str(), metric.c_str(), value, unit,
-                higher ? "<" : ">", limit, unit);
+  std::snprintf(text, sizeof text, "%s: %s %.6g%s %s limit %.6g%s", sequence.c_str(), metric.c_str(), value,
+                unit.c_str(), higher ? "<" : ">", limit, unit.c_str());
   return text;
 }
 

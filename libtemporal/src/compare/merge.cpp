@@ -210,6 +210,7 @@ Expected<ComparisonReport> merge_comparison_csvs(const std::vector<std::string>&
   merged->layer = setup.layer;
   merged->reference_layer = setup.reference_layer.empty() ? setup.layer : setup.reference_layer;
   merged->bootstrap = setup.bootstrap;
+  merged->speed_metric = setup.speed_metric;
   return merged;
 }
 

@@ -31,6 +31,7 @@ class Flicker final : public FrameMeasure {
 MetricDefinition flicker_metric() {
   MetricDefinition d;
   d.name = "flicker";
+  d.label = "flicker";
   d.higher_is_better = false;
   d.columns = {{"flicker", ""}};
   d.mask_columns = {"flicker_in", "flicker_out"};

@@ -74,6 +74,7 @@ class Flip final : public FrameMeasure {
 MetricDefinition flip_metric() {
   MetricDefinition d;
   d.name = "flip";
+  d.label = "FLIP";
   d.higher_is_better = false;
   d.columns = {{"flip", ""},
                {"flip_weighted_median", "weighted_median"},

@@ -60,7 +60,8 @@ class PsnrY final : public FrameMeasure {
 MetricDefinition psnr_rgb_metric() {
   MetricDefinition d;
   d.name = "psnr_rgb";
-  d.unit = " dB";
+  d.label = "PSNR";
+  d.unit = "dB";
   d.columns = {{"psnr_rgb_db", ""}, {"mse_rgb", ""}};
   d.mask_columns = {"psnr_rgb_in_db", "psnr_rgb_out_db"};
   d.historical_csv = true;
@@ -76,13 +77,15 @@ MetricDefinition psnr_rgb_metric() {
 MetricDefinition psnr_y_metric() {
   MetricDefinition d;
   d.name = "psnr_y";
-  d.unit = " dB";
+  d.label = "PSNR-Y";
+  d.unit = "dB";
   d.columns = {{"psnr_y_db", ""}};
   d.mask_columns = {"psnr_y_in_db", "psnr_y_out_db"};
   d.historical_csv = true;
   d.chart = {"-psnr-y", "PSNR of luminance per frame", "PSNR of luminance (dB)", false, {}, {}};
   d.table_width = 10;
   d.table_format = "%.3f";
+  d.on_sheet = false;  // the sheet's PSNR line says it
   d.make = [](const ComparisonSetup&) -> std::unique_ptr<FrameMeasure> { return std::make_unique<PsnrY>(); };
   return d;
 }

@@ -34,7 +34,8 @@ class PsnrLatency final : public FrameMeasure {
 MetricDefinition psnr_latency_metric() {
   MetricDefinition d;
   d.name = "psnr_latency";
-  d.unit = " dB";
+  d.label = "psnr_latency";  // the contact sheet's text for it since it was added (a label of its own would change it)
+  d.unit = "dB";
   d.columns = {{"psnr_latency_db", ""}, {"latency_frames", "latency_frames"}};
   d.mask_columns = {"psnr_latency_in_db", "psnr_latency_out_db"};
   d.threshold_option = "psnr-latency";

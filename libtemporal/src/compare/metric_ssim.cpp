@@ -31,6 +31,7 @@ class Ssim final : public FrameMeasure {
 MetricDefinition ssim_metric() {
   MetricDefinition d;
   d.name = "ssim";
+  d.label = "SSIM";
   d.columns = {{"ssim", ""}};
   d.mask_columns = {"ssim_in", "ssim_out"};
   d.historical_csv = true;

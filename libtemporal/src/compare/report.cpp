@@ -189,7 +189,8 @@ nlohmann::ordered_json metric_json(const ComparisonReport& report, const Sequenc
   return j;
 }
 
-nlohmann::ordered_json sequence_json(const ComparisonReport& report, const SequenceReport& s) {
+// `on_front`: the sequence is on the Pareto front of compute time against report.speed_metric (speed_points).
+nlohmann::ordered_json sequence_json(const ComparisonReport& report, const SequenceReport& s, bool on_front) {
   using json = nlohmann::ordered_json;
   json js;
   js["name"] = s.name;
@@ -205,6 +206,7 @@ nlohmann::ordered_json sequence_json(const ComparisonReport& report, const Seque
   js["nonfinite_pixels"] = {{"test", nf_test}, {"reference", nf_ref}};
   js["compute_ms"] = jnum(mean_compute_ms(s));
   js["compute_kind"] = compute_kind_name(s.compute_kind);
+  js["pareto"] = on_front;
   js["tool"] = s.tool.empty() ? nlohmann::ordered_json(nullptr) : nlohmann::ordered_json(s.tool);
   json timings = json::object();
   std::map<std::string, std::pair<double, std::size_t>> sums;
@@ -287,6 +289,7 @@ Status write_comparison_json(const ComparisonReport& report, const Thresholds& t
   j["mask"] = report.mask.empty() ? json(nullptr) : json(report.mask);
   if (report.flip != FlipMode::Off)
     j["flip"] = {{"mode", flip_mode_name(report.flip)}, {"pixels_per_degree", report.pixels_per_degree}};
+  j["speed_metric"] = report.speed_metric;  // the metric of the sequences' `pareto` flags
   json th = json::object();
   for (const auto* d : definitions_of(report)) {
     if (d->threshold_option.empty()) continue;
@@ -302,7 +305,9 @@ Status write_comparison_json(const ComparisonReport& report, const Thresholds& t
                   {"limit", jnum(f.limit)}, {"message", f.message()}});
   j["failures"] = jf;
   json seqs = json::array();
-  for (const auto& s : report.sequences) seqs.push_back(sequence_json(report, s));
+  std::vector<bool> on_front(report.sequences.size(), false);
+  for (const SpeedPoint& p : speed_points(report)) on_front[p.sequence] = p.on_front;
+  for (std::size_t i = 0; i < report.sequences.size(); ++i) seqs.push_back(sequence_json(report, report.sequences[i], on_front[i]));
   j["sequences"] = seqs;
   j["paired"] = paired_json(report);
   return write_text_atomic(path, j.dump(2) + "\n");

@@ -1,5 +1,6 @@
 #include "temporal/core/image.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
@@ -95,17 +96,98 @@ std::vector<std::string> Image::channel_names() const {
   return names;
 }
 
+namespace {
+// Order of the usual channel suffixes; others follow by name. Files and tools agree on it (OpenImageIO reads
+// R, G, B, A first), and a test and its reference pair their channels by it.
+int suffix_rank(std::string_view suffix) {
+  static constexpr std::string_view kOrder[] = {"R", "G", "B", "A", "X", "Y", "Z"};
+  for (int i = 0; i < 7; ++i)
+    if (suffix == kOrder[i]) return i;
+  return 7;
+}
+std::string_view suffix_of(std::string_view name) {
+  const auto dot = name.rfind('.');
+  return dot == std::string_view::npos ? name : name.substr(dot + 1);
+}
+}  // namespace
+
 std::vector<std::string> Image::layer_channels(std::string_view layer) const {
   std::vector<std::string> names;
+  if (layer.empty() || layer == "rgb" || layer == "rgba") {
+    for (const char* c : {"R", "G", "B", "A"})
+      if ((layer == "rgba" || c[0] != 'A') && has_channel(c)) names.emplace_back(c);
+    return names;
+  }
   for (const auto& c : channels_) {
     const auto dot = c.name.rfind('.');
-    if (layer.empty() || layer == "rgb" || layer == "rgba") {
-      if (dot == std::string::npos) names.push_back(c.name);
-    } else if (dot != std::string::npos && std::string_view(c.name).substr(0, dot) == layer) {
-      names.push_back(c.name);
-    }
+    if (dot != std::string::npos && std::string_view(c.name).substr(0, dot) == layer) names.push_back(c.name);
+  }
+  std::stable_sort(names.begin(), names.end(), [](const std::string& a, const std::string& b) {
+    const int ra = suffix_rank(suffix_of(a)), rb = suffix_rank(suffix_of(b));
+    return ra != rb ? ra < rb : a < b;
+  });
+  return names;
+}
+
+std::vector<std::string> layer_items(std::string_view selection) {
+  std::vector<std::string> items;
+  std::size_t begin = 0;
+  while (true) {
+    const auto comma = selection.find(',', begin);
+    items.emplace_back(selection.substr(begin, comma == std::string_view::npos ? std::string_view::npos : comma - begin));
+    if (comma == std::string_view::npos) break;
+    begin = comma + 1;
+  }
+  if (items.size() == 1 && items.front().empty()) items.front() = "rgb";
+  return items;
+}
+
+std::vector<std::string> layer_names(const Image& image) { return layer_names(image.channel_names()); }
+
+std::vector<std::string> layer_names(const std::vector<std::string>& channels) {
+  std::vector<std::string> names;
+  auto add = [&](std::string n) {
+    if (std::find(names.begin(), names.end(), n) == names.end()) names.push_back(std::move(n));
+  };
+  auto has = [&](const char* c) { return std::find(channels.begin(), channels.end(), c) != channels.end(); };
+  if (has("R") && has("G") && has("B")) add("rgb");
+  for (const std::string& c : channels) {
+    const auto dot = c.rfind('.');
+    if (dot != std::string::npos) add(c.substr(0, dot));
+    else if (c != "R" && c != "G" && c != "B" && c != "A") add(c);
   }
   return names;
+}
+
+Expected<std::vector<std::string>> select_layers(const Image& image, std::string_view selection,
+                                                 const std::string& file) {
+  auto have = [&] {
+    std::string text;
+    for (const auto& n : layer_names(image)) text += (text.empty() ? "" : ", ") + n;
+    return text.empty() ? std::string("none") : text;
+  };
+  std::vector<std::string> out;
+  for (const std::string& item : layer_items(selection)) {
+    if (item.empty()) return Error::usage("--layer '" + std::string(selection) + "' has an empty item");
+    std::vector<std::string> names = image.layer_channels(item);
+    const bool colour = item == "rgb" || item == "rgba";
+    if (colour && names.size() != (item == "rgb" ? 3u : 4u))
+      return Error::input(file, "no layer '" + item + "': " + item + " needs the bare channels " +
+                                    (item == "rgb" ? "R, G, B" : "R, G, B, A") + " (have: " + have() +
+                                    "); pick another with --layer");
+    if (names.empty() && image.has_channel(item)) names.push_back(item);
+    if (names.empty())
+      return Error::input(file, "no layer '" + item + "' (have: " + have() + "); pick another with --layer");
+    for (auto& n : names) {
+      if (image.channel_type(n) != ChannelType::Float)
+        return Error::input(file, "channel '" + n + "' of layer '" + item + "' is not float (uint data such as the "
+                                  "material id cannot be selected with --layer)");
+      if (std::find(out.begin(), out.end(), n) != out.end())
+        return Error::usage("--layer '" + std::string(selection) + "' selects channel '" + n + "' twice");
+      out.push_back(std::move(n));
+    }
+  }
+  return out;
 }
 
 Image Image::crop(const Rect& r) const {

@@ -41,6 +41,10 @@ std::string param_value_text(const Param& p) {
           return *v != p.inverted ? "on" : "off";
         else if constexpr (std::is_same_v<T, std::string>)
           return *v;
+        else if constexpr (std::is_same_v<T, std::vector<std::string>>)
+          return join(*v);
+        else if constexpr (std::is_same_v<T, std::optional<double>> || std::is_same_v<T, std::optional<int>>)
+          return *v ? number(double(**v)) : std::string();
         else
           return number(double(*v));
       },
@@ -49,7 +53,9 @@ std::string param_value_text(const Param& p) {
 
 std::string param_range_text(const Param& p) {
   if (!p.choices.empty()) return "one of: " + join(p.choices);
-  if (std::holds_alternative<bool*>(p.value)) return {};
+  if (std::holds_alternative<bool*>(p.value) || std::holds_alternative<std::string*>(p.value) ||
+      std::holds_alternative<std::vector<std::string>*>(p.value))
+    return {};
   const bool lo = std::isfinite(p.min), hi = std::isfinite(p.max);
   // Appended piece by piece: `"[" + std::string` trips a false -Wrestrict in GCC 12.
   std::string text;
@@ -63,21 +69,36 @@ std::string param_range_text(const Param& p) {
   return text;
 }
 
+namespace {
+Status check_choice(const Param& p, const std::string& value) {
+  if (p.choices.empty()) return Status::ok();
+  for (const auto& c : p.choices)
+    if (value == c) return Status::ok();
+  std::string list;
+  for (const auto& c : p.choices) list += (list.empty() ? "" : ", ") + c;
+  return Error::usage(p.flag + ": '" + value + "' is not one of " + list);
+}
+}  // namespace
+
 Status check_param(const Param& p) {
-  if (const auto* s = std::get_if<std::string*>(&p.value)) {
-    if (p.choices.empty()) return Status::ok();
-    for (const auto& c : p.choices)
-      if (**s == c) return Status::ok();
-    return not_one_of(p.flag, **s, p.choices);
+  if (const auto* s = std::get_if<std::string*>(&p.value)) return check_choice(p, **s);
+  if (const auto* list = std::get_if<std::vector<std::string>*>(&p.value)) {
+    for (const auto& item : **list)
+      if (Status st = check_choice(p, item); !st) return st;
+    return Status::ok();
   }
   if (std::holds_alternative<bool*>(p.value)) return Status::ok();
-  const double v = std::visit(
-      [](auto* x) -> double {
+  std::optional<double> value = std::visit(
+      [](auto* x) -> std::optional<double> {
         using T = std::remove_pointer_t<decltype(x)>;
         if constexpr (std::is_arithmetic_v<T>) return double(*x);
+        if constexpr (std::is_same_v<T, std::optional<double>> || std::is_same_v<T, std::optional<int>>)
+          return *x ? std::optional<double>(double(**x)) : std::nullopt;
         return 0.0;
       },
       p.value);
+  if (!value) return Status::ok();  // an optional number not given
+  const double v = *value;
   if (!std::isfinite(v)) return Error::usage(p.flag + " must be a finite number (got " + number(v) + ")");
   if (v < p.min || v > p.max || (p.above_min && v == p.min))
     return Error::usage(p.flag + " " + number(v) + " is out of range: it must be " + param_range_text(p));
@@ -112,10 +133,22 @@ Status apply_args(const ParamList& params, const std::vector<std::string>& args)
           using T = std::remove_pointer_t<decltype(field)>;
           if constexpr (std::is_same_v<T, std::string>) {
             *field = text;
-          } else if constexpr (std::is_same_v<T, int>) {
+          } else if constexpr (std::is_same_v<T, std::vector<std::string>>) {
+            if (!p->separator) {
+              field->push_back(text);
+            } else {
+              std::size_t begin = 0;
+              for (std::size_t at; (at = text.find(p->separator, begin)) != std::string::npos; begin = at + 1)
+                field->push_back(text.substr(begin, at - begin));
+              field->push_back(text.substr(begin));
+            }
+          } else if constexpr (std::is_same_v<T, int> || std::is_same_v<T, std::optional<int>>) {
             if (!number || v != std::floor(v) || std::abs(v) > 2e9)
               return Error::usage(p->flag + " needs an integer (got '" + text + "')");
             *field = int(v);
+          } else if constexpr (std::is_same_v<T, std::optional<double>>) {
+            if (!number) return Error::usage(p->flag + " needs a number (got '" + text + "')");
+            *field = v;
           } else if constexpr (std::is_arithmetic_v<T>) {
             if (!number) return Error::usage(p->flag + " needs a number (got '" + text + "')");
             *field = T(v);

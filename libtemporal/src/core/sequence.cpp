@@ -129,11 +129,19 @@ Expected<SequencePattern> SequencePattern::parse(std::string pattern) {
   return p;
 }
 
+namespace {
+std::string padded(int frame, int width) {
+  std::string digits = std::to_string(frame < 0 ? -frame : frame);
+  if (int(digits.size()) < width) digits.insert(0, std::size_t(width) - digits.size(), '0');
+  return (frame < 0 ? "-" : "") + digits;
+}
+}  // namespace
+
+std::string frame_digits(int frame) { return padded(frame, 4); }
+
 std::string SequencePattern::path(int frame) const {
   if (width_ < 0) return pattern_;
-  std::string digits = std::to_string(frame < 0 ? -frame : frame);
-  if (int(digits.size()) < width_) digits.insert(0, std::size_t(width_) - digits.size(), '0');
-  return prefix_ + (frame < 0 ? "-" : "") + digits + suffix_;
+  return prefix_ + padded(frame, width_) + suffix_;
 }
 
 std::vector<int> SequencePattern::frames_on_disk() const {

@@ -63,14 +63,10 @@ std::vector<std::string> unmatched(const ExrSelection& selection, const std::vec
   return missing;
 }
 
+// What --layer can name, as select_layers lists it (temporal/core/image.h): rgb, then the layers in file order.
 std::string describe_layers(const std::vector<std::string>& channels) {
-  std::set<std::string> layers;
-  for (const auto& c : channels) {
-    const std::string l = layer_of(c);
-    layers.insert(l.empty() ? c : l);
-  }
   std::string text;
-  for (const auto& l : layers) text += (text.empty() ? "" : ", ") + l;
+  for (const auto& l : layer_names(channels)) text += (text.empty() ? "" : ", ") + l;
   return text.empty() ? "none" : text;
 }
 

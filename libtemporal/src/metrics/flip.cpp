@@ -11,7 +11,7 @@
 // accumulators stay in vector registers.
 #include "temporal/metrics/flip.h"
 
-#include "fast_math.h"
+#include "temporal/core/fast_math.h"
 #include "temporal/core/parallel.h"
 
 #include <algorithm>

@@ -16,19 +16,6 @@
 namespace temporal {
 namespace {
 
-// Order of the usual channel suffixes; others follow by name.
-int suffix_rank(std::string_view suffix) {
-  static constexpr std::string_view kOrder[] = {"R", "G", "B", "A", "X", "Y", "Z"};
-  for (int i = 0; i < 7; ++i)
-    if (suffix == kOrder[i]) return i;
-  return 7;
-}
-
-std::string_view suffix_of(std::string_view name) {
-  const auto dot = name.rfind('.');
-  return dot == std::string_view::npos ? name : name.substr(dot + 1);
-}
-
 template <typename Partial, typename RowBody>
 std::vector<Partial> row_partials(int height, RowBody&& body) {
   std::vector<Partial> partials(std::size_t(std::max(height, 0)));
@@ -41,21 +28,8 @@ std::vector<Partial> row_partials(int height, RowBody&& body) {
 }  // namespace
 
 std::vector<std::string> compared_channels(const Image& image, std::string_view layer) {
-  std::vector<std::string> names;
-  if (layer.empty() || layer == "rgb") {
-    for (const char* c : {"R", "G", "B"})
-      if (image.has_channel(c)) names.emplace_back(c);
-    return names;
-  }
-  for (auto& n : image.layer_channels(layer))
-    if (image.channel_type(n) == ChannelType::Float) names.push_back(std::move(n));
-  if (names.empty() && image.has_channel(layer) && image.channel_type(layer) == ChannelType::Float)
-    names.emplace_back(layer);
-  std::stable_sort(names.begin(), names.end(), [](const std::string& a, const std::string& b) {
-    const int ra = suffix_rank(suffix_of(a)), rb = suffix_rank(suffix_of(b));
-    return ra != rb ? ra < rb : a < b;
-  });
-  return names;
+  auto names = select_layers(image, layer, {});
+  return names ? std::move(*names) : std::vector<std::string>();
 }
 
 void luminance_plane(std::span<const float* const> channels, std::size_t count, float* out) {

@@ -14,9 +14,9 @@
 // The low-pass is computed on the rendered frame and warped with the same grid (rather than blurring each
 // warped frame): for a piecewise-affine warp the two agree up to the local scale change, and this way the
 // energy balance of the compensation holds exactly along each motion trajectory, the one the eye follows.
-#include "fast_pow.h"
 #include "method_common.h"
 #include "temporal/core/color.h"
+#include "temporal/core/fast_math.h"
 #include "temporal/core/parallel.h"
 #include "temporal/morph/blur_pyramid.h"
 #include "temporal/morph/grid_warp.h"
@@ -40,14 +40,14 @@ void compensate_span(const float* o, const float* v, const float* l, const float
   if (!compensate) {
     for (std::size_t i = i0; i < i1; ++i) {
       top[i] = o[i];
-      lowlin[i] = fast_pow(l[i], gamma);
+      lowlin[i] = fast_math::pow(l[i], gamma);
     }
     return;
   }
   // Selects only (no short-circuit logic): the loop vectorises.
   for (std::size_t i = i0; i < i1; ++i) {
     const float oi = o[i], B = bs[i];
-    const float lg = fast_pow(l[i], gamma);
+    const float lg = fast_math::pow(l[i], gamma);
     const float top_g = (1.0f + B) * oi - B * lg;  // N_eff (H + L)^g - (N_eff - 1) L^g, N_eff = 1 + B
     const float excess_low = ((1.0f + B) * oi - 1.0f) / (B > 0.0f ? B : 1.0f);
     // Rule 2: the enhanced original would exceed the display: show 1, the excess goes to the low layer.
@@ -181,7 +181,7 @@ class Didyk final : public MorphMethod {
       float* v = P(kV + c);
       const float* l = color.plane(kRGB[c]);
       parallel_chunks(np, [&](std::size_t i0, std::size_t i1) {
-        for (std::size_t i = i0; i < i1; ++i) v[i] = fast_pow(std::clamp(l[i], 0.0f, 1.0f), inv_gamma);
+        for (std::size_t i = i0; i < i1; ++i) v[i] = fast_math::pow(std::clamp(l[i], 0.0f, 1.0f), inv_gamma);
       });
     }
     const float* vplanes[3] = {P(kV), P(kV + 1), P(kV + 2)};
@@ -217,7 +217,7 @@ class Didyk final : public MorphMethod {
         for (int c = 0; c < 3; ++c) {
           const float l = planes_[std::size_t(kL + c)][i];
           hv[c] = planes_[std::size_t(kV + c)][i] - l;
-          hp[c] = fast_pow(std::clamp(o0.plane(kRGB[c])[i], 0.0f, 1.0f), inv_gamma) - l;
+          hp[c] = fast_math::pow(std::clamp(o0.plane(kRGB[c])[i], 0.0f, 1.0f), inv_gamma) - l;
         }
         dbgH[i] = luminance(hv[0], hv[1], hv[2]);
         dbgHp[i] = luminance(hp[0], hp[1], hp[2]);

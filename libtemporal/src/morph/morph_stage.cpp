@@ -39,6 +39,23 @@ const Image* finite_copy(const Image* image, const std::vector<std::string>& cha
 
 const std::vector<std::string> kColor = {"R", "G", "B"};
 
+// A copy of `image` with channel from[k] called to[k] (the other channels as they are): the morph methods read
+// and write R, G, B, so another --layer is morphed under those names and written back under its own.
+Image renamed(const Image& image, const std::vector<std::string>& from, const std::vector<std::string>& to) {
+  Image out(image.width(), image.height());
+  out.metadata() = image.metadata();
+  for (std::size_t i = 0; i < image.channel_count(); ++i) {
+    const std::string& name = image.channel_name(i);
+    const auto k = std::find(from.begin(), from.end(), name);
+    const std::string& target = k == from.end() ? name : to[std::size_t(k - from.begin())];
+    if (const float* src = image.plane(name))
+      std::copy(src, src + image.pixel_count(), out.add_channel(target));
+    else if (const std::uint32_t* usrc = image.uint_plane(name))
+      std::copy(usrc, usrc + image.pixel_count(), out.add_uint_channel(target));
+  }
+  return out;
+}
+
 std::vector<std::string> gbuffer_channels(const std::vector<std::string>& layers) {
   std::vector<std::string> channels;
   for (const auto& l : layers)
@@ -64,7 +81,7 @@ class FrameRateStage final : public FrameStage {
   FrameRateStage(const MorphStageOptions& options, const MethodEntry& entry)
       : options_(options), entry_(entry), layers_(layer_names(entry.layers(options.morph))),
         gbuffer_channels_(gbuffer_channels(layers_)) {
-    inputs_.input_layers = {"rgb"};
+    inputs_.input_layers = layer_items(options.layer);
     for (const auto& l : layers_) inputs_.gbuffer_layers.push_back({l, true});
     inputs_.gbuffer_required = !layers_.empty();
     inputs_.gbuffer_purpose = "--method " + entry.info.name + " reads its " + layer_list(layers_);
@@ -76,9 +93,25 @@ class FrameRateStage final : public FrameStage {
   const StageInputs& inputs() const override { return inputs_; }
 
   Status process(const StageFrame& f, std::vector<StageOutput>& out) override {
-    const Image* color = finite_copy(f.input, kColor, color_);
+    auto layer = select_layers(*f.input, options_.layer, f.input_path);
+    if (!layer) return layer.error();
+    if (layer->size() != 3)
+      return Error::usage("--layer " + options_.layer + " has " + std::to_string(layer->size()) +
+                          " channels; the morph methods take 3 (a colour layer: rgb, direct, ...)");
+    const bool bare = *layer == kColor;  // rgb: no copies
+    const Image* input = f.input;
+    const Image* following = f.next.empty() ? nullptr : f.next.front();
+    if (!bare) {
+      layer_input_ = renamed(*f.input, *layer, kColor);
+      input = &layer_input_;
+      if (following) {
+        layer_next_ = renamed(*following, *layer, kColor);
+        following = &layer_next_;
+      }
+    }
+    const Image* color = finite_copy(input, kColor, color_);
     const Image* gbuffer = finite_copy(f.gbuffer, gbuffer_channels_, gbuffer_);
-    const Image* next = f.next.empty() ? nullptr : finite_copy(f.next.front(), kColor, next_);
+    const Image* next = following ? finite_copy(following, kColor, next_) : nullptr;
     double fps = options_.fps;
     if (fps <= 0.0) {
       if (!color->metadata().fps)
@@ -122,11 +155,16 @@ class FrameRateStage final : public FrameStage {
         md.jitter.reset();
         md.camera_cut.reset();
       }
-      Image& img = slots_[std::size_t(k)];
-      img.metadata() = std::move(md);
+      Image* img = &slots_[std::size_t(k)];
+      if (!bare) {  // the slots stay the morpher's (it reuses them next frame)
+        layer_slots_.resize(slots_.size());
+        layer_slots_[std::size_t(k)] = renamed(*img, kColor, *layer);
+        img = &layer_slots_[std::size_t(k)];
+      }
+      img->metadata() = std::move(md);
       StageOutput o;
       o.frame = frame;
-      o.image = &img;
+      o.image = img;
       o.compute_ms = total_ms_ / n;  // the rendered frame's work produces all its slots: each gets an equal share
       o.timings_ms = {{"flow", timings_.flow_ms}, {"morph", timings_.morph_ms}, {"blur", timings_.blur_ms}};
       o.extra = {{"method", entry_.info.name},
@@ -161,6 +199,8 @@ class FrameRateStage final : public FrameStage {
   std::optional<Morpher> morpher_;
   std::vector<Image> slots_;
   Image color_, gbuffer_, next_;  // finite copies (only of frames with NaN/Inf)
+  Image layer_input_, layer_next_;  // a --layer other than rgb under the names R, G, B
+  std::vector<Image> layer_slots_;  // the slots under the layer's names
   MorphTimings timings_;
   double total_ms_ = 0.0;
 };
@@ -272,6 +312,8 @@ ParamList morph_stage_params(MorphStageOptions& o) {
   ViewingOptions& v = o.viewing;
   ParamList params = morph::params(o.morph);
   const ParamList stage = {
+      Param::text("--layer", "Colour layer morphed: rgb (the bare R,G,B) or a layer with NAME.R,G,B (docs/conventions.md, "
+                             "Layers); the outputs keep its channel names", &o.layer),
       {.flag = "--fps", .help = "Input frame rate; 0 reads temporal:fps from the input header", .value = &o.fps,
        .min = 0.0, .max = 1e4},
       {.flag = "--display",
@@ -307,6 +349,8 @@ ParamList morph_stage_params(MorphStageOptions& o) {
 
 Expected<std::unique_ptr<FrameStage>> make_morph_stage(const MorphStageOptions& options, const MorphStageIO& io) {
   if (options.perceive) {
+    if (layer_items(options.layer) != std::vector<std::string>{"rgb"})
+      return Error::usage("--perceive reads the colour channels R, G, B: drop --layer " + options.layer);
     if (options.hold.window < 1) return Error::usage("--window must be at least 1");
     std::optional<SequencePattern> lag_reference;
     if (!options.lag_reference.empty()) {

@@ -9,12 +9,11 @@ namespace {
 
 std::string dims(int w, int h) { return std::to_string(w) + "x" + std::to_string(h); }
 
-// Channels of the filtered layer: R,G,B for `rgb`, else every `NAME.*` channel; 1 or 3 of them.
+// Channels of the filtered layer (select_layers, the --layer rule of every tool); 1 or 3 of them.
 Expected<std::vector<std::string>> layer_channels(const Image& img, const std::string& layer, const std::string& file) {
-  std::vector<std::string> names = layer == "rgb" ? std::vector<std::string>{"R", "G", "B"} : img.layer_channels(layer);
-  for (const auto& n : names)
-    if (!img.plane(n))
-      return Error::input(file, "no float channel '" + n + "' for --layer " + layer + "; pick a layer the file has");
+  auto selected = select_layers(img, layer, file);
+  if (!selected) return selected.error();
+  const std::vector<std::string>& names = *selected;
   if (names.size() != 1 && names.size() != 3)
     return Error::usage("--layer " + layer + " has " + std::to_string(names.size()) +
                         " channels; the filters take 1 (e.g. ssao) or 3 (rgb, direct)");
@@ -25,7 +24,7 @@ class FilterStage final : public FrameStage {
  public:
   FilterStage(const FilterOptions& options, const MethodEntry& method, std::unique_ptr<FrameFilter> filter)
       : options_(options), method_(method), filter_(std::move(filter)) {
-    inputs_.input_layers = {options.layer};
+    inputs_.input_layers = layer_items(options.layer);
     inputs_.gbuffer_layers = method.layers(options);
     // Every parameter of the method with its value (ablation switches included), for the output headers.
     FilterOptions copy = options;

@@ -7,6 +7,7 @@
 #include "temporal/pictures/comparison_pictures.h"
 
 #include "temporal/io/exr.h"
+#include "temporal/core/sequence.h"
 #include "temporal/pictures/colormap.h"
 #include "temporal/pictures/sheet.h"
 #include "temporal/pictures/text.h"
@@ -32,12 +33,6 @@ std::string safe_name(const std::string& name) {
   return out.empty() ? std::string("test") : out;
 }
 
-std::string digits(int frame) {
-  char text[32];
-  std::snprintf(text, sizeof text, "%04d", frame);
-  return text;
-}
-
 std::vector<const float*> planes_of(const Image& image, std::span<const std::string> channels) {
   std::vector<const float*> planes;
   for (const auto& c : channels) planes.push_back(image.plane(c));
@@ -47,17 +42,13 @@ std::vector<const float*> planes_of(const Image& image, std::span<const std::str
 }  // namespace
 
 std::string metric_label(std::string_view metric) {
-  if (metric == "psnr_rgb") return "PSNR";
-  if (metric == "psnr_y") return "PSNR-Y";
-  if (metric == "ssim") return "SSIM";
-  if (metric == "flicker") return "flicker";
-  if (metric == "flip") return "FLIP";
-  return std::string(metric);
+  const MetricDefinition* d = find_metric(metric);
+  return d && !d->label.empty() ? d->label : std::string(metric);
 }
 
 std::string metric_text(std::string_view metric, double value) {
   const MetricDefinition* d = find_metric(metric);
-  return metric_label(metric) + " " + format_number(value, 4) + (d && std::isfinite(value) ? d->unit : std::string());
+  return metric_label(metric) + " " + format_number(value, 4) + (d && std::isfinite(value) ? unit_suffix(*d) : std::string());
 }
 
 struct ComparisonPictures::Impl {
@@ -302,7 +293,7 @@ Status ComparisonPictures::Impl::observe(const ComparedFrame& cf) {
 
   if (png_on) {
     auto write_all = [&]() -> Status {
-      const std::string d = digits(cf.frame);
+      const std::string d = frame_digits(cf.frame);
       if (auto st = write(*ref, (fs::path(o.png_dir) / ("reference." + d + ext)).string(), "--png"); !st) return st;
       for (std::size_t i = 0; i < cf.tests.size(); ++i) {
         const auto& t = cf.tests[i];
@@ -450,7 +441,7 @@ Status ComparisonPictures::Impl::finish_sheet(const ComparisonReport& report) {
     std::string line;
     int on_line = 0;
     for (const auto& m : report.metrics) {
-      if (m == "psnr_y") continue;
+      if (const MetricDefinition* d = find_metric(m); d && !d->on_sheet) continue;
       const double v = t.metrics.value(m);
       if (std::isnan(v)) continue;
       line += (on_line ? "  " : "") + metric_text(m, v);
@@ -476,7 +467,7 @@ Status ComparisonPictures::Impl::finish_sheet(const ComparisonReport& report) {
       exr.metadata().frame = c.frame;
       exr.metadata().extra["reference"] = c.reference_path;
       exr.metadata().extra["test"] = t.path;
-      const std::string rel_path = maps_dir + "/" + safe_name(t.name) + "." + digits(c.frame) + ".exr";
+      const std::string rel_path = maps_dir + "/" + safe_name(t.name) + "." + frame_digits(c.frame) + ".exr";
       if (auto st = write_exr_file(exr, in_report(rel_path), "--report"); !st) return st;
       link = rel_path;
     }
@@ -521,7 +512,7 @@ Status ComparisonPictures::Impl::finish_sheet(const ComparisonReport& report) {
   auto sheet = compose_sheet(title, rows, *font);
   if (!sheet) return sheet.error();
   if (png_on)
-    if (auto st = write(sheet->picture, (fs::path(o.png_dir) / ("sheet." + digits(c.frame) + ext)).string(), "--png"); !st)
+    if (auto st = write(sheet->picture, (fs::path(o.png_dir) / ("sheet." + frame_digits(c.frame) + ext)).string(), "--png"); !st)
       return st;
   if (!report_on) return {};
   if (auto st = write(sheet->picture, in_report("pictures/sheet.png"), "--report"); !st) return st;

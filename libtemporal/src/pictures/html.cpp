@@ -68,7 +68,7 @@ void metric_table(std::ostringstream& out, const ComparisonReport& r) {
   for (const auto& name : r.metrics)
     if (const MetricDefinition* d = find_metric(name)) defs.push_back(d);
   for (const auto* d : defs)
-    out << "<th>" << html_escape(d->name) << (d->unit.empty() ? "" : " (" + html_escape(d->unit.substr(1)) + ")")
+    out << "<th>" << html_escape(d->name) << (d->unit.empty() ? "" : " (" + html_escape(d->unit) + ")")
         << (d->higher_is_better ? " ↑" : " ↓") << "</th>";
   out << "<th>compute ms</th></tr>\n";
   // The best mean of each metric in bold.

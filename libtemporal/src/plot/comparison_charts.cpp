@@ -67,53 +67,40 @@ std::vector<std::pair<std::string, Chart>> comparison_charts(const ComparisonRep
 
   // Speed: only times that measure the method itself (ComputeKind::Method). A render-gbuffer input's computeMs
   // is the render, a morph-120hz --perceive output's the perception simulation: neither is a method's cost.
+  // The points and their Pareto front come from speed_points (the JSON's `pareto` flags are the same).
   Chart speed;
   speed.title = with_title(title, "Speed against error (mean over frames)");
   speed.x_label = "method compute time per frame (ms, temporal:computeMs, I/O excluded)";
+  const MetricDefinition* metric = find_metric(report.speed_metric);
+  const std::string label = metric && !metric->label.empty() ? metric->label : report.speed_metric;
+  const std::string unit = metric ? metric->unit : std::string();
   // A merged report (compare --merge) does not know its layer: the CSV does not carry it.
-  speed.y_label = report.layer.empty() ? std::string("mean PSNR (dB)") : "mean PSNR (" + report.layer + ", dB)";
+  std::string axis = report.layer;
+  if (!unit.empty()) axis += (axis.empty() ? "" : ", ") + unit;
+  speed.y_label = "mean " + label + (axis.empty() ? std::string() : " (" + axis + ")");
   speed.style = ChartStyle::Points;
-  for (std::size_t i = 0; i < report.sequences.size(); ++i) {
-    const SequenceReport& s = report.sequences[i];
-    if (s.compute_kind != ComputeKind::Method) continue;
-    const auto ms = mean_compute_ms(s);
-    const auto psnr = summarize(s, "psnr_rgb");
-    if (!ms || !psnr.count || !std::isfinite(psnr.mean)) continue;
-    speed.series.push_back({s.name, {*ms}, {psnr.mean}, int(i)});  // the colour it has in the other charts
+  const std::vector<SpeedPoint> points = speed_points(report);
+  std::vector<const SpeedPoint*> front_points;
+  for (const SpeedPoint& point : points) {
+    // The colour the sequence has in the other charts.
+    speed.series.push_back({report.sequences[point.sequence].name, {point.compute_ms}, {point.value}, int(point.sequence)});
+    if (point.on_front) front_points.push_back(&point);
   }
-  // The Pareto front of the methods (and of a sweep's parameter values): where a faster method costs PSNR.
-  std::vector<double> cost, score;
-  for (const auto& s : speed.series) {
-    cost.push_back(s.x.front());
-    score.push_back(s.y.front());
-  }
-  if (speed.series.size() >= 2) {
+  // The Pareto front of the methods (and of a sweep's parameter values): where a faster method costs quality.
+  if (points.size() >= 2) {
+    std::stable_sort(front_points.begin(), front_points.end(),
+                     [](const SpeedPoint* a, const SpeedPoint* b) { return a->compute_ms < b->compute_ms; });
     ChartSeries front;
     front.name = "Pareto front";
     front.line = true;
-    for (const std::size_t i : pareto_front(cost, score)) {
-      front.x.push_back(cost[i]);
-      front.y.push_back(score[i]);
+    for (const SpeedPoint* point : front_points) {
+      front.x.push_back(point->compute_ms);
+      front.y.push_back(point->value);
     }
     speed.series.push_back(std::move(front));
   }
   if (!speed.series.empty()) charts.emplace_back(stem + "-speed" + ext, std::move(speed));
   return charts;
-}
-
-std::vector<std::size_t> pareto_front(const std::vector<double>& cost, const std::vector<double>& score) {
-  const std::size_t n = std::min(cost.size(), score.size());
-  std::vector<std::size_t> front;
-  for (std::size_t i = 0; i < n; ++i) {
-    if (!std::isfinite(cost[i]) || !std::isfinite(score[i])) continue;
-    bool dominated = false;
-    for (std::size_t j = 0; j < n && !dominated; ++j)
-      dominated = j != i && std::isfinite(cost[j]) && std::isfinite(score[j]) && cost[j] <= cost[i] &&
-                  score[j] >= score[i] && (cost[j] < cost[i] || score[j] > score[i]);
-    if (!dominated) front.push_back(i);
-  }
-  std::stable_sort(front.begin(), front.end(), [&](std::size_t a, std::size_t b) { return cost[a] < cost[b]; });
-  return front;
 }
 
 }  // namespace temporal

@@ -84,9 +84,7 @@ Status check_camera(const std::string& file, const FrameState& state, int frame,
 }
 
 std::string frame_path(const std::string& dir, const char* name, int frame) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, ".%04d.exr", frame);
-  return (std::filesystem::path(dir) / (std::string(name) + buf)).string();
+  return (std::filesystem::path(dir) / (std::string(name) + "." + frame_digits(frame) + ".exr")).string();
 }
 
 const char* const kPasses[] = {kPassGbuffer, kPassLightMaps, kPassShadeLow, kPassShadeFull, kPassReference, kPassColor};
@@ -284,7 +282,7 @@ Status replay(const Scene& scene, const RenderOptions& render, const ReplayOptio
     if (!rendered) return rendered.error();
     if (auto s = write_outputs(*rendered, options, frame); !s) return s;
     if (auto s = csv.row(frame, double(frame) / options.fps, rendered->timings_ms); !s) return s;
-    if (hooks.frame_done) hooks.frame_done(frame, range.count());
+    if (hooks.frame_done) hooks.frame_done(frame, frame - range.first + 1, range.count());
     previous = std::move(current);
   }
   return {};

@@ -73,6 +73,7 @@ Expected<CompareRun> run_compare(const ComparisonSetup& setup, const Thresholds&
   if (!merging && (setup.reference.empty() || setup.tests.empty()))
     return Error::usage("give --reference REF.####.exr and at least one test sequence (or --merge A.csv B.csv ...)");
   if (auto st = check_threshold_setup(setup, thresholds); !st) return st.error();
+  if (auto st = check_speed_metric(setup); !st) return st.error();
   if (!o.plot.empty())
     if (auto f = chart_format(o.plot); !f) return f.error();
   // No output may replace a file this run reads (error maps and pictures are checked as they are written).

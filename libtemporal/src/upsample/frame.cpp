@@ -8,7 +8,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
-#include <sstream>
 
 namespace temporal::upsample {
 namespace {
@@ -19,40 +18,10 @@ std::string join(const std::vector<std::string>& v) {
   return s.empty() ? "(none)" : s;
 }
 
-std::vector<std::string> split(const std::string& text) {
-  std::vector<std::string> out;
-  std::stringstream ss(text);
-  std::string item;
-  while (std::getline(ss, item, ','))
-    if (!item.empty()) out.push_back(item);
-  return out;
-}
-
 }  // namespace
 
 Expected<std::vector<std::string>> select_channels(const Image& low, const std::string& layers, const std::string& file) {
-  std::vector<std::string> out;
-  for (const auto& layer : split(layers.empty() ? std::string("rgb") : layers)) {
-    std::vector<std::string> names;
-    if (layer == "rgb") {
-      for (const char* c : {"R", "G", "B"})
-        if (low.has_channel(c)) names.push_back(c);
-      if (names.size() != 3)
-        return Error::input(file, "no R,G,B payload (have: " + join(low.channel_names()) +
-                                      "); render it with render-gbuffer --outputs shade, or pick one with --layer");
-    } else if (low.has_channel(layer)) {
-      names.push_back(layer);
-    } else {
-      names = low.layer_channels(layer);
-      if (names.empty())
-        return Error::input(file, "no layer '" + layer + "' (have: " + join(low.channel_names()) + ")");
-    }
-    for (auto& n : names)
-      if (low.channel_type(n) != ChannelType::Float)
-        return Error::input(file, "channel '" + n + "' is not float; only float payloads can be upsampled");
-    out.insert(out.end(), names.begin(), names.end());
-  }
-  return out;
+  return select_layers(low, layers, file);  // the --layer rule of every tool (temporal/core/image.h)
 }
 
 void TapTable::build(int full, int low, int k, int s) {

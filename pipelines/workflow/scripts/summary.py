@@ -1,8 +1,8 @@
 #!/usr/bin/env python3
 """An experiment's summary table from compare's JSON files (one per scene): per variant the mean of each metric
 with its 95 % interval, the mean compute time from the output headers, whether the variant is on the Pareto front
-of compute time against PSNR, and its paired PSNR difference against the baseline with the interval. It only
-formats what compare computed (docs/pipelines.md)."""
+of compute time against PSNR (compare's `pareto` flag, the front of its speed chart), and its paired PSNR
+difference against the baseline with the interval. It only formats what compare computed (docs/pipelines.md)."""
 import argparse
 import json
 import os
@@ -11,19 +11,6 @@ import sys
 # The cells are formatted by pipelines/tables.py, the pipelines' one table formatter.
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", ".."))
 from tables import fmt_value as fmt, num, with_ci  # noqa: E402
-
-
-def pareto(points):
-    """Names of the points not dominated in (lower cost, higher score)."""
-    front = []
-    for name, cost, score in points:
-        if cost is None or score is None:
-            continue
-        dominated = any(c2 <= cost and s2 >= score and (c2 < cost or s2 > score)
-                        for n2, c2, s2 in points if n2 != name and c2 is not None and s2 is not None)
-        if not dominated:
-            front.append(name)
-    return front
 
 
 def main():
@@ -38,8 +25,6 @@ def main():
         scene = os.path.basename(os.path.dirname(path))
         report = json.load(open(path))
         seqs = report["sequences"]
-        points = [(s["name"], num(s.get("compute_ms")), num((s.get("psnr_rgb") or {}).get("mean"))) for s in seqs]
-        front = set(pareto(points))
         lines += [f"## {scene}", "",
                   "| variant | PSNR dB [95% CI] | SSIM | flicker | compute ms | Pareto | PSNR - " + (a.baseline or "baseline") + " [95% CI] |",
                   "|---|---|---|---|---|---|---|"]
@@ -57,7 +42,7 @@ def main():
             diff = "-" if not d else f"{fmt(d[0])} [{fmt(d[1][0])}, {fmt(d[1][1])}]"
             lines.append(f"| {s['name']} | {with_ci(s.get('psnr_rgb'))} | {with_ci(s.get('ssim'), 4)} | "
                          f"{with_ci(s.get('flicker'), 4)} | {fmt(s.get('compute_ms'), 3)} | "
-                         f"{'yes' if s['name'] in front else ''} | {diff} |")
+                         f"{'yes' if s.get('pareto') else ''} | {diff} |")
         plots = os.path.join(os.path.dirname(path), "plots")
         lines += ["", f"Charts: `{os.path.relpath(plots, os.path.dirname(a.out))}/` (metrics-speed.png: compute time "
                       "against PSNR)", ""]

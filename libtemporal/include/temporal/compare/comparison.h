@@ -4,12 +4,12 @@
 // maps, and turns the results into CSV, JSON, a summary table, charts and threshold checks. docs/compare.md
 // defines every number.
 //
-// The metric set is open: a metric is one entry of the registry (metric_registry()) - its name, the per-frame
-// measure, the CSV columns it writes, whether higher is better, its threshold option `--fail-<option>`, its
-// chart and its column of the summary table - and the CSV, JSON, thresholds, charts and table iterate the
-// registry. Adding a metric is one source file (src/metrics/metric_<name>.cpp: the definition and its
-// FrameMeasure), one line in src/metrics/registry.cpp (with its declaration in registry.h), and its section in
-// docs/compare.md.
+// The metric set is open: a metric is one entry of the registry (metric_registry()) - its name, label, unit,
+// the per-frame measure, the CSV columns it writes, whether higher is better, its threshold option
+// `--fail-<option>`, its chart and its column of the summary table - and the CSV, JSON, thresholds, charts,
+// pictures, table and `compare --list-metrics` iterate the registry. Adding a metric is one source file
+// (src/compare/metric_<name>.cpp: the definition and its FrameMeasure, named in the stage's source list), one
+// line in src/compare/registry.cpp, and its section in docs/compare.md.
 #pragma once
 
 #include "temporal/core/error.h"
@@ -63,6 +63,8 @@ struct ComparisonSetup {
   // (docs/conventions.md, "Latency"). The reference is read past `frames` where the files exist.
   bool latency_aware = false;
   BootstrapOptions bootstrap;          // intervals of the JSON summary (temporal/metrics/statistics.h)
+  // The metric judged against compute time: the speed chart's y axis and the JSON's Pareto flags (speed_points).
+  std::string speed_metric = "psnr_rgb";
   std::string tool;                    // `temporal:tool` of the error maps
   std::string parameters;              // `temporal:parameters` of the error maps
 };
@@ -138,7 +140,8 @@ struct MetricChart {
 
 struct MetricDefinition {
   std::string name;                    // "psnr_rgb": JSON key, threshold and failure name, table header
-  std::string unit;                    // " dB" in messages, or empty
+  std::string label;                   // "PSNR": what pictures and charts call it
+  std::string unit;                    // "dB", or empty for a unitless metric
   bool higher_is_better = true;
   std::vector<MetricColumn> columns;   // CSV columns, primary first
   std::array<std::string, 2> mask_columns;  // CSV columns of the primary value inside / outside the mask
@@ -151,6 +154,7 @@ struct MetricDefinition {
   MetricChart chart;
   int table_width = 10;                // summary table column
   std::string table_format = "%.3f";   // printf format of the mean
+  bool on_sheet = true;                // printed under each test on the contact sheet (psnr_y is not: PSNR says it)
   // Null: always measured. Otherwise whether `setup` asks for the metric, and what to add when it does not.
   bool (*enabled)(const ComparisonSetup& setup) = nullptr;
   std::string enable_hint;             // e.g. "add --flip ldr or --flip hdr"
@@ -163,6 +167,13 @@ const std::vector<MetricDefinition>& metric_registry();
 const MetricDefinition* find_metric(std::string_view name);
 // The entries `setup` measures.
 std::vector<const MetricDefinition*> enabled_metrics(const ComparisonSetup& setup);
+// " dB": the unit as it follows a number in messages and pictures, or "" for a unitless metric.
+std::string unit_suffix(const MetricDefinition& metric);
+// The registry for people and for scripts (`compare --list-metrics`, `--list-metrics-json`): one line per metric,
+// tab-separated name, label, unit, better ("higher" or "lower"); or a JSON array of objects with those keys and
+// the metric's CSV columns, threshold option and chart range.
+std::string metric_list_text();
+std::string metric_list_json();
 
 // --- Results -----------------------------------------------------------------------------------------------
 
@@ -230,6 +241,7 @@ struct ComparisonReport {
   std::vector<std::string> metrics;             // names of the measured metrics, registry order
   int warmup_frames = 0;                        // ComparisonSetup::warmup_frames
   BootstrapOptions bootstrap;                   // ComparisonSetup::bootstrap
+  std::string speed_metric = "psnr_rgb";        // ComparisonSetup::speed_metric
   std::vector<SequenceReport> sequences;
 };
 
@@ -302,6 +314,24 @@ std::vector<double> metric_series(const SequenceReport& sequence, std::string_vi
 
 // Mean of `temporal:computeMs` over frames that have it (else the mean sum of the `temporal:ms:*` timings).
 std::optional<double> mean_compute_ms(const SequenceReport& sequence);
+
+// Indices of the points not dominated in (lower cost, higher score): no other point has a cost <= and a score >=
+// with one of them strictly better. Sorted by cost. Points with a non-finite cost or score are left out.
+std::vector<std::size_t> pareto_front(const std::vector<double>& cost, const std::vector<double>& score);
+
+// Speed against error (docs/compare.md, "Speed"): one point per sequence whose headers time the method itself
+// (ComputeKind::Method: never a render's or a simulation's time) and that has a finite mean of
+// `report.speed_metric`, in sequence order. `on_front`: the point is on the Pareto front of lower compute time
+// against a better mean (higher or lower as the metric's registry entry says).
+struct SpeedPoint {
+  std::size_t sequence = 0;  // index into report.sequences
+  double compute_ms = 0.0;   // mean_compute_ms
+  double value = 0.0;        // mean of the speed metric
+  bool on_front = false;
+};
+std::vector<SpeedPoint> speed_points(const ComparisonReport& report);
+// Usage error unless `setup.speed_metric` is a registry metric that `setup` measures (with how to turn it on).
+Status check_speed_metric(const ComparisonSetup& setup);
 
 // The table compare prints: one line per sequence with its frame count, the mean of each measured metric and
 // the mean compute time from the headers.

@@ -79,7 +79,9 @@ class Image {
   std::size_t channel_count() const { return channels_.size(); }
   const std::string& channel_name(std::size_t i) const { return channels_[i].name; }
   std::vector<std::string> channel_names() const;
-  // Channels whose name is `layer.*`, or the bare colour channels when layer is empty.
+  // The channels of one layer (docs/conventions.md, "Layers"): `layer.*` in channel order (R, G, B, A, X, Y, Z,
+  // then by name), or the bare colour channels R, G, B for `rgb` or empty (R, G, B, A for `rgba`) that the image
+  // has. Any channel type. select_layers is the --layer rule built on it.
   std::vector<std::string> layer_channels(std::string_view layer) const;
 
   // A copy of a sub-rectangle with every channel.
@@ -107,6 +109,23 @@ class Image {
   std::vector<Channel> channels_;
   FrameMetadata metadata_;
 };
+
+// The --layer rule of every tool (docs/conventions.md, "Layers"). `selection` is a layer or a comma-separated list
+// of them; empty means `rgb`. Each item selects, in this order of precedence:
+//   rgb       the bare colour channels R, G, B (all three); `rgba` adds A
+//   NAME      the channels NAME.* (albedo -> albedo.R, albedo.G, albedo.B), in channel order (Image::layer_channels)
+//   CHANNEL   else the channel with exactly that name (ssao, debug.mask)
+// The result is the items' channels in the order of the items. Every selected channel must be float. Errors:
+// Input, naming `file`, the item and the layers the image has (layer_names); Usage for an empty item ("a,,b") or a
+// channel selected twice.
+Expected<std::vector<std::string>> select_layers(const Image& image, std::string_view selection,
+                                                 const std::string& file);
+// The items of a selection (`rgb` for an empty one), e.g. the layers to read (ExrSelection).
+std::vector<std::string> layer_items(std::string_view selection);
+// What --layer can name in an image: `rgb` when it has R, G and B, then every NAME of NAME.* channels and every
+// other bare channel, in channel order, each once.
+std::vector<std::string> layer_names(const Image& image);
+std::vector<std::string> layer_names(const std::vector<std::string>& channels);  // the same from channel names
 
 // Counts the non-finite values (NaN, +-Inf) of a float plane.
 std::size_t count_non_finite(std::span<const float> plane);

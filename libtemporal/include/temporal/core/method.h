@@ -158,14 +158,14 @@ MethodOptionSet method_option_set(const std::vector<const Entry*>& registry) {
   return set;
 }
 
-// Each method's own parameters, bound to `set`, their help prefixed with the method's name ("taau: ...").
+// Each method's own parameters, bound to `set`, in a --help section named after the method (Param::group).
 template <typename Entry>
 ParamList method_params(const std::vector<const Entry*>& registry, MethodOptionSet& set) {
   ParamList list;
   for (const Entry* e : registry)
     if (MethodOptions* m = set.find(e->info.name))
       for (Param p : m->params()) {
-        p.help = e->info.name + ": " + p.help;
+        if (p.group.empty()) p.group = e->info.name;
         list.push_back(std::move(p));
       }
   return list;

@@ -7,6 +7,7 @@
 #include "temporal/core/error.h"
 
 #include <limits>
+#include <optional>
 #include <string>
 #include <variant>
 #include <vector>
@@ -15,11 +16,15 @@ namespace temporal {
 
 // One parameter: the command-line flag, a help line (what it is, the paper's name and equation), the field it
 // sets, and its valid range. Floating-point values must be finite and inside [min, max]; integers inside
-// [min, max]; strings one of `choices` (when given).
+// [min, max]; strings one of `choices` (when given). Optional numbers (a threshold that is off until given) are
+// checked the same way once set; a list takes the option again for each value (or `separator`-separated
+// values) and checks each against `choices`.
+using ParamValue = std::variant<float*, double*, int*, bool*, std::string*, std::optional<double>*,
+                                std::optional<int>*, std::vector<std::string>*>;
 struct Param {
-  std::string flag;  // "--sigma-normal"
+  std::string flag;  // "--sigma-normal"; a name without a leading '-' is a positional argument ("tests")
   std::string help;  // "sigma_n of the normal weight (seed 000 eq. 2)"
-  std::variant<float*, double*, int*, bool*, std::string*> value;
+  ParamValue value;
   double min = -std::numeric_limits<double>::infinity();
   double max = std::numeric_limits<double>::infinity();
   std::vector<std::string> choices = {};  // (a default, so designated initializers may leave it out)
@@ -27,6 +32,11 @@ struct Param {
   // A flag that turns a default-on feature off: giving it sets the bool field to false (`--no-snap` for
   // `GridOptions::snap`), so the option struct keeps its positive-sense field and its default.
   bool inverted = false;
+  // The --help section the option is listed under (a method's name: "herzog"); empty: the one add_params names,
+  // else the tool's general options.
+  std::string group = {};
+  char separator = 0;                  // a list: each value is split at this character ("a,b" for --names)
+  std::vector<std::string> excludes = {};  // flags that cannot be given together with this one
 
   // Shorthands for the common ranges.
   static Param real(std::string flag, std::string help, float* v, double lo, double hi) {
@@ -34,6 +44,12 @@ struct Param {
   }
   // A value strictly above `lo` (e.g. a positive scale: > 0).
   static Param positive(std::string flag, std::string help, float* v, double lo = 0.0,
+                        double hi = std::numeric_limits<double>::infinity()) {
+    Param p{std::move(flag), std::move(help), v, lo, hi, {}};
+    p.above_min = true;
+    return p;
+  }
+  static Param positive(std::string flag, std::string help, double* v, double lo = 0.0,
                         double hi = std::numeric_limits<double>::infinity()) {
     Param p{std::move(flag), std::move(help), v, lo, hi, {}};
     p.above_min = true;
@@ -55,15 +71,34 @@ struct Param {
     return {std::move(flag), std::move(help), v, -std::numeric_limits<double>::infinity(),
             std::numeric_limits<double>::infinity(), {}};
   }
+  // Text values, one per occurrence or per `separator`-separated item.
+  static Param list(std::string flag, std::string help, std::vector<std::string>* v, char separator = 0) {
+    Param p{std::move(flag), std::move(help), v};
+    p.separator = separator;
+    return p;
+  }
+  // A number that is unset until given (no default), checked against [lo, hi] when set.
+  static Param optional(std::string flag, std::string help, std::optional<double>* v,
+                        double lo = -std::numeric_limits<double>::infinity(),
+                        double hi = std::numeric_limits<double>::infinity()) {
+    return {std::move(flag), std::move(help), v, lo, hi, {}};
+  }
+  static Param optional(std::string flag, std::string help, std::optional<int>* v,
+                        double lo = -std::numeric_limits<double>::infinity(),
+                        double hi = std::numeric_limits<double>::infinity()) {
+    return {std::move(flag), std::move(help), v, lo, hi, {}};
+  }
 };
 using ParamList = std::vector<Param>;
 
 // The current value as text (the default, before parsing): "0.2", "4", "on", "herzog". A flag reads "on" when it is
-// in effect (an inverted flag: when its field is false).
+// in effect (an inverted flag: when its field is false); an unset optional number ""; a list its values joined with
+// ", ".
 std::string param_value_text(const Param& param);
 // The valid range as text: "[0, 1]", "> 0", "one of: cache, refresh"; empty when unbounded.
 std::string param_range_text(const Param& param);
-// Usage error unless the current value is valid: finite, inside the range, one of the choices.
+// Usage error unless the current value is valid: finite, inside the range, one of the choices
+// ("--flip: 'yes' is not one of off, ldr, hdr").
 Status check_param(const Param& param);
 // check_param for every entry (the first failure).
 Status check_params(const ParamList& params);

@@ -60,6 +60,10 @@ class SequencePattern {
   int width_ = -1;  // -1: no placeholder; 0: unpadded
 };
 
+// `frame` as the suite names its own files, NAME.####.exr: zero-padded to four digits ("0012"), wider numbers in
+// full. SequencePattern("NAME.####.exr").path(frame) gives the same digits.
+std::string frame_digits(int frame);
+
 // The frames to process: the given range (every file in it must exist), or every frame on disk (which must
 // be contiguous: a gap is an error naming the first missing file). An empty result is an error.
 Expected<std::vector<int>> resolve_frames(const SequencePattern& pattern, const std::optional<FrameRange>& range);

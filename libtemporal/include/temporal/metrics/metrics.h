@@ -27,9 +27,8 @@ namespace temporal {
 
 // --- Channel selection ------------------------------------------------------------------------------------
 
-// The channels that `--layer NAME` compares, in canonical order: `rgb` (or an empty name) gives the bare
-// `R,G,B`; any other name gives the channels `NAME.*` ordered R, G, B, A, X, Y, Z first and then by name, and
-// a full channel name (`debug.disocclusion`) gives that one channel. Empty when the image has none of them.
+// The channels that `--layer NAME` compares: select_layers (temporal/core/image.h, the rule of every tool), or
+// empty when it finds none (where a missing layer is not an error, e.g. the mask's lookup).
 std::vector<std::string> compared_channels(const Image& image, std::string_view layer);
 
 // --- Per-pixel helpers (each parallel over rows) -----------------------------------------------------------

@@ -44,6 +44,9 @@ float tracking_pixels_per_degree(const ViewingOptions& viewing, int image_width)
 // tool's defaults (the command line binds to these fields through morph_stage_params()).
 struct MorphStageOptions {
   MorphOptions morph;    // the method and its parameters
+  // The three colour channels morphed (select_layers, temporal/core/image.h: rgb, or a layer such as `direct`
+  // with direct.R, G, B); the outputs keep their names. --perceive reads rgb only.
+  std::string layer = "rgb";
   double fps = 0.0;      // input frame rate; 0 reads temporal:fps from each input header
   std::string display;   // display colour space whose gamma replaces morph.gamma (empty: none)
   std::string ocio;      // OpenColorIO config for `display` (empty: $OCIO, else the built-in one)

@@ -69,8 +69,8 @@ class ComparisonPictures {
   std::unique_ptr<Impl> impl_;
 };
 
-// The short label of a metric on pictures ("PSNR", "SSIM", "FLIP", ...), and a frame's value as text with it:
-// "PSNR 31.20 dB".
+// The short label of a metric on pictures ("PSNR", "SSIM", "FLIP", ...: its registry entry's label and unit,
+// temporal/compare/comparison.h), and a frame's value as text with it: "PSNR 31.20 dB".
 std::string metric_label(std::string_view metric);
 std::string metric_text(std::string_view metric, double value);
 

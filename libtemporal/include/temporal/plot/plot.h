@@ -98,18 +98,14 @@ class VirtualDisplay {
 
 // The charts of `--plot F.EXT` (EXT = png, svg or pdf): the file name and the chart. One per measured metric, as
 // its registry entry names it (temporal/compare/comparison.h): F.EXT per-frame PSNR (RGB); F-psnr-y.EXT,
-// F-ssim.EXT, F-flicker.EXT (only when there are two frames or more), F-flip.EXT with --flip; F-speed.EXT: mean
-// PSNR against the mean compute time of each test whose headers time the method itself
-// (ComputeKind::Method: never a render's or a simulation's time), when there is one. Titles are the metric's,
-// after `title` ("walkers: PSNR (rgb) per frame") when given; series are the sequences' names (--names). The speed
-// chart also draws the Pareto front of its points (pareto_front) as a line named "Pareto front" when it has two
-// points or more.
+// F-ssim.EXT, F-flicker.EXT (only when there are two frames or more), F-flip.EXT with --flip; F-speed.EXT: the
+// mean of the report's speed metric (PSNR by default, `--speed-metric`) against the mean compute time of each
+// test whose headers time the method itself (speed_points in temporal/compare/comparison.h), when there is one.
+// Titles are the metric's, after `title` ("walkers: PSNR (rgb) per frame") when given; series are the sequences'
+// names (--names). The speed chart also draws the Pareto front of its points as a line named "Pareto front" when
+// it has two points or more.
 std::vector<std::pair<std::string, Chart>> comparison_charts(const ComparisonReport& report,
                                                              const std::string& plot_path,
                                                              const std::string& title = {});
-
-// Indices of the points not dominated in (lower cost, higher score): no other point has a cost <= and a score >=
-// with one of them strictly better. Sorted by cost. Points with a non-finite cost or score are left out.
-std::vector<std::size_t> pareto_front(const std::vector<double>& cost, const std::vector<double>& score);
 
 }  // namespace temporal

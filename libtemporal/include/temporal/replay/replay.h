@@ -6,6 +6,7 @@
 
 #include "temporal/core/error.h"
 #include "temporal/io/exr.h"
+#include "temporal/io/runner.h"
 #include "temporal/core/sequence.h"
 #include "temporal/render/render.h"
 #include "temporal/scene/scene.h"
@@ -35,10 +36,9 @@ Status validate(const ReplayOptions& options);
 // The frames the replay renders: `frames` when given, else Scene::default_frames(fps, duration_s).
 FrameRange replay_frames(const Scene& scene, const ReplayOptions& options);
 
-struct ReplayHooks {
-  std::function<void(const std::string&)> log;            // what --verbose prints (OpenGL, the frame range)
-  std::function<void(int frame, int total)> frame_done;   // after each frame's files are written
-};
+// The observers every run has (temporal/io/runner.h): `log` gets what --verbose prints (OpenGL, the frame
+// range), `frame_done` is called after each frame's files are written.
+using ReplayHooks = RunHooks;
 
 // Renders and writes the sequence. Errors: Usage (options), Internal (OpenGL), Output (folder or file not
 // writable). LP_NUM_THREADS must be set before this creates the OpenGL context.
