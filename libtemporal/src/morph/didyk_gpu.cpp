@@ -41,13 +41,14 @@
 #include <cstdint>
 #include <cstdio>
 #include <string>
+#include <vector>
 
 namespace temporal::morph {
 namespace {
 
 using namespace detail;
 
-// Passes of the one program (u_pass).
+// The passes, one program each (u_pass is a constant in each program's source).
 enum Pass : int {
   kScore = 0,
   kMax,
@@ -132,7 +133,6 @@ constexpr const char* kDidykMain = R"(
 #define POS_INF uintBitsToFloat(0x7f800000u)
 const uint kEmpty = 0xffffffffu;
 
-uniform int u_pass;
 uniform uint u_n;        // pixels
 uniform ivec2 u_grid;    // vertices per row and per column
 uniform uint u_nv;       // vertices
@@ -669,9 +669,9 @@ void main() {
 
 class DidykGpu final : public MorphMethod, public gpu::TimedKernel {
  public:
-  DidykGpu(std::shared_ptr<gpu::Context> ctx, gpu::Program program, const MorphOptions& options,
+  DidykGpu(std::shared_ptr<gpu::Context> ctx, std::vector<gpu::Program> programs, const MorphOptions& options,
            const DidykOptions& didyk)
-      : ctx_(std::move(ctx)), program_(std::move(program)), timer_(ctx_), options_(options), didyk_(didyk) {
+      : ctx_(std::move(ctx)), programs_(std::move(programs)), timer_(ctx_), options_(options), didyk_(didyk) {
     didyk_.grid.pixels_per_degree = options.pixels_per_degree;
     didyk_.grid.fps = options.fps;
   }
@@ -760,13 +760,44 @@ class DidykGpu final : public MorphMethod, public gpu::TimedKernel {
     return Status::ok();
   }
 
+  // The uniforms of the next dispatches, by name: the passes are separate programs, and each dispatch sets on its
+  // program every uniform set so far (a name the program does not use is ignored).
+  struct Uniform {
+    std::string name;
+    int kind = 0;  // 0 int, 1 uint, 2 float, 3 ivec2
+    int i[2] = {0, 0};
+    unsigned u = 0;
+    float f = 0.0f;
+  };
+  Uniform& uniform(const char* name, int kind) {
+    for (Uniform& x : uniforms_)
+      if (x.name == name) return x;
+    uniforms_.push_back({name, kind});
+    return uniforms_.back();
+  }
+  void set(const char* name, int v) { uniform(name, 0).i[0] = v; }
+  void set(const char* name, unsigned v) { uniform(name, 1).u = v; }
+  void set(const char* name, float v) { uniform(name, 2).f = v; }
+  void set_int2(const char* name, int x, int y) {
+    Uniform& u = uniform(name, 3);
+    u.i[0] = x;
+    u.i[1] = y;
+  }
+
   // One dispatch of `pass` over an nx x ny domain (u_size stays the image size: the shared snippets read it).
   Status go(Pass pass, int nx, int ny, double planes_moved) {
-    program_.set("u_pass", int(pass));
-    program_.set_int2("u_size", w_, h_);
+    const gpu::Program& program = programs_[std::size_t(pass)];
+    if (Status s = program.use(); !s) return s;
+    for (const Uniform& u : uniforms_) {
+      if (u.kind == 0) program.set(u.name.c_str(), u.i[0]);
+      if (u.kind == 1) program.set(u.name.c_str(), u.u);
+      if (u.kind == 2) program.set(u.name.c_str(), u.f);
+      if (u.kind == 3) program.set_int2(u.name.c_str(), u.i[0], u.i[1]);
+    }
+    program.set_int2("u_size", w_, h_);
     timing_.bytes_moved += planes_moved * 4.0;
-    return program_.dispatch_groups(unsigned((nx + gpu::kGroupSize - 1) / gpu::kGroupSize),
-                                    unsigned((ny + gpu::kGroupSize - 1) / gpu::kGroupSize));
+    return program.dispatch_groups(unsigned((nx + gpu::kGroupSize - 1) / gpu::kGroupSize),
+                                   unsigned((ny + gpu::kGroupSize - 1) / gpu::kGroupSize));
   }
   std::uint32_t gplane(int plane) const { return std::uint32_t(plane) * std::uint32_t(nx_ * ny_); }
   std::uint32_t slot_plane(int k) const { return std::uint32_t(kGridFixed + kSlotPlanes * (k - 1)); }
@@ -777,17 +808,17 @@ class DidykGpu final : public MorphMethod, public gpu::TimedKernel {
   Status raster(std::uint32_t tpx, std::uint32_t tpy, int nattr, std::uint32_t attr0, std::uint32_t attr1,
                 bool sources, bool cull, float unc0, float unc1) {
     const double np = double(w_) * double(h_);
-    program_.set("u_tpx", tpx);
-    program_.set("u_tpy", tpy);
-    program_.set("u_nattr", nattr);
-    program_.set("u_attr0", attr0);
-    program_.set("u_attr1", attr1);
-    program_.set("u_sources", sources ? 1 : 0);
-    program_.set("u_depth", sources ? 1 : 0);
-    program_.set("u_cull", cull ? 1 : 0);
-    program_.set("u_unc0", unc0);
-    program_.set("u_unc1", unc1);
-    program_.set("u_ntri", 2 * (nx_ - 1) * (ny_ - 1));
+    set("u_tpx", tpx);
+    set("u_tpy", tpy);
+    set("u_nattr", nattr);
+    set("u_attr0", attr0);
+    set("u_attr1", attr1);
+    set("u_sources", sources ? 1 : 0);
+    set("u_depth", sources ? 1 : 0);
+    set("u_cull", cull ? 1 : 0);
+    set("u_unc0", unc0);
+    set("u_unc1", unc1);
+    set("u_ntri", 2 * (nx_ - 1) * (ny_ - 1));
     if (Status s = go(kKeysClear, w_, h_, 2 * np); !s) return s;
     // Key passes: the depth read at every fragment's source pixel and the keys read and written.
     if (sources)
@@ -801,10 +832,10 @@ class DidykGpu final : public MorphMethod, public gpu::TimedKernel {
 
   // Draws the grid at (tpx, tpy) into outb plane 3 (cleared first).
   Status grid_lines(std::uint32_t tpx, std::uint32_t tpy) {
-    program_.set("u_clear_mask", 1u << kGrid);
+    set("u_clear_mask", 1u << kGrid);
     if (Status s = go(kClear, w_, h_, 1.0 * w_ * h_); !s) return s;
-    program_.set("u_tpx", tpx);
-    program_.set("u_tpy", tpy);
+    set("u_tpx", tpx);
+    set("u_tpy", tpy);
     return go(kGridLines, nx_, ny_, 0.0);
   }
 
@@ -824,7 +855,7 @@ class DidykGpu final : public MorphMethod, public gpu::TimedKernel {
     const char* names[6] = {"R", "G", "B", "motion.X", "motion.Y", "depth.Z"};
     for (int p = 0; p < 6; ++p)
       if (Status s = img_.upload(p, p < 3 ? color : gbuffer, names[p]); !s) return s;
-    if (Status s = program_.use(); !s) return s;
+    if (Status s = ctx_->make_current(); !s) return s;
     img_.bind(0);
     out_.bind(1);
     keys_.bind(2);
@@ -834,49 +865,49 @@ class DidykGpu final : public MorphMethod, public gpu::TimedKernel {
     taps_.bind(6);
     const GridOptions& gopt = didyk_.grid;
     const double np = double(w) * double(h), nv = double(nx_) * double(ny_);
-    program_.set("u_n", std::uint32_t(w * h));
-    program_.set_int2("u_grid", nx_, ny_);
-    program_.set("u_nv", std::uint32_t(nx_ * ny_));
-    program_.set("u_cell", gopt.cell);
-    program_.set("u_half", gopt.cell / 2);
+    set("u_n", std::uint32_t(w * h));
+    set_int2("u_grid", nx_, ny_);
+    set("u_nv", std::uint32_t(nx_ * ny_));
+    set("u_cell", gopt.cell);
+    set("u_half", gopt.cell / 2);
 
     // --- flow (section 6): snapped grid and damped vertex motion.
     timer_.start();
     if (gopt.snap) {
-      program_.set("u_bias", 1e-3f / float(gopt.cell));
+      set("u_bias", 1e-3f / float(gopt.cell));
       if (Status s = go(kScore, w, h, 3 * np); !s) return s;
       for (int l = 1; l <= mp_level_; ++l) {
         const auto L = std::size_t(l);
-        program_.set_int2("u_lsize", mp_w_[L], mp_h_[L]);
-        program_.set_int2("u_psize", l > 1 ? mp_w_[L - 1] : w, l > 1 ? mp_h_[L - 1] : h);
-        program_.set("u_off_prev", l > 1 ? mp_off_[L - 1] : 0u);
-        program_.set("u_off_cur", mp_off_[L]);
-        program_.set("u_first", l == 1 ? 1 : 0);
-        program_.set("u_offset", gopt.cell / 2);
+        set_int2("u_lsize", mp_w_[L], mp_h_[L]);
+        set_int2("u_psize", l > 1 ? mp_w_[L - 1] : w, l > 1 ? mp_h_[L - 1] : h);
+        set("u_off_prev", l > 1 ? mp_off_[L - 1] : 0u);
+        set("u_off_cur", mp_off_[L]);
+        set("u_first", l == 1 ? 1 : 0);
+        set("u_offset", gopt.cell / 2);
         const double read = l == 1 ? np : 2.0 * mp_w_[L - 1] * mp_h_[L - 1];
         if (Status s = go(kMax, mp_w_[L], mp_h_[L], read + 2.0 * mp_w_[L] * mp_h_[L]); !s) return s;
       }
       const auto L = std::size_t(mp_level_);
-      program_.set_int2("u_lsize", mp_w_[L], mp_h_[L]);
-      program_.set("u_off_cur", mp_off_[L]);
+      set_int2("u_lsize", mp_w_[L], mp_h_[L]);
+      set("u_off_cur", mp_off_[L]);
     }
-    program_.set("u_snap", gopt.snap ? 1 : 0);
-    program_.set("u_snap_threshold", gopt.snap_threshold);
-    program_.set("u_speed_scale",
+    set("u_snap", gopt.snap ? 1 : 0);
+    set("u_snap_threshold", gopt.snap_threshold);
+    set("u_speed_scale",
                  gopt.pixels_per_degree > 0.0f ? float(gopt.fps) / gopt.pixels_per_degree : 0.0f);
     if (Status s = go(kVertex, nx_, ny_, 6 * nv + 2 * nv); !s) return s;
     t.flow_ms = timer_.stop_ms();
 
     // --- morph (part 1): per slot the extrapolated vertices, distortion, blur strength; the blur sum B.
     timer_.start();
-    program_.set("u_inv_cell", 1.0f / float(gopt.cell));
-    program_.set("u_min_blur", didyk_.min_blur);
-    program_.set("u_dist_low", didyk_.distortion_low);
-    program_.set("u_dist_high", didyk_.distortion_high);
+    set("u_inv_cell", 1.0f / float(gopt.cell));
+    set("u_min_blur", didyk_.min_blur);
+    set("u_dist_low", didyk_.distortion_low);
+    set("u_dist_high", didyk_.distortion_high);
     for (int k = 1; k < n; ++k) {
-      program_.set("u_slot", slot_plane(k));
-      program_.set("u_t", float(k) / float(n));
-      program_.set("u_first_slot", k == 1 ? 1 : 0);
+      set("u_slot", slot_plane(k));
+      set("u_t", float(k) / float(n));
+      set("u_first_slot", k == 1 ? 1 : 0);
       if (Status s = go(kExtrapolate, nx_, ny_, 6 * nv); !s) return s;
       if (Status s = go(kCellDistortion, nx_ - 1, ny_ - 1, 5 * nv); !s) return s;
       if (Status s = go(kVertexBlur, nx_, ny_, 5 * nv); !s) return s;
@@ -885,20 +916,20 @@ class DidykGpu final : public MorphMethod, public gpu::TimedKernel {
 
     // --- blur (section 5.1): display values, their low-pass, the blur sum on the source grid, compensation.
     timer_.start();
-    program_.set("u_gamma", options_.gamma);
-    program_.set("u_inv_gamma", 1.0f / options_.gamma);
-    program_.set("u_compensate", didyk_.compensate ? 1 : 0);
+    set("u_gamma", options_.gamma);
+    set("u_inv_gamma", 1.0f / options_.gamma);
+    set("u_compensate", didyk_.compensate ? 1 : 0);
     if (Status s = go(kDisplay, w, h, 6 * np); !s) return s;
     for (int l = 1; l <= blur_levels_; ++l) {
       const auto L = std::size_t(l);
       const int pw = bp_w_[L - 1], ph = bp_h_[L - 1], lw = bp_w_[L], lh = bp_h_[L];
-      program_.set_int2("u_lsize", lw, lh);
-      program_.set_int2("u_psize", pw, ph);
-      program_.set("u_from_img", l == 1 ? 1 : 0);
-      program_.set("u_src_off", l == 1 ? std::uint32_t(kV) * std::uint32_t(w * h) : bp_off_[L - 1]);
-      program_.set("u_src_plane", std::uint32_t(pw * ph));
-      program_.set("u_tmp_off", 0u);
-      program_.set("u_dst_off", bp_off_[L]);
+      set_int2("u_lsize", lw, lh);
+      set_int2("u_psize", pw, ph);
+      set("u_from_img", l == 1 ? 1 : 0);
+      set("u_src_off", l == 1 ? std::uint32_t(kV) * std::uint32_t(w * h) : bp_off_[L - 1]);
+      set("u_src_plane", std::uint32_t(pw * ph));
+      set("u_tmp_off", 0u);
+      set("u_dst_off", bp_off_[L]);
       if (Status s = go(kBlurH, lw, ph, 3.0 * (double(pw) * ph + double(lw) * ph)); !s) return s;
       if (Status s = go(kBlurV, lw, lh, 3.0 * (double(lw) * ph + double(lw) * lh)); !s) return s;
     }
@@ -908,12 +939,12 @@ class DidykGpu final : public MorphMethod, public gpu::TimedKernel {
     const float f = level - float(l0);
     auto reconstruct = [&](int lv, float weight, bool accumulate) -> Status {
       const auto L = std::size_t(lv);
-      program_.set("u_level0", lv == 0 ? 1 : 0);
-      program_.set_int2("u_lsize", bp_w_[L], bp_h_[L]);
-      program_.set("u_src_off", bp_off_[L]);
-      program_.set("u_taps_off", taps_off_[L]);
-      program_.set("u_weight", weight);
-      program_.set("u_accumulate", accumulate ? 1 : 0);
+      set("u_level0", lv == 0 ? 1 : 0);
+      set_int2("u_lsize", bp_w_[L], bp_h_[L]);
+      set("u_src_off", bp_off_[L]);
+      set("u_taps_off", taps_off_[L]);
+      set("u_weight", weight);
+      set("u_accumulate", accumulate ? 1 : 0);
       return go(kReconstruct, w, h, 3.0 * (double(bp_w_[L]) * bp_h_[L] + np * (accumulate ? 2 : 1)));
     };
     if (f <= 0.0f || l0 >= blur_levels_) {
@@ -933,7 +964,7 @@ class DidykGpu final : public MorphMethod, public gpu::TimedKernel {
     // Slot 0: the compensated rendered frame; debug.grid (the snapped grid), debug.distortion 0, debug.blur = B.
     if (debug) {
       if (Status s = grid_lines(gplane(kGX), gplane(kGY)); !s) return s;
-      program_.set("u_clear_mask", 1u << kDist);
+      set("u_clear_mask", 1u << kDist);
       if (Status s = go(kClear, w, h, 0.0); !s) return s;
     }
     if (Status s = download(out[0], debug); !s) return s;
@@ -952,7 +983,7 @@ class DidykGpu final : public MorphMethod, public gpu::TimedKernel {
       ms += timer_.stop_ms();
       if (debug) {
         if (Status s = grid_lines(gplane(int(sp)), gplane(int(sp) + 1)); !s) return s;
-        program_.set("u_clear_mask", (1u << kH) | (1u << kHp));
+        set("u_clear_mask", (1u << kH) | (1u << kHp));
         if (Status s = go(kClear, w, h, 0.0); !s) return s;
       }
       if (Status s = download(out[std::size_t(k)], debug); !s) return s;
@@ -963,7 +994,7 @@ class DidykGpu final : public MorphMethod, public gpu::TimedKernel {
   }
 
   std::shared_ptr<gpu::Context> ctx_;
-  gpu::Program program_;
+  std::vector<gpu::Program> programs_;  // one per Pass
   gpu::Timer timer_;
   MorphOptions options_;
   DidykOptions didyk_;  // with the eye-tracking limit of options_
@@ -971,6 +1002,7 @@ class DidykGpu final : public MorphMethod, public gpu::TimedKernel {
   std::vector<int> mp_w_, mp_h_, bp_w_, bp_h_;
   std::vector<std::uint32_t> mp_off_, bp_off_, taps_off_;
   gpu::ImageBuffer img_, out_, keys_, mp_, bp_, taps_, grid_;
+  std::vector<Uniform> uniforms_;
   Status status_;
   gpu::KernelTiming timing_;
 };
@@ -999,14 +1031,21 @@ Expected<std::unique_ptr<MorphMethod>> make_didyk_method_gpu(std::shared_ptr<gpu
     if (!created) return created.error();
     context = std::move(*created);
   }
+  // One program per pass (u_pass a constant): the compiler keeps only that pass's code. (One program switching on
+  // a uniform runs every branch under a mask on llvmpipe, which cannot know the switch is uniform.)
   const std::string defines = constants();
-  auto program = gpu::Program::compile(
-      context, "didyk",
-      {gpu::glsl::prelude(), gpu::glsl::storage(0, "img"), gpu::glsl::storage(1, "outb"),
-       gpu::glsl::storage(2, "keys"), gpu::glsl::storage(3, "mp"), gpu::glsl::storage(4, "bp"),
-       gpu::glsl::storage(5, "grid"), gpu::glsl::storage(6, "taps"), defines, gpu::glsl::reproject(), kDidykMain});
-  if (!program) return program.error();
-  return std::unique_ptr<MorphMethod>(new DidykGpu(std::move(context), std::move(*program), options, didyk));
+  std::vector<gpu::Program> programs;
+  for (int pass = 0; pass <= kGridLines; ++pass) {
+    const std::string which = "#define u_pass " + std::to_string(pass) + "\n";
+    auto program = gpu::Program::compile(
+        context, "didyk pass " + std::to_string(pass),
+        {gpu::glsl::prelude(), which, gpu::glsl::storage(0, "img"), gpu::glsl::storage(1, "outb"),
+         gpu::glsl::storage(2, "keys"), gpu::glsl::storage(3, "mp"), gpu::glsl::storage(4, "bp"),
+         gpu::glsl::storage(5, "grid"), gpu::glsl::storage(6, "taps"), defines, gpu::glsl::reproject(), kDidykMain});
+    if (!program) return program.error();
+    programs.push_back(std::move(*program));
+  }
+  return std::unique_ptr<MorphMethod>(new DidykGpu(std::move(context), std::move(programs), options, didyk));
 }
 
 namespace detail {
