@@ -1,5 +1,6 @@
 // `didyk` (didyk.cpp, seed 004) as GLSL compute kernels: the same steps as the C++ reference of record, in the same
-// order and with the same arithmetic where GLSL allows it (docs/gpu.md lists what differs and bounds it).
+// order and with the same arithmetic where GLSL allows it (docs/gpu.md lists what differs and bounds it). Each pass
+// below is its own program compiled from the one source with u_pass defined, so each keeps only its own code.
 //
 //   flow   - SCORE: the flow-discontinuity strength of every pixel corner (grid_warp.cpp, GridBuilder::build);
 //            MAX: the max-pyramid with its argmax, one dispatch per level (max_pyramid.cpp, Figure 6);
