@@ -11,8 +11,9 @@
 //    (m - 1) / (m + 1) and the same contractions differ in the last bit. This moves values by a few 1e-7.
 //  - decisions taken on those values: where a texture coordinate rounded differently lands exactly on a pixel
 //    border, the nearest source pixel of the depth test or a bilinear tap changes, and that pixel shows a neighbour's
-//    value. Everything the rasteriser decides in double (coverage, the top-left rule, the barycentric weights) is
-//    exact on both sides (products of floats are exact in double), so no pixel changes triangle on its own.
+//    value. What the rasteriser decides in double (coverage, the top-left rule, the barycentric weights) is computed
+//    from floats whose products fit a double's mantissa at these coordinate sizes, so an FMA or not gives the same
+//    bits on both sides and no pixel changes triangle (measured: debug.grid and the coverage are equal).
 #include "gpu_support.h"
 #include "synthetic_scene.h"  // tests/render
 #include "temporal/core/method.h"
