@@ -293,7 +293,8 @@ TEST(DidykGpu, StaticFrameIsShownInEverySlot) {
 }
 
 // didyk's registry entry has the GPU implementation beside the C++ one (device "gpu"); through the registry's
-// factory it runs like the direct factory. Invalid didyk options are usage errors of the factory.
+// factory it runs like the direct factory. Invalid didyk options are usage errors of the factory, and come back from
+// the registry's method's run_status().
 TEST(DidykGpu, IsRegisteredAsTheGpuImplementation) {
   TEMPORAL_GPU_CONTEXT_OR_SKIP(ctx);
   const morph::MethodEntry* entry = morph::find_entry("didyk");
@@ -320,6 +321,14 @@ TEST(DidykGpu, IsRegisteredAsTheGpuImplementation) {
   auto refused = make_didyk_method_gpu(ctx, six);
   ASSERT_FALSE(refused);
   EXPECT_NE(refused.error().message.find("power of two"), std::string::npos) << refused.error().message;
+  // The registry's factory cannot return the error: its method reports it from run_status() and writes nothing.
+  auto unavailable = impl->make(six);
+  ASSERT_TRUE(unavailable);
+  for (auto& o : out) std::fill(o.plane("R"), o.plane("R") + o.pixel_count(), 7.0f);
+  unavailable->run(f.color, &f.gbuffer, nullptr, out, t);
+  ASSERT_FALSE(unavailable->run_status());
+  EXPECT_NE(unavailable->run_status().error().message.find("power of two"), std::string::npos);
+  EXPECT_EQ(out[1].plane("R")[0], 7.0f);
 }
 
 }  // namespace
