@@ -15,6 +15,8 @@
 
 namespace temporal::morph::detail {
 
+// Section 5.1 "Selective Blur": cell distortion x to blur strength, 0 below lo, 1 above hi, cubic between (a step at
+// hi when hi <= lo). didyk_gpu.cpp's didyk_smoothstep is the same in GLSL.
 inline float smoothstep(float lo, float hi, float x) {
   if (hi <= lo) return x >= hi ? 1.0f : 0.0f;
   const float t = std::clamp((x - lo) / (hi - lo), 0.0f, 1.0f);
