@@ -119,6 +119,31 @@ const T& method_options(const MethodOptionSet& set, std::string_view name) {
 
 // --- Helpers every stage's registry.cpp uses on its table (a vector of `const Entry*`) ------------------------
 
+// A stage's table is an X-macro list, one line per method: `X(name)` stands for `const MethodEntry&
+// name_method()`, defined in the method's source file. These two expand a list into the declarations and into the
+// table's initialiser, so that a new method is one line in the list (compare's metrics do the same).
+#define TEMPORAL_DECLARE_METHOD(name) const MethodEntry& name##_method();
+#define TEMPORAL_METHOD_ADDRESS(name) &name##_method(),
+
+template <typename Variant>
+const Variant* find_variant_in(const std::vector<Variant>& variants, std::string_view name) {
+  for (const Variant& v : variants)
+    if (v.name == name) return &v;
+  return nullptr;
+}
+
+// Options of a stage for `method`, with parameters set by command-line style arguments (the stage's params() and
+// check()); usage error for an unknown method or parameter, or an invalid value.
+template <typename Options, typename ParamsFn, typename CheckFn>
+Expected<Options> make_options_with(const std::string& method, const std::vector<std::string>& args,
+                                    ParamsFn&& params, CheckFn&& check) {
+  Options o;
+  o.method = method;
+  if (Status s = apply_args(params(o), args); !s) return s.error();
+  if (Status s = check(o); !s) return s.error();
+  return o;
+}
+
 template <typename Entry>
 const Entry* find_entry_in(const std::vector<const Entry*>& registry, std::string_view name) {
   for (const Entry* e : registry)
