@@ -24,6 +24,9 @@ Expected<std::unique_ptr<MethodState>> make_temporal_state_gpu(std::shared_ptr<g
 // HerzogOptions (herzog.h) included.
 Expected<std::unique_ptr<MethodState>> make_herzog_state_gpu(std::shared_ptr<gpu::Context> context,
                                                              const Options& options, const Geometry& geometry);
+// `taau` (taau.cpp): the FSR 2 / UE4 TAAU steps 1-5 per pixel, after a low-resolution pass for the thin features.
+Expected<std::unique_ptr<MethodState>> make_taau_state_gpu(std::shared_ptr<gpu::Context> context,
+                                                           const Options& options, const Geometry& geometry);
 
 // --- Registration as a method's "gpu" implementation (temporal/upsample/methods.h) ------------------------------
 
