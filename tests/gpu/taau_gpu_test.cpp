@@ -1,7 +1,8 @@
 // upsample-st's `taau` GLSL kernels (taau_gpu.cpp) against its C++ state (taau.cpp, the reference of record)
 // on the synthetic G-buffer sequence of the upsampling tests (a panning textured background, a foreground square
 // moving over it with its own depth and id: disocclusions every frame; k = 4 regular jitter; a NaN low-resolution
-// sample now and then; a cut at frame 6), for the defaults and every option that changes the kernels' arithmetic,
+// sample now and then; isolated bright samples, thin features that lock pixels; a cut at frame 6), for the defaults
+// and every option that changes the kernels' arithmetic,
 // and the state round trips GPU -> CPU and CPU -> GPU. The FrameContext is built as Upsampler::build_context builds it.
 #include "gpu_methods.h"
 #include "gpu_support.h"
