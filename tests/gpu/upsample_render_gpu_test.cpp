@@ -136,6 +136,7 @@ TEST(UpsampleGpuRendered, EveryGpuMethodMatchesItsCppMethod) {
   expect_agreement("temporal", compare(ctx, "temporal", make_temporal_state_gpu), 1e-6);
   expect_agreement("herzog", compare(ctx, "herzog", make_herzog_state_gpu), 2e-6);
   expect_agreement("taau", compare(ctx, "taau", make_taau_state_gpu), 1e-5);
+  expect_agreement("drobot", compare(ctx, "drobot", make_drobot_state_gpu), 2e-6);
 }
 
 }  // namespace

@@ -27,6 +27,10 @@ Expected<std::unique_ptr<MethodState>> make_herzog_state_gpu(std::shared_ptr<gpu
 // `taau` (taau.cpp): the FSR 2 / UE4 TAAU steps 1-5 per pixel, after a low-resolution pass for the thin features.
 Expected<std::unique_ptr<MethodState>> make_taau_state_gpu(std::shared_ptr<gpu::Context> context,
                                                            const Options& options, const Geometry& geometry);
+// `drobot` (drobot.cpp): seed 002's cache mode (cache grid, Listing 7.2 accumulation, Listing 7.3 filter, Listing 7.1
+// upsampling) and the refresh mode of Figure 7.12, chosen by --mode when the state is made.
+Expected<std::unique_ptr<MethodState>> make_drobot_state_gpu(std::shared_ptr<gpu::Context> context,
+                                                             const Options& options, const Geometry& geometry);
 
 // --- Registration as a method's "gpu" implementation (temporal/upsample/methods.h) ------------------------------
 
