@@ -31,8 +31,8 @@ namespace temporal {
 
 // The device of the implementations every method has.
 inline constexpr const char* kCpuDevice = "cpu";
-// The device of the GLSL compute implementations (temporal/gpu), registered beside the CPU one where a method has
-// one (issue 23).
+// The device of the GPU implementations (GLSL compute kernels of the gpu stage, docs/gpu.md), registered beside the
+// C++ one where a method has them.
 inline constexpr const char* kGpuDevice = "gpu";
 
 // A named way to run a method: the method and the arguments that select the variant, written as on the command
