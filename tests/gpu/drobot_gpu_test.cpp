@@ -129,7 +129,8 @@ Comparison compare(const std::shared_ptr<gpu::Context>& ctx, const Options& o, b
       if (!pa || !pb) continue;
       for (std::size_t i = 0; i < a.pixel_count(); ++i) {
         const double diff = std::abs(double(pa[i]) - pb[i]);
-        r.debug[d] = std::max(r.debug[d], kDebugBounds[d].relative ? diff / std::max(1e-6, std::abs(double(pa[i]))) : diff);
+        const double scaled = kDebugBounds[d].relative ? diff / std::max(1e-6, std::abs(double(pa[i]))) : diff;
+        r.debug[d] = std::max(r.debug[d], scaled);
       }
     }
   }
@@ -258,7 +259,8 @@ TEST(DrobotGpu, StateResumesOnTheCpuAndBack) {
       EXPECT_LE(a.max_abs, kDrobotMaxAbs);
       EXPECT_GE(a.psnr, kDrobotPsnr);
       EXPECT_EQ(a.finiteness_mismatches, 0u);
-      RecordProperty(std::string("round_trip_max_abs_") + (gpu_first ? "gpu_cpu" : "cpu_gpu") + (lagged ? "_refresh" : "_cache"),
+      RecordProperty(std::string("round_trip_max_abs_") + (gpu_first ? "gpu_cpu" : "cpu_gpu") +
+                         (lagged ? "_refresh" : "_cache"),
                      (::testing::Message() << a.max_abs).GetString());
     }
   }

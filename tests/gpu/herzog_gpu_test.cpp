@@ -246,7 +246,8 @@ TEST(HerzogGpu, StateResumesOnTheCpuAndBack) {
       EXPECT_LE(a.max_abs, kHerzogMaxAbs);
       EXPECT_GE(a.psnr, kHerzogPsnr);
       EXPECT_EQ(a.finiteness_mismatches, 0u);
-      RecordProperty(std::string("round_trip_max_abs_") + (gpu_first ? "gpu_cpu" : "cpu_gpu") + (lagged ? "_lagged" : ""),
+      RecordProperty(std::string("round_trip_max_abs_") + (gpu_first ? "gpu_cpu" : "cpu_gpu") +
+                         (lagged ? "_lagged" : ""),
                      (::testing::Message() << a.max_abs).GetString());
     }
   }

@@ -137,7 +137,8 @@ Comparison compare(const std::shared_ptr<gpu::Context>& ctx, const Options& o, b
       if (!pa || !pb) continue;
       for (std::size_t i = 0; i < a.pixel_count(); ++i) {
         const double diff = std::abs(double(pa[i]) - pb[i]);
-        r.debug[d] = std::max(r.debug[d], kDebugBounds[d].relative ? diff / std::max(1e-6, std::abs(double(pa[i]))) : diff);
+        const double scaled = kDebugBounds[d].relative ? diff / std::max(1e-6, std::abs(double(pa[i]))) : diff;
+        r.debug[d] = std::max(r.debug[d], scaled);
       }
     }
   }
@@ -263,7 +264,8 @@ TEST(TaauGpu, StateResumesOnTheCpuAndBack) {
       EXPECT_LE(a.max_abs, kTaauMaxAbs);
       EXPECT_GE(a.psnr, kTaauPsnr);
       EXPECT_EQ(a.finiteness_mismatches, 0u);
-      RecordProperty(std::string("round_trip_max_abs_") + (gpu_first ? "gpu_cpu" : "cpu_gpu") + (lagged ? "_no_locks" : ""),
+      RecordProperty(std::string("round_trip_max_abs_") + (gpu_first ? "gpu_cpu" : "cpu_gpu") +
+                         (lagged ? "_no_locks" : ""),
                      (::testing::Message() << a.max_abs).GetString());
     }
   }

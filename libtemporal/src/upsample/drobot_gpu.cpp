@@ -312,7 +312,10 @@ void main() {
 constexpr const char* kRefreshDecl = R"(
 uniform bool u_history, u_use_ids, u_warped, u_debug;
 uniform float u_tol, u_warped_tol, u_threshold, u_convergence_time;
-#define COARSE(q, plane) gb[uint(plane) * u_n + (uint(u_k) * ((q) / uint(u_low.x)) + uint(u_sy)) * uint(u_full.x) + uint(u_sx) + uint(u_k) * ((q) % uint(u_low.x))]
+// The sample's pixel (k x + sx, k y + sy) in the full-resolution G-buffer (gather_low_geometry).
+#define SAMPLE_PIXEL(q) \
+  ((uint(u_k) * ((q) / uint(u_low.x)) + uint(u_sy)) * uint(u_full.x) + uint(u_sx) + uint(u_k) * ((q) % uint(u_low.x)))
+#define COARSE(q, plane) gb[uint(plane) * u_n + SAMPLE_PIXEL(q)]
 #define COARSE_AVAIL(q) (low_valid(q) ? 1.0 : 0.0)
 #define COARSE_VALUE(c, q) lowb[uint(c) * u_ln + (q)]
 #define REPROJECT_PREV_Z(q) prevg[uint(q)]
@@ -532,7 +535,8 @@ class DrobotStateGpu final : public MethodState, public gpu::TimedKernel {
 
   Status run_cache(const FrameContext& f, bool have_history, FrameStats& stats) {
     const DrobotOptions& o = drobot_options(*f.options);
-    if (f.C > 16) return Error::usage("drobot on the GPU takes at most 16 payload channels, not " + std::to_string(f.C));
+    if (f.C > 16)
+      return Error::usage("drobot on the GPU takes at most 16 payload channels, not " + std::to_string(f.C));
     if (Status s = allocate(); !s) return s;
     if (Status s = frame_.upload(ctx_, f, true); !s) return s;
     if (Status s = counters_.clear(0, 1); !s) return s;
