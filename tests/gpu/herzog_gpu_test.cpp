@@ -289,6 +289,32 @@ TEST(HerzogGpu, IsRegisteredAsTheGpuImplementation) {
   }
 }
 
+// Every upsampling method is registered with a "gpu" implementation (what --device gpu picks), and the registered
+// factory runs its kernels: three frames against the CPU implementation, within the loosest method bound (taau's).
+TEST(GpuImplementation, EveryUpsampleMethodHasOne) {
+  TEMPORAL_GPU_CONTEXT_OR_SKIP(ctx);
+  const auto frames = sequence(3);
+  const Geometry g = geometry_of(frames[0]);
+  const Options o;
+  for (const MethodEntry* e : registry()) {
+    SCOPED_TRACE(e->info.name);
+    const auto* gpu_impl = find_implementation(*e, kGpuDevice);
+    ASSERT_NE(gpu_impl, nullptr);
+    auto gpu = gpu_impl->make(o, g);
+    auto cpu = find_implementation(*e, kCpuDevice)->make(o, g);
+    ASSERT_TRUE(gpu && cpu);
+    FrameContext f;
+    FrameStats stats;
+    for (int t = 0; t < 3; ++t) {
+      build_context(f, o, frames[std::size_t(t)], true, false);
+      const Image& a = cpu->run(f, t > 0, stats);
+      const Image& b = gpu->run(f, t > 0, stats);
+      ASSERT_TRUE(gpu->run_status()) << gpu->run_status().error().message;
+      EXPECT_LE(test::agreement(b, a, kRgb).max_abs, 1e-5);
+    }
+  }
+}
+
 // A GPU factory that failed (no EGL device, a kernel that does not compile) leaves a state that says so.
 TEST(GpuImplementation, AFailedFactoryReportsItsError) {
   auto state = state_or_failure(Error::usage("no EGL device"));
