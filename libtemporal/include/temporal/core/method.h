@@ -1,11 +1,11 @@
 // The methods of a stage as units, one pattern for every stage (upsample-st's methods, filter-phlm's filters,
 // morph-120hz's methods). A method's source file defines its registry entry: what it is (MethodInfo), its own
 // parameters (an options struct with defaults and `ParamList params()`, wrapped by OptionsOf), the G-buffer
-// layers it reads, and its implementations (one per device: "cpu" today). The stage's registry.cpp lists the
-// entries, one line each. Everything else is derived from that list: the --method choices and --help, each
-// method's options inside the stage's options (MethodOptionSet), --list-methods and --list-methods-json, the
-// variants the benchmarks and tests run, the layers read. A stage's entry type starts with the three members the
-// helpers below read:
+// layers it reads, and its implementations (one per device: "cpu", and "gpu" where a GLSL kernel exists). The
+// stage's registry.cpp lists the entries, one line each. Everything else is derived from that list: the --method
+// choices and --help, each method's options inside the stage's options (MethodOptionSet), --list-methods and
+// --list-methods-json, the variants the benchmarks and tests run, the layers read. A stage's entry type starts
+// with the three members the helpers below read:
 //   struct MethodEntry {
 //     MethodInfo info;
 //     std::unique_ptr<MethodOptions> (*make_options)() = nullptr;  // nullptr: no parameters of its own
