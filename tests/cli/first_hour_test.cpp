@@ -159,5 +159,17 @@ TEST(FirstHour, PatternAndGBufferMessagesSayWhatToDo) {
   EXPECT_EQ(out.find("--layer"), std::string::npos) << "--layer does not pick G-buffer layers\n" << out;
 }
 
+// Help texts list only the exit codes a tool returns: 3 (a failed threshold) is compare's alone.
+TEST(FirstHour, HelpListsOnlyTheExitCodesTheToolReturns) {
+  for (const std::string t : {"render-gbuffer", "upsample-st", "filter-phlm", "morph-120hz", "compare"}) {
+    std::string out;
+    ASSERT_EQ(test::run_command(tool(t) + " --help", &out), 0) << out;
+    const auto codes = out.find("Exit codes:");
+    ASSERT_NE(codes, std::string::npos) << t;
+    const std::string line = out.substr(codes, out.find('\n', codes) - codes);
+    EXPECT_EQ(line.find(" 3 ") != std::string::npos, t == "compare") << t << ": " << line;
+  }
+}
+
 }  // namespace
 }  // namespace temporal

@@ -127,7 +127,7 @@ std::vector<std::string> gbuffer_selection(const StageInputs& needs, const std::
 Status check_gbuffer_file(const StageInputs& needs, const std::string& path) {
   auto info = read_exr_info(path);
   if (!info) return info.error();
-  std::string missing;
+  std::string missing, alternatives;
   for (const auto& n : needs.gbuffer_layers) {
     if (!n.required) continue;
     const auto channels = layer_channel_names(n.layer);
@@ -135,7 +135,9 @@ Status check_gbuffer_file(const StageInputs& needs, const std::string& path) {
     for (const auto& c : info->channels)
       present = present || (channels.empty() ? c.rfind(n.layer + ".", 0) == 0
                                              : std::find(channels.begin(), channels.end(), c) != channels.end());
-    if (!present) missing += (missing.empty() ? "" : ", ") + n.layer;
+    if (present) continue;
+    missing += (missing.empty() ? "" : ", ") + n.layer;
+    if (!n.alternative.empty()) alternatives += " (" + n.layer + ": " + n.alternative + ")";
   }
   if (missing.empty()) return Status::ok();
   bool colour = !info->channels.empty();
@@ -148,7 +150,8 @@ Status check_gbuffer_file(const StageInputs& needs, const std::string& path) {
   return Error::input(path, "--gbuffer: this file has no " + missing + " layer (it has " + have + ")" +
                                 (colour ? ": it looks like a colour image. --gbuffer takes the G-buffer, e.g. "
                                           "gbuffer.####.exr from render-gbuffer --outputs gbuffer"
-                                        : "; render the G-buffer with render-gbuffer --outputs gbuffer"));
+                                        : "; render the G-buffer with render-gbuffer --outputs gbuffer") +
+                                alternatives);
 }
 
 // Reads frames in order, keeping the lookahead frames in memory (each file is read once).
