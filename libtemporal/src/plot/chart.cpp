@@ -16,6 +16,7 @@
 #include <vtkDoubleArray.h>
 #include <vtkGL2PSExporter.h>
 #include <vtkNew.h>
+#include <vtkObject.h>
 #include <vtkPNGWriter.h>
 #include <vtkPen.h>
 #include <vtkPlot.h>
@@ -139,6 +140,9 @@ Status write_chart(const Chart& chart, const std::string& path) {
   if (chart.series.empty()) return Error::usage("chart '" + chart.title + "' has no series to draw");
   if (chart.width < 64 || chart.height < 64) return Error::usage("chart size must be at least 64x64 pixels");
 
+  // VTK prints its errors and warnings to stderr itself (e.g. "Attempted to paint a line with <2 points", from a
+  // legend entry, on every chart): the library never prints, and a chart that fails shows as a missing file below.
+  vtkObject::GlobalWarningDisplayOff();
   vtkNew<vtkContextView> view;
   view->GetRenderer()->SetBackground(1.0, 1.0, 1.0);
   view->GetRenderWindow()->SetSize(chart.width, chart.height);
