@@ -84,13 +84,8 @@ Status clear_earlier_report(const std::string& dir, const ProtectedInputs& input
   for (const char* f : kReportFolders)
     if (fs::exists(fs::path(dir) / f, ec)) owned.push_back(fs::path(dir) / f);
   if (owned.empty()) return Status::ok();
-  std::ifstream page(fs::path(dir) / "index.html");
-  const std::string text((std::istreambuf_iterator<char>(page)), std::istreambuf_iterator<char>());
-  if (text.find("Written by compare ") == std::string::npos)
-    return Error::usage("--report '" + dir + "' holds " + owned.front().filename().string() +
-                        " but no earlier report of compare (index.html): the report's files would mix with these; give "
-                        "--report a new or empty folder");
-  // Every file to remove, checked against the inputs first: nothing is removed when one of them is read.
+  // Every file the report would replace, checked against the inputs first: nothing is removed (or written over)
+  // when one of them is read.
   std::vector<fs::path> files;
   for (const fs::path& p : owned) {
     if (!fs::is_directory(p, ec)) {
@@ -103,8 +98,14 @@ Status clear_earlier_report(const std::string& dir, const ProtectedInputs& input
   }
   for (const fs::path& f : files)
     if (Status s = inputs.check(f.string(), "--report"); !s)
-      return Error::usage("--report '" + dir + "' holds an earlier report, to be replaced, and " + f.string() +
-                          " in it is one of this run's inputs: copy it elsewhere or give --report another folder");
+      return Error::usage("--report '" + dir + "': " + f.string() + " is one of this run's inputs, in a file or folder "
+                          "the report replaces: copy it elsewhere or give --report another folder");
+  std::ifstream page(fs::path(dir) / "index.html");
+  const std::string text((std::istreambuf_iterator<char>(page)), std::istreambuf_iterator<char>());
+  if (text.find("Written by compare ") == std::string::npos)
+    return Error::usage("--report '" + dir + "' holds " + owned.front().filename().string() +
+                        " but no earlier report of compare (index.html): the report's files would mix with these; give "
+                        "--report a new or empty folder");
   for (const fs::path& p : owned) {
     fs::remove_all(p, ec);
     if (ec) return Error::output(p.string(), "cannot remove this file of the earlier report (" + ec.message() +
