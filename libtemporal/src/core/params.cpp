@@ -74,7 +74,7 @@ Status check_choice(const Param& p, const std::string& value) {
   if (p.choices.empty()) return Status::ok();
   for (const auto& c : p.choices)
     if (value == c) return Status::ok();
-  return not_one_of(p.flag, value, p.choices);  // one wording in every tool, with the closest name (issue 25)
+  return not_one_of(p.flag, value, p.choices);
 }
 }  // namespace
 

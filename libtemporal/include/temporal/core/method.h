@@ -31,6 +31,9 @@ namespace temporal {
 
 // The device of the implementations every method has.
 inline constexpr const char* kCpuDevice = "cpu";
+// The device of the GPU implementations (GLSL compute kernels of the gpu stage, docs/gpu.md), registered beside the
+// C++ one where a method has them.
+inline constexpr const char* kGpuDevice = "gpu";
 
 // A named way to run a method: the method and the arguments that select the variant, written as on the command
 // line ("herzog-lagged" = --method herzog --lagged-wf).
