@@ -12,7 +12,7 @@ PACKAGES=(
   libopencolorio-dev opencolorio-tools
   libtinygltf-dev libstb-dev nlohmann-json3-dev libglm-dev
   libosmesa6-dev libegl-dev libegl-mesa0
-  libvtk9-dev xvfb xauth
+  libvtk9-dev xvfb xauth librsvg2-dev poppler-utils
   libtbb-dev libcli11-dev libfmt-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   snakemake slurm-wlm munge python3

@@ -32,9 +32,13 @@ pkg_check_modules(STB REQUIRED IMPORTED_TARGET stb)
 find_package(MPI REQUIRED COMPONENTS C)
 set(TEMPORAL_VTK_COMPONENTS CommonCore CommonDataModel ChartsCore ViewsContext2D RenderingContext2D
   RenderingContextOpenGL2 RenderingCore RenderingOpenGL2 RenderingFreeType IOImage InteractionStyle
-  IOExportPDF IOExportGL2PS RenderingGL2PSOpenGL2)
+  IOExportGL2PS RenderingGL2PSOpenGL2)
 find_package(VTK 9.1 REQUIRED COMPONENTS ${TEMPORAL_VTK_COMPONENTS})
 list(JOIN TEMPORAL_VTK_COMPONENTS " " TEMPORAL_VTK_COMPONENTS)  # for temporalConfig.cmake
+# PDF charts: the chart's SVG (VTK through GL2PS) drawn by librsvg onto a cairo PDF surface, which embeds the fonts
+# as subsets. VTK's own PDF exporter (libharu) drew every marker as a disc filling the plot area and left its
+# Helvetica unembedded (issue 25).
+pkg_check_modules(RSVG REQUIRED IMPORTED_TARGET librsvg-2.0 cairo-pdf)
 
 if(TEMPORAL_BUILD_TESTS)
   find_package(GTest CONFIG REQUIRED)

@@ -10,8 +10,10 @@
 #include <cmath>
 #include <csignal>
 #include <cstdio>
+#include <filesystem>
 #include <iostream>
 #include <optional>
+#include <set>
 #include <type_traits>
 
 #ifndef TEMPORAL_VERSION
@@ -47,7 +49,7 @@ Tool::Tool(std::string name, std::string description) : name_(std::move(name)), 
       ->check(CLI::Range(0, 1024).description("in 0..1024"));
   app_.add_flag("--verbose", verbose_, "Print what the tool does to stderr");
   app_.footer(
-      "Exit codes: 0 success, 1 usage error, 2 input error, 3 threshold failed, 4 output error, 5 internal error.\n"
+      "Exit codes: 0 success, 1 usage error, 2 input error, 4 output error, 5 internal error.\n"
       "Conventions (layers, units, motion vectors, jitter): docs/conventions.md");
 }
 
@@ -93,6 +95,7 @@ void Tool::add_sequence_options(SequenceOptions& o, const SequenceFlags& f) {
     if (f.gbuffer_required) g->required();
   }
   app_.add_option("--out", o.out, f.out_help)->required();
+  add_output(&o.out);
   app_.add_option("--frames", o.frames, "Frames A-B (default: every input frame on disk)");
   if (f.reset_frames)
     app_.add_option("--reset-frames", o.reset_frames,
@@ -104,8 +107,11 @@ void Tool::add_sequence_options(SequenceOptions& o, const SequenceFlags& f) {
     app_.add_option("--state-out", o.state_out,
                     "Write the state (everything the next frame needs) each frame (pattern with ####) or after the "
                     "last frame only (plain path)");
+    add_output(&o.state_out);
   }
 }
+
+void Tool::add_output(const std::string* value, bool folder) { outputs_.emplace_back(value, folder); }
 
 RunHooks Tool::hooks() {
   RunHooks h;
@@ -137,6 +143,15 @@ int Tool::run(int argc, char** argv, const std::function<Status()>& body) {
     print_error(s.error());
     std::cerr << name_ << ": run `" << name_ << " --help` for the options\n";
     return kExitUsage;
+  }
+  std::set<std::string> noted;
+  for (const auto& [value, folder] : outputs_) {
+    if (value->empty()) continue;
+    const std::filesystem::path dir = folder ? std::filesystem::path(*value) : std::filesystem::path(*value).parent_path();
+    std::error_code ec;
+    if (dir.empty() || std::filesystem::exists(dir, ec) || ec) continue;
+    if (noted.insert(dir.lexically_normal().string()).second)
+      std::cerr << name_ << ": " << dir.string() << ": note: the folder does not exist; it will be created for the outputs\n";
   }
   for (int sig : {SIGINT, SIGTERM, SIGHUP}) {
     struct sigaction action {};

@@ -13,6 +13,8 @@
 #include <functional>
 #include <memory>
 #include <string>
+#include <utility>
+#include <vector>
 
 namespace temporal::tool {
 
@@ -60,6 +62,11 @@ class Tool {
   };
   void add_sequence_options(SequenceOptions& options, const SequenceFlags& flags);
 
+  // An output option's value: a file or a frame pattern (`folder` false: its folder is the parent) or a folder.
+  // Before the run, each folder that does not exist yet is named on stderr (`tool: DIR: note: ...`): it is created
+  // for the outputs, as every tool does, but not silently (issue 25: `--out /nonexistent/a.####.exr`).
+  void add_output(const std::string* value, bool folder = false);
+
   // Hooks that draw the progress line, print warnings and --verbose lines (temporal/io/runner.h).
   RunHooks hooks();
   // `temporal:tool` / `temporal:parameters` of the outputs.
@@ -83,6 +90,7 @@ class Tool {
   int threads_ = 0;
   bool verbose_ = false;
   ParamList params_;
+  std::vector<std::pair<const std::string*, bool>> outputs_;
   std::shared_ptr<class Progress> progress_;
   std::chrono::steady_clock::time_point hooks_start_;
 };

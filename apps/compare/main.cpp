@@ -130,6 +130,8 @@ int main(int argc, char** argv) {
                       &pic.display.ocio),
       },
       "Pictures");
+  for (const std::string* file : {&out.csv, &out.json, &out.plot}) tool.add_output(file);
+  for (const std::string* folder : {&setup.error_maps, &pic.report_dir, &pic.png_dir}) tool.add_output(folder, true);
   // One --fail-<option> per registry metric that has a threshold.
   std::map<std::string, std::optional<double>> fail;
   std::string fail_list;

@@ -88,6 +88,7 @@ int main(int argc, char** argv) {
   auto& app = tool.app();
   app.add_option("scene", st.scene, "glTF 2.0 (.gltf, .glb) or text USD (.usda, .usd) scene")->required();
   app.add_option("--out", p.out_dir, "Output folder (gbuffer/shade/reference/color.####.exr, timings.csv)")->required();
+  tool.add_output(&p.out_dir, true);
   tool.add_params(sequence_params(l, p, st));
   tool.add_params(render_params(r, rt));
   app.get_option("--frames")->excludes("--duration");

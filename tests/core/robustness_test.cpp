@@ -236,7 +236,7 @@ TEST(Robustness, TheRunnerNeverWritesOverItsInputs) {
   CopyStage stage;
   SequenceOptions o;
   o.input = (dir / "c.%d.exr").string();
-  for (const std::string& out : {o.input, (dir / "." / "c.%d.exr").string(), (dir / "c.#.exr").string()}) {
+  for (const std::string& out : {o.input, (dir / "." / "c.%d.exr").string(), (dir / "c.%1d.exr").string()}) {
     o.out = out;
     auto r = run_sequence(o, stage, {"test", ""});
     ASSERT_FALSE(r) << out;

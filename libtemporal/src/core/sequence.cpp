@@ -101,6 +101,10 @@ Expected<SequencePattern> SequencePattern::parse(std::string pattern) {
     if (end == std::string::npos) end = pattern.size();
     if (pattern.find('#', end) != std::string::npos)
       return Error::usage("'" + shown(pattern) + "' has more than one run of '#': use one placeholder such as name.####.exr");
+    // One '#' means one digit in Nuke but four in oiiotool (whose one digit is '@'): refused rather than guessed.
+    if (end - hash == 1)
+      return Error::usage("'" + shown(pattern) + "': a lone '#' is one digit in Nuke but four in oiiotool; write one '#' "
+                          "per digit (name.####.exr for name.0012.exr) or %d for unpadded numbers");
     if (end - hash > 10)
       return Error::usage("'" + shown(pattern) + "': a placeholder of more than 10 '#' cannot be meant (frame numbers have at most 8 digits)");
     p.prefix_ = pattern.substr(0, hash);
@@ -162,13 +166,39 @@ std::vector<int> SequencePattern::frames_on_disk() const {
     const std::string_view digits(name.data() + file_prefix.size(), name.size() - file_prefix.size() - suffix.size());
     int frame = 0;
     if (!parse_int(digits, frame)) continue;
-    if (width_ > 0 && digits.size() < std::size_t(width_)) continue;
+    // Only the spelling path(frame) gives: with `###`, color.0012.exr is not frame 12 (that is color.012.exr).
+    if (digits != padded(frame, width_)) continue;
     frames.push_back(frame);
   }
   std::sort(frames.begin(), frames.end());
   frames.erase(std::unique(frames.begin(), frames.end()), frames.end());
   return frames;
 }
+
+namespace {
+// A file of the pattern's folder with the pattern's prefix and suffix around digits of another width than the
+// pattern's (`color.0000.exr` for `color.###.exr`): the likely meaning of a pattern that matches nothing. Empty when
+// there is none.
+std::string other_width_file(const SequencePattern& pattern) {
+  namespace fs = std::filesystem;
+  const fs::path prefix_path(pattern.prefix());
+  const fs::path dir = prefix_path.parent_path().empty() ? fs::path(".") : prefix_path.parent_path();
+  const std::string file_prefix = prefix_path.filename().string();
+  const std::string& suffix = pattern.suffix();
+  std::error_code ec;
+  std::string best;
+  for (auto it = fs::directory_iterator(dir, ec); !ec && it != fs::directory_iterator(); it.increment(ec)) {
+    const std::string name = it->path().filename().string();
+    if (name.size() <= file_prefix.size() + suffix.size() || name.compare(0, file_prefix.size(), file_prefix) != 0 ||
+        name.compare(name.size() - suffix.size(), suffix.size(), suffix) != 0)
+      continue;
+    const std::string digits = name.substr(file_prefix.size(), name.size() - file_prefix.size() - suffix.size());
+    if (digits.find_first_not_of("0123456789") != std::string::npos) continue;
+    if (best.empty() || name < best) best = name;
+  }
+  return best.empty() ? best : (fs::path(pattern.prefix()).parent_path() / best).string();
+}
+}  // namespace
 
 Expected<bool> input_exists(const std::string& path) {
   std::error_code ec;
@@ -200,9 +230,12 @@ Expected<std::vector<int>> resolve_frames(const SequencePattern& pattern, const 
     return frames;
   }
   frames = pattern.frames_on_disk();
-  if (frames.empty())
-    return Error::input(pattern.pattern(), "no frames found on disk matching this pattern; check the folder and the "
-                                           "number of # (their count is the zero-padded width)");
+  if (frames.empty()) {
+    std::string hint = "check the folder and the number of # (their count is the zero-padded width)";
+    if (const std::string other = other_width_file(pattern); !other.empty())
+      hint = "there is " + other + ", numbered with another width: write one # per digit of its number";
+    return Error::input(pattern.pattern(), "no frames found on disk matching this pattern; " + hint);
+  }
   for (std::size_t i = 1; i < frames.size(); ++i) {
     if (frames[i] != frames[i - 1] + 1)
       return Error::input(pattern.path(frames[i - 1] + 1),

@@ -53,6 +53,18 @@ Expected<Plan> make_plan(const SequenceOptions& o, const StageInputs& needs) {
   }
   auto frames = resolve_frames(*input, range);
   if (!frames) return frames.error();
+  // One file in (no placeholder) and no --frames: the run's frame is the file's own (its temporal:frame), not 0.
+  // Frame 0 wrote `a.0000.exr` stamped `temporal:frame 0` beside frame 3's `temporal:time` (issue 25). A file
+  // without that attribute is frame 0, except into a frame pattern, where the number would be a guess.
+  if (!input->has_placeholder() && !range) {
+    auto info = read_exr_info(o.input);
+    if (!info) return info.error();
+    if (info->metadata.frame)
+      frames = std::vector<int>{*info->metadata.frame};
+    else if (out->has_placeholder())
+      return Error::usage("--input '" + o.input + "' is one file without a temporal:frame attribute, so --out '" + o.out +
+                          "' has no frame number to take: give --frames N (the frame it is) or an --out without ####");
+  }
   auto compression = parse_data_compression(o.compression);
   if (!compression) return compression.error();
   Plan plan{*input, *out, std::nullopt, std::nullopt, *frames, {}, {}};
@@ -107,6 +119,39 @@ std::vector<std::string> gbuffer_selection(const StageInputs& needs, const std::
     layers.push_back(n.layer);
   }
   return layers;
+}
+
+// The required G-buffer layers that the first G-buffer file lacks, said for a G-buffer: read_exr's message
+// ("no layer 'depth, N, motion, id' ... or pick another --layer") pointed a colour file given as --gbuffer at
+// --layer, which does not choose G-buffer layers (issue 25).
+Status check_gbuffer_file(const StageInputs& needs, const std::string& path) {
+  auto info = read_exr_info(path);
+  if (!info) return info.error();
+  std::string missing, alternatives;
+  for (const auto& n : needs.gbuffer_layers) {
+    if (!n.required) continue;
+    const auto channels = layer_channel_names(n.layer);
+    bool present = false;
+    for (const auto& c : info->channels)
+      present = present || (channels.empty() ? c.rfind(n.layer + ".", 0) == 0
+                                             : std::find(channels.begin(), channels.end(), c) != channels.end());
+    if (present) continue;
+    missing += (missing.empty() ? "" : ", ") + n.layer;
+    if (!n.alternative.empty()) alternatives += " (" + n.layer + ": " + n.alternative + ")";
+  }
+  if (missing.empty()) return Status::ok();
+  bool colour = !info->channels.empty();
+  std::string have;
+  for (const auto& c : info->channels) {
+    colour = colour && (c == "R" || c == "G" || c == "B" || c == "A" || c.find('.') != std::string::npos) &&
+             c.rfind("motion.", 0) != 0 && c.rfind("depth.", 0) != 0 && c.rfind("N.", 0) != 0 && c != "id";
+    if (have.size() < 120) have += (have.empty() ? "" : ", ") + c;
+  }
+  return Error::input(path, "--gbuffer: this file has no " + missing + " layer (it has " + have + ")" +
+                                (colour ? ": it looks like a colour image. --gbuffer takes the G-buffer, e.g. "
+                                          "gbuffer.####.exr from render-gbuffer --outputs gbuffer"
+                                        : "; render the G-buffer with render-gbuffer --outputs gbuffer") +
+                                alternatives);
 }
 
 // Reads frames in order, keeping the lookahead frames in memory (each file is read once).
@@ -308,6 +353,16 @@ Expected<RunSummary> run_sequence(const SequenceOptions& options, FrameStage& st
   auto log = [&](const std::string& text) {
     if (hooks.log) hooks.log(text);
   };
+  // A method that reads motion, run over several frames without a G-buffer, takes every pixel as still: on a
+  // moving scene its history ghosts (issue 25: taa lost 1.7 dB and said nothing). Say so once, before the work.
+  if (!plan->gbuffer && plan->frames.size() > 1)
+    for (const LayerNeed& n : needs.gbuffer_layers)
+      if (n.layer == "motion") {
+        warn(options.input, "no --gbuffer: this method reads motion vectors, so without them every pixel is taken "
+                            "as still (a static scene) and moving content smears; give --gbuffer G.####.exr "
+                            "(render-gbuffer --outputs gbuffer writes it)");
+        break;
+      }
   bool resumed = false;
   if (!options.state_in.empty()) {
     auto state = read_exr(options.state_in);
@@ -326,6 +381,9 @@ Expected<RunSummary> run_sequence(const SequenceOptions& options, FrameStage& st
   if (Status s = inputs.check(plan->out.path(plan->frames.front()), "--out"); !s) return s.error();
   if (plan->state_out)
     if (Status s = inputs.check(plan->state_out->path(plan->frames.front()), "--state-out"); !s) return s.error();
+
+  if (plan->gbuffer)
+    if (Status s = check_gbuffer_file(needs, plan->gbuffer->path(plan->frames.front())); !s) return s.error();
 
   RunSummary summary;
   InputWindow window(*plan, needs);

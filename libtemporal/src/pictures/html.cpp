@@ -23,11 +23,11 @@ th { background: #f2f2f2; }
 td.name, th.name { text-align: left; }
 td.best { font-weight: bold; }
 span.ci { color: #666; font-size: 0.85em; }
-td.better { color: #1a6b1a; } td.worse { color: #a01818; } td.tie { color: #666; }
+td.decided { color: #0072b2; font-weight: bold; } td.winner { font-weight: bold; } td.tie { color: #666; }
 figure { display: inline-block; margin: 0.5em 1em 1em 0; vertical-align: top; max-width: 100%; }
 figcaption { font-size: 0.85em; color: #444; max-width: 60em; }
 img { border: 1px solid #ddd; max-width: 100%; height: auto; }
-figure.chart { width: 400px; }
+figure.chart { width: 640px; }
 img.chart { width: 100%; }
 div.mapped { position: relative; display: inline-block; max-width: 100%; }
 div.mapped img { width: 100%; height: auto; display: block; }
@@ -110,15 +110,20 @@ void paired_table(std::ostringstream& out, const ComparisonReport& r) {
         const auto sa = metric_series(r.sequences[a], name), sb = metric_series(r.sequences[b], name);
         const MeanInterval m = bootstrap_paired_difference(sa, sb, r.bootstrap);
         if (m.count == 0) continue;
-        std::string verdict = "no difference", cls = "tie";
+        // The verdict names the better method in bold blue (Okabe-Ito's blue: colour-blind safe) and bolds its
+        // name in the row; the old table coloured "a better" green and "b better" red, a colour by the row's
+        // order, not by which is better, and red/green is what colour-blind readers cannot tell apart (issue 25).
+        std::string verdict = "no difference", cls = "tie", a_cls, b_cls;
         const bool above = m.ci.low > 0.0, below = m.ci.high < 0.0;
         if (above || below) {
           const bool a_better = d->higher_is_better ? above : below;
           verdict = (a_better ? r.sequences[a].name : r.sequences[b].name) + " better";
-          cls = a_better ? "better" : "worse";
+          cls = "decided";
+          (a_better ? a_cls : b_cls) = " winner";
         }
-        out << "<tr><td class=\"name\">" << html_escape(r.sequences[a].name) << "</td><td class=\"name\">"
-            << html_escape(r.sequences[b].name) << "</td><td class=\"name\">" << html_escape(name) << "</td><td>"
+        out << "<tr><td class=\"name" << a_cls << "\">" << html_escape(r.sequences[a].name) << "</td><td class=\"name"
+            << b_cls << "\">" << html_escape(r.sequences[b].name) << "</td><td class=\"name\">" << html_escape(name)
+            << "</td><td>"
             << cell_value(m, 3) << "</td><td class=\"name " << cls << "\">" << html_escape(verdict) << "</td></tr>\n";
       }
   out << "</table>\n";

@@ -1,6 +1,8 @@
 // VTK charts written to PNG, SVG or PDF (temporal/plot/plot.h): vtkChartXY in an off-screen vtkContextView; PNG
 // read back with vtkWindowToImageFilter and written with vtkPNGWriter, SVG through GL2PS (vtkGL2PSExporter), PDF
-// through libharu (vtkPDFExporter).
+// as that SVG drawn by librsvg onto a cairo PDF surface. VTK's own PDF exporter (vtkPDFExporter, libharu) drew
+// every data marker as a disc filling the plot area and referenced Helvetica without embedding it (issue 25);
+// cairo draws the markers at their stated size and embeds the fonts it uses as subsets.
 #include "temporal/plot/plot.h"
 
 #include "temporal/io/atomic_file.h"
@@ -14,7 +16,7 @@
 #include <vtkDoubleArray.h>
 #include <vtkGL2PSExporter.h>
 #include <vtkNew.h>
-#include <vtkPDFExporter.h>
+#include <vtkObject.h>
 #include <vtkPNGWriter.h>
 #include <vtkPen.h>
 #include <vtkPlot.h>
@@ -24,6 +26,10 @@
 #include <vtkTable.h>
 #include <vtkTextProperty.h>
 #include <vtkWindowToImageFilter.h>
+
+#include <cairo-pdf.h>
+#include <cairo.h>
+#include <librsvg/rsvg.h>
 
 #include <algorithm>
 #include <cctype>
@@ -35,10 +41,63 @@
 namespace temporal {
 namespace {
 
-// Tableau 10: distinguishable colours, in the order methods are given on the command line.
-constexpr unsigned char kPalette[][3] = {{31, 119, 180}, {255, 127, 14}, {44, 160, 44},  {214, 39, 40},
-                                         {148, 103, 189}, {140, 86, 75}, {227, 119, 194}, {127, 127, 127},
-                                         {188, 189, 34}, {23, 190, 207}};
+// Okabe and Ito's colour-blind-safe palette (Color Universal Design, 2008), without its black (kept for text) and
+// with its yellow last (faint on white), then a grey: in the order methods are given on the command line. Tableau
+// 10's red and green, used before, are the pair that readers with a red-green deficiency cannot tell apart.
+constexpr unsigned char kPalette[][3] = {{0, 114, 178},  {230, 159, 0},   {0, 158, 115}, {213, 94, 0},
+                                         {204, 121, 167}, {86, 180, 233}, {240, 228, 66}, {127, 127, 127}};
+
+// Writes the view as an SVG through GL2PS: text stays text. `svg_path` must end in ".svg" (GL2PS appends the
+// extension to the prefix it is given).
+void export_svg(vtkRenderWindow* window, const std::string& svg_path, const std::string& title) {
+  const std::string prefix = svg_path.substr(0, svg_path.size() - 4);
+  vtkNew<vtkGL2PSExporter> exporter;
+  exporter->SetRenderWindow(window);
+  exporter->SetFileFormatToSVG();
+  exporter->SetFilePrefix(prefix.c_str());
+  exporter->SetTitle(title.c_str());
+  exporter->CompressOff();
+  exporter->TextAsPathOff();  // text stays text: selectable, editable, searchable
+  exporter->SilentOn();       // GL2PS would print notices to stderr; the library never prints
+  exporter->Write();
+}
+
+// Draws the SVG at `svg_path` into a one-page PDF at `pdf_path`. One SVG pixel is 0.75 pt (CSS's 96 px per inch,
+// as rsvg-convert and browsers print), so 14-pixel labels are 10.5 pt type on the page.
+Status svg_to_pdf(const std::string& svg_path, const std::string& pdf_path, const std::string& title, int width,
+                  int height) {
+  GError* error = nullptr;
+  RsvgHandle* svg = rsvg_handle_new_from_file(svg_path.c_str(), &error);
+  auto fail = [&](const std::string& what) {
+    std::string why = what;
+    if (error) {
+      why += std::string(": ") + error->message;
+      g_error_free(error);
+      error = nullptr;
+    }
+    return Error::output(pdf_path, why);
+  };
+  if (!svg) return fail("cannot read back the chart's SVG to draw the PDF");
+  constexpr double kPointsPerPixel = 0.75;
+  cairo_surface_t* surface = cairo_pdf_surface_create(pdf_path.c_str(), width * kPointsPerPixel,
+                                                      height * kPointsPerPixel);
+  cairo_pdf_surface_set_metadata(surface, CAIRO_PDF_METADATA_TITLE, title.c_str());
+  cairo_pdf_surface_set_metadata(surface, CAIRO_PDF_METADATA_CREATOR, "temporal plot (VTK, librsvg, cairo)");
+  cairo_t* cr = cairo_create(surface);
+  cairo_scale(cr, kPointsPerPixel, kPointsPerPixel);
+  const RsvgRectangle viewport{0.0, 0.0, double(width), double(height)};
+  const gboolean drawn = rsvg_handle_render_document(svg, cr, &viewport, &error);
+  cairo_destroy(cr);
+  cairo_surface_finish(surface);
+  const cairo_status_t status = cairo_surface_status(surface);
+  cairo_surface_destroy(surface);
+  g_object_unref(svg);
+  if (!drawn) return fail("cannot draw the chart into the PDF");
+  if (status != CAIRO_STATUS_SUCCESS)
+    return Error::output(pdf_path, std::string("cannot write the PDF (") + cairo_status_to_string(status) +
+                                       "): check that the folder is writable");
+  return Status::ok();
+}
 
 }  // namespace
 
@@ -81,6 +140,9 @@ Status write_chart(const Chart& chart, const std::string& path) {
   if (chart.series.empty()) return Error::usage("chart '" + chart.title + "' has no series to draw");
   if (chart.width < 64 || chart.height < 64) return Error::usage("chart size must be at least 64x64 pixels");
 
+  // VTK prints its errors and warnings to stderr itself (e.g. "Attempted to paint a line with <2 points", from a
+  // legend entry, on every chart): the library never prints, and a chart that fails shows as a missing file below.
+  vtkObject::GlobalWarningDisplayOff();
   vtkNew<vtkContextView> view;
   view->GetRenderer()->SetBackground(1.0, 1.0, 1.0);
   view->GetRenderWindow()->SetSize(chart.width, chart.height);
@@ -127,7 +189,7 @@ Status write_chart(const Chart& chart, const std::string& path) {
     }
     table->AddColumn(xs);
     table->AddColumn(ys);
-    const bool as_line = chart.style == ChartStyle::Lines || series.line;
+    const bool as_line = chart.style == ChartStyle::Lines || series.line || series.error_bar;
     vtkPlot* plot = xy->AddPlot(as_line ? vtkChart::LINE : vtkChart::POINTS);
     plot->SetInputData(table, 0, 1);
     plot->SetLabel(ys->GetName());
@@ -136,6 +198,13 @@ Status write_chart(const Chart& chart, const std::string& path) {
     if (series.line && chart.style == ChartStyle::Points) {
       plot->SetColor(110, 110, 110, 255);  // the front: grey, thin, behind the markers' colours
       plot->SetWidth(1.5f);
+      if (auto* points = vtkPlotPoints::SafeDownCast(plot)) points->SetMarkerStyle(vtkPlotPoints::NONE);
+      continue;
+    }
+    if (series.error_bar && chart.style == ChartStyle::Points) {
+      plot->SetColor(c[0], c[1], c[2], 255);
+      plot->SetWidth(1.5f);
+      plot->SetLegendVisibility(false);
       if (auto* points = vtkPlotPoints::SafeDownCast(plot)) points->SetMarkerStyle(vtkPlotPoints::NONE);
       continue;
     }
@@ -192,23 +261,11 @@ Status write_chart(const Chart& chart, const std::string& path) {
     writer->Write();
     if (writer->GetErrorCode() != 0) return Error::output(path, "cannot write the PNG: check that the folder is writable");
   } else if (*format == ChartFormat::Svg) {
-    // GL2PS appends the extension to its prefix: give it the temporary name without `.svg`.
-    const std::string prefix = tmp.path().substr(0, tmp.path().size() - 4);
-    vtkNew<vtkGL2PSExporter> exporter;
-    exporter->SetRenderWindow(view->GetRenderWindow());
-    exporter->SetFileFormatToSVG();
-    exporter->SetFilePrefix(prefix.c_str());
-    exporter->SetTitle(chart.title.c_str());
-    exporter->CompressOff();
-    exporter->TextAsPathOff();  // text stays text: selectable, editable, searchable
-    exporter->SilentOn();       // GL2PS would print notices to stderr; the library never prints
-    exporter->Write();
+    export_svg(view->GetRenderWindow(), tmp.path(), chart.title);
   } else {
-    vtkNew<vtkPDFExporter> exporter;
-    exporter->SetRenderWindow(view->GetRenderWindow());
-    exporter->SetFileName(tmp.path().c_str());
-    exporter->SetTitle(chart.title.c_str());
-    exporter->Write();
+    TemporaryFile svg(path + ".svg");  // the drawing the PDF is made from; removed when done
+    export_svg(view->GetRenderWindow(), svg.path(), chart.title);
+    if (Status s = svg_to_pdf(svg.path(), tmp.path(), chart.title, chart.width, chart.height); !s) return s;
   }
   std::error_code ec;
   if (!std::filesystem::exists(tmp.path()) || std::filesystem::file_size(tmp.path(), ec) == 0)

@@ -1,5 +1,6 @@
 // The charts of `compare --plot` (temporal/plot/plot.h): per-frame metric curves and speed against error.
 #include "temporal/compare/comparison.h"
+#include "temporal/metrics/statistics.h"
 #include "temporal/plot/plot.h"
 
 #include <algorithm>
@@ -70,7 +71,7 @@ std::vector<std::pair<std::string, Chart>> comparison_charts(const ComparisonRep
   // The points and their Pareto front come from speed_points (the JSON's `pareto` flags are the same).
   Chart speed;
   speed.title = with_title(title, "Speed against error (mean over frames)");
-  speed.x_label = "method compute time per frame (ms, temporal:computeMs, I/O excluded)";
+  speed.x_label = "compute time per frame (ms; the method's own, file I/O excluded)";
   const MetricDefinition* metric = find_metric(report.speed_metric);
   const std::string label = metric && !metric->label.empty() ? metric->label : report.speed_metric;
   const std::string unit = metric ? metric->unit : std::string();
@@ -98,6 +99,22 @@ std::vector<std::pair<std::string, Chart>> comparison_charts(const ComparisonRep
       front.y.push_back(point->value);
     }
     speed.series.push_back(std::move(front));
+  }
+  // Error bars: the 95 % bootstrap interval of each mean (the JSON's ci95, docs/compare.md "Intervals"), vertical
+  // for the metric and horizontal for the compute time, so that two methods whose bars overlap are not read as
+  // ranked by the chart alone. A bar of zero length (one frame, a constant time) is not drawn.
+  for (const SpeedPoint& point : points) {
+    const SequenceReport& s = report.sequences[point.sequence];
+    const MeanInterval y = bootstrap_mean(metric_series(s, report.speed_metric), report.bootstrap);
+    std::vector<double> ms;
+    for (const auto& f : s.frames)
+      if (f.compute_ms) ms.push_back(*f.compute_ms);
+    const MeanInterval x = bootstrap_mean(ms, report.bootstrap);
+    const int colour = int(point.sequence);
+    if (std::isfinite(y.ci.low) && std::isfinite(y.ci.high) && y.ci.high > y.ci.low)
+      speed.series.push_back({"", {point.compute_ms, point.compute_ms}, {y.ci.low, y.ci.high}, colour, false, true});
+    if (!ms.empty() && std::isfinite(x.ci.low) && std::isfinite(x.ci.high) && x.ci.high > x.ci.low)
+      speed.series.push_back({"", {x.ci.low, x.ci.high}, {point.value, point.value}, colour, false, true});
   }
   if (!speed.series.empty()) charts.emplace_back(stem + "-speed" + ext, std::move(speed));
   return charts;

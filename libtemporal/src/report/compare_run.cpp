@@ -6,6 +6,8 @@
 #include "temporal/plot/plot.h"
 
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <memory>
 #include <optional>
 
@@ -62,6 +64,58 @@ std::vector<std::string> speed_notes(const ComparisonReport& report) {
   return notes;
 }
 
+// What a report owns in its folder (docs/compare.md, Report): these files and folders, nothing else.
+constexpr const char* kReportFiles[] = {"index.html", "metrics.csv", "metrics.json", "video.mp4"};
+constexpr const char* kReportFolders[] = {"pictures", "plots", "maps", "profiles"};
+
+// A report written into a folder that holds an earlier one left the earlier run's pictures beside the new ones
+// (another method's maps, charts of a metric not measured now: issue 25). An earlier report (its index.html says
+// "Written by compare") is removed first - only what a report owns, and never a file this run reads; report
+// files in a folder without that page are someone else's: refused.
+Status clear_earlier_report(const std::string& dir, const ProtectedInputs& inputs, const ComparisonHooks& hooks) {
+  std::error_code ec;
+  const fs::file_status st = fs::status(dir, ec);
+  if (!fs::exists(st)) return Status::ok();
+  if (!fs::is_directory(st))
+    return Error::usage("--report '" + dir + "' exists and is not a folder: name a folder for the report");
+  std::vector<fs::path> owned;
+  for (const char* f : kReportFiles)
+    if (fs::exists(fs::path(dir) / f, ec)) owned.push_back(fs::path(dir) / f);
+  for (const char* f : kReportFolders)
+    if (fs::exists(fs::path(dir) / f, ec)) owned.push_back(fs::path(dir) / f);
+  if (owned.empty()) return Status::ok();
+  // Every file the report would replace, checked against the inputs first: nothing is removed (or written over)
+  // when one of them is read.
+  std::vector<fs::path> files;
+  for (const fs::path& p : owned) {
+    if (!fs::is_directory(p, ec)) {
+      files.push_back(p);
+      continue;
+    }
+    for (auto it = fs::recursive_directory_iterator(p, ec); !ec && it != fs::recursive_directory_iterator();
+         it.increment(ec))
+      if (!it->is_directory(ec)) files.push_back(it->path());
+  }
+  for (const fs::path& f : files)
+    if (Status s = inputs.check(f.string(), "--report"); !s)
+      return Error::usage("--report '" + dir + "': " + f.string() + " is one of this run's inputs, in a file or folder "
+                          "the report replaces: copy it elsewhere or give --report another folder");
+  std::ifstream page(fs::path(dir) / "index.html");
+  const std::string text((std::istreambuf_iterator<char>(page)), std::istreambuf_iterator<char>());
+  if (text.find("Written by compare ") == std::string::npos)
+    return Error::usage("--report '" + dir + "' holds " + owned.front().filename().string() +
+                        " but no earlier report of compare (index.html): the report's files would mix with these; give "
+                        "--report a new or empty folder");
+  for (const fs::path& p : owned) {
+    fs::remove_all(p, ec);
+    if (ec) return Error::output(p.string(), "cannot remove this file of the earlier report (" + ec.message() +
+                                                 "): remove it, or give --report another folder");
+  }
+  if (hooks.log) hooks.log("removed the earlier report in " + dir + " (index.html, metrics, video, pictures/, plots/, "
+                           "maps/, profiles/)");
+  return Status::ok();
+}
+
 }  // namespace
 
 Expected<CompareRun> run_compare(const ComparisonSetup& setup, const Thresholds& thresholds,
@@ -90,6 +144,9 @@ Expected<CompareRun> run_compare(const ComparisonSetup& setup, const Thresholds&
   for (const auto& path : {page, report_csv, report_json})
     if (!path.empty())
       if (auto st = inputs->check(path, "--report"); !st) return st.error();
+
+  if (report_on)
+    if (auto st = clear_earlier_report(o.pictures.report_dir, *inputs, base_hooks); !st) return st.error();
 
   CompareRun run;
   ComparisonHooks hooks = base_hooks;

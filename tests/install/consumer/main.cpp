@@ -34,6 +34,9 @@ int main(int argc, char** argv) {
     if (Status s = write_exr(pattern->path(f), noisy); !s) return std::fprintf(stderr, "%s\n", s.error().message.c_str()), 1;
   }
 
+  // The clean image too: docs/library.md's example (built beside this program) reads it.
+  if (Status s = write_exr(dir + "/clean.exr", clean); !s) return std::fprintf(stderr, "%s\n", s.error().message.c_str()), 1;
+
   // Load the sequence back, filter it, measure the last frame.
   auto list = resolve_frames(*pattern, std::nullopt);
   if (!list) return std::fprintf(stderr, "%s\n", list.error().message.c_str()), 1;

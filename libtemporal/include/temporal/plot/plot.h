@@ -21,8 +21,11 @@ struct ChartSeries {
   std::string name;  // legend entry
   std::vector<double> x;
   std::vector<double> y;
-  int color = -1;    // palette entry (Tableau 10); -1: the series' position. A method keeps its colour across charts
+  int color = -1;    // palette entry (Okabe-Ito, colour-blind safe); -1: the series' position. A method keeps its colour across charts
   bool line = false;  // in a Points chart: drawn as a grey line without markers (the Pareto front of the speed chart)
+  // In a Points chart: one error bar (a two-point segment) in the colour of `color`, without markers and left
+  // out of the legend (the 95 % intervals of the speed chart).
+  bool error_bar = false;
 };
 
 enum class ChartStyle {
