@@ -422,18 +422,18 @@ std::string summary_table(const ComparisonReport& report) {
   put("sequence", 20, true);
   put("frames", 7, false);
   for (const auto* d : defs) put(d->name, d->table_width, false);
+  put("compute_ms", 11, false);  // the columns before it as they always were (scripts read them by position)
   for (const auto* d : pooled) put(d->name + "_pooled", pooled_width(d), false);
-  put("compute_ms", 11, false);
   out += '\n';
   for (const auto& s : report.sequences) {
     put(s.name, 20, true);
     put(std::to_string(s.frames.size()), 7, false);
     for (const auto* d : defs) put(cell(summarize(s, d->name).mean, d->table_format), d->table_width, false);
+    const auto ms = mean_compute_ms(s);
+    put(ms ? cell(*ms, "%.3f") : std::string("-"), 11, false);
     for (const auto* d : pooled)
       put(cell(pooled_psnr(metric_series(s, d->name), region_weights(s, kAllRegions)), d->table_format),
           pooled_width(d), false);
-    const auto ms = mean_compute_ms(s);
-    put(ms ? cell(*ms, "%.3f") : std::string("-"), 11, false);
     out += '\n';
   }
   if (!report.regions) return out;
