@@ -22,7 +22,8 @@
 #   REUSE_RENDER=1 (keep an existing render folder instead of rendering again, e.g. after changing only the
 #   filters), REUSE_OUTPUTS=1 (keep existing filtered sequences: measure again only), WARMUP (frames compare
 #   reports apart as warm-up, default 10 = 1 / TAA's alpha; only when compare has --warmup), PAIRS (paired differences printed, "A:B,..."; default: phlm and taa against each other, the input
-#   and the previous TAA).
+#   and the previous TAA), REGIONS (compare --regions: motion (default) or none), STATIC_FRAMES (compare
+#   --static-frames, default 10).
 #
 # The comparison target: render-gbuffer's `color` is the shading payload's R,G,B at one sample per pixel with
 # the chosen jitter, and its `reference` is the same payload's R,G,B averaged over --reference-spp samples at
@@ -46,6 +47,8 @@ VARIANTS="${VARIANTS-taa-0.1 taa --taa-alpha 0.1
 taa-2014 taa --taa-velocity centre --taa-clip minmax --taa-alpha 0.04}"
 RENDERS="${RENDERS:-$OUT}"
 WARMUP="${WARMUP:-10}"
+REGIONS="${REGIONS:-motion}"
+STATIC_FRAMES="${STATIC_FRAMES:-10}"
 PAIRS="${PAIRS:-phlm:taa,phlm:taa-0.1,phlm:input,taa:input,taa:taa-0.1,phlm:fxaa,phlm:ema,taa-0.1:taa-2014}"
 
 require_tools render-gbuffer filter-phlm compare
@@ -76,6 +79,11 @@ while read -r n m args; do [[ -n "$n" ]] && runs+=("$n --method $m $args"); done
 compare_args=()
 compare_help="$("$compare" --help 2>/dev/null || true)"
 if [[ "$compare_help" == *--warmup* ]]; then compare_args+=(--warmup "$WARMUP"); fi
+# Every metric also per region (static / moving / disoccluded, from the G-buffer; docs/compare.md "Regions"): the
+# tables show where a method wins and where it loses, not only the whole-frame mean.
+if [[ "$REGIONS" != none && "$compare_help" == *--regions* ]]; then
+  compare_args+=(--regions "$REGIONS" --static-frames "$STATIC_FRAMES")
+fi
 {
   echo "# filter-phlm: seed 003 Table 2 on the built-in scenes"
   echo

@@ -9,7 +9,9 @@ Tables:
       per scene (OUT_DIR/SCENE/metrics.json): mean PSNR (RGB) over frames with its 95% interval and the
       steady-state mean (after compare's --warmup frames), mean flicker; the mean of those over the scenes (not
       compare's: one compare run sees one scene); then the paired differences A - B (PSNR, and flicker) with
-      their 95% intervals for each PAIR "A:B" (names as given to compare --names)
+      their 95% intervals for each PAIR "A:B" (names as given to compare --names); when compare ran with
+      --regions motion, a table per region (share, mean PSNR [95%] / pooled PSNR) and the paired differences per
+      region
   tables.py scenes-by-row OUT_DIR ...
       the same, with the paired differences one row per pair and one column per scene, PSNR only (ablations)
   tables.py upsample-st SCENE_DIR SHADE_LOW_MS SHADE_FULL_MS [SS_JSON SS_LABEL]
@@ -176,6 +178,7 @@ def scenes(out_dir, scene_list, seq_list, pair_list, by_row=False):
         means.append(f"{fmt(mp)} / {fmt(mf, 4)}")
     out.append("| mean of the scenes | " + " | ".join(means) + " |")
     print("\n".join(out))
+    region_tables(data, scene_list, seq_list, pair_list)
     if not pair_list:
         return
     if by_row:
@@ -197,7 +200,7 @@ def scenes(out_dir, scene_list, seq_list, pair_list, by_row=False):
                 for key, digits in (("psnr_rgb", 2), ("flicker", 4)):
                     hit = None
                     for p in paired:
-                        if p.get("metric") == key and {p.get("a"), p.get("b")} == {a, b}:
+                        if p.get("metric") == key and {p.get("a"), p.get("b")} == {a, b} and whole_frame(p):
                             hit = p
                             break
                     if hit is not None and part == "steady":
@@ -214,10 +217,10 @@ def scenes(out_dir, scene_list, seq_list, pair_list, by_row=False):
             print(f"| {s} | " + " | ".join(cells) + " |")
 
 
-def paired_value(paired, key, a, b, part):
+def paired_value(paired, key, a, b, part, region="all"):
     """(mean of a - b, sorted 95% interval or None) from compare's `paired`, over all frames or the steady state."""
     for p in paired or []:
-        if p.get("metric") == key and {p.get("a"), p.get("b")} == {a, b}:
+        if p.get("metric") == key and {p.get("a"), p.get("b")} == {a, b} and p.get("region", "all") == region:
             sign = 1.0 if p["a"] == a else -1.0
             hit = p.get("steady") if part == "steady" else p
             if hit is None or hit.get("mean_difference") is None:
@@ -245,9 +248,61 @@ def pairs_by_row(data, scene_list, pair_list):
 def _orient(paired, key, a, b):
     """True when compare's entry for {a, b} and `key` is a - b (not b - a)."""
     for p in paired:
-        if p.get("metric") == key and {p.get("a"), p.get("b")} == {a, b}:
+        if p.get("metric") == key and {p.get("a"), p.get("b")} == {a, b} and whole_frame(p):
             return p["a"] == a
     return True
+
+
+def whole_frame(p):
+    """True for a paired entry of the whole frame (compare --regions adds entries per region)."""
+    return p.get("region", "all") == "all"
+
+
+REGIONS = ("static", "moving", "disoccluded")
+
+
+def region_tables(data, scene_list, seq_list, pair_list):
+    """With compare --regions motion (docs/compare.md, Regions): per scene and region the pixel share, then per
+    sequence the mean PSNR (RGB) over frames [95% interval] / the pooled PSNR (PSNR of the pooled squared error);
+    then the paired differences A - B of the mean PSNR per region. Nothing when no scene has regions."""
+    if not any("regions" in q for s in scene_list for q in data[s]["sequences"]):
+        return
+    print()
+    print("Per region (compare --regions motion): share of the pixels; mean PSNR (RGB, dB) over frames [95% interval]"
+          " / pooled PSNR (of the squared error over all the region's pixels and frames):\n")
+    print("| scene | region | share | " + " | ".join(seq_list) + " |")
+    print("|---|---|---|" + "---|" * len(seq_list))
+    for s in scene_list:
+        by = {q["name"]: q for q in data[s]["sequences"]}
+        for region in ("all",) + REGIONS:
+            share, cells = None, []
+            for name in seq_list:
+                q = by.get(name)
+                if q is None:
+                    cells.append("")
+                    continue
+                if region == "all":
+                    m, pooled, share = q.get("psnr_rgb") or {}, q.get("psnr_rgb_pooled") or {}, 1.0
+                else:
+                    r = (q.get("regions") or {}).get(region) or {}
+                    m, pooled = r.get("psnr_rgb") or {}, r.get("psnr_rgb_pooled") or {}
+                    share = r.get("share", share)
+                cells.append(cell(num(m.get("mean")), m.get("ci95")) + " / " + fmt(num(pooled.get("value"))))
+            print(f"| {s} | {region} | {fmt(100.0 * share, 1) + ' %' if share is not None else 'n/a'} | "
+                  + " | ".join(cells) + " |")
+    if not pair_list:
+        return
+    print()
+    print("Paired differences A - B of the mean PSNR (RGB, dB) per region [95% interval] (compare's `paired`):\n")
+    print("| scene | region | " + " | ".join(f"{a} - {b}" for a, b in pair_list) + " |")
+    print("|---|---|" + "---|" * len(pair_list))
+    for s in scene_list:
+        for region in REGIONS:
+            cells = []
+            for a, b in pair_list:
+                d, ci = paired_value(data[s].get("paired"), "psnr_rgb", a, b, "all", region)
+                cells.append(cell(d, ci, 2, sign=True) if d is not None else "n/a")
+            print(f"| {s} | {region} | " + " | ".join(cells) + " |")
 
 
 def upsample_st(scene_dir, low, full, ss_json=None, ss_label=None):
@@ -321,7 +376,7 @@ def paired_rows(path, scene, score, key):
     def f(v):
         return "" if v is None or isinstance(v, str) else "%.3f" % v
     for p in json.load(open(path)).get("paired", []):
-        if p["metric"] != key:
+        if p["metric"] != key or not whole_frame(p):
             continue
         ci = p.get("ci95") or [None, None]
         print(",".join([scene, score, p["metric"], p["a"], p["b"], str(p["frames"]), f(p["mean_difference"]),

@@ -30,7 +30,7 @@ def main():
                   "|---|---|---|---|---|---|---|"]
         paired = {}
         for p in report.get("paired", []):
-            if p["metric"] != "psnr_rgb":
+            if p["metric"] != "psnr_rgb" or p.get("region", "all") != "all":  # the whole frame (--regions adds more)
                 continue
             if p["b"] == a.baseline:
                 paired[p["a"]] = (num(p["mean_difference"]), p["ci95"])
