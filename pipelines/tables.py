@@ -33,6 +33,10 @@ Tables:
       rows "scene,score,metric,a,b,frames,mean_difference_db,ci_low,ci_high" of compare's paired differences
   tables.py morph-summary SUMMARY.csv
       morph-120hz.sh's summary table (Markdown) from its summary.csv
+  tables.py noise-floor FLOOR_JSON METRICS_JSON SPP SPP4
+      the reference's noise floor: compare's PSNR (RGB) of the SPP-spp reference against the SPP4-spp one
+      (FLOOR_JSON: mean over its frames with the 95% interval, and pooled), and whether the best mean PSNR of
+      METRICS_JSON comes within 10 dB of it (then the table cannot rank methods finer than the reference's noise)
 Numbers compare does not compute (see that section):
   tables.py csv-mean CSV COLUMN [DIGITS]          mean of a column (render-gbuffer's timings.csv)
   tables.py pass-ms-mean TIMINGS.csv [DIGITS]     mean over frames of the sum of render-gbuffer's pass columns
@@ -383,6 +387,27 @@ def paired_rows(path, scene, score, key):
                         f(ci[0]), f(ci[1])]))
 
 
+def noise_floor(floor_path, metrics_path, spp, spp4):
+    q = json.load(open(floor_path))["sequences"][0]
+    m = q.get("psnr_rgb") or {}
+    floor = num(m.get("mean"))
+    pooled = num((q.get("psnr_rgb_pooled") or {}).get("value"))
+    line = (f"Noise floor: PSNR (RGB) of the {spp}-spp reference against a {spp4}-spp render of its first "
+            f"{m.get('frames', 0)} frames: {cell(floor, m.get('ci95'))} dB (pooled {fmt(pooled)} dB).")
+    best = None
+    for s in json.load(open(metrics_path))["sequences"]:
+        v = num((s.get("psnr_rgb") or {}).get("mean"))
+        if v is not None and math.isfinite(v) and (best is None or v > best[1]):
+            best = (s["name"], v)
+    if best is not None and floor is not None and math.isfinite(floor):
+        if best[1] > floor - 10.0:
+            line += (f" The best mean PSNR ({best[0]}, {fmt(best[1])} dB) is within 10 dB of it: differences between"
+                     " methods near the top are partly the reference's noise.")
+        else:
+            line += f" The best mean PSNR ({best[0]}, {fmt(best[1])} dB) is {fmt(floor - best[1])} dB below it."
+    print(line)
+
+
 def morph_summary(path):
     print("| scene | method | L | in-between | in-between, shown | all | perceived | perceived, shown | "
           "blur (lag removed) | lag ms | compute ms | command ms | render ms |")
@@ -502,6 +527,7 @@ def main(argv):
         "value": (3, 4, lambda a: value(*a)),
         "paired-rows": (4, 4, lambda a: paired_rows(*a)),
         "morph-summary": (1, 1, lambda a: morph_summary(a[0])),
+        "noise-floor": (4, 4, lambda a: noise_floor(*a)),
         "csv-mean": (2, 3, lambda a: csv_mean(*a)),
         "pass-ms-mean": (1, 2, lambda a: pass_ms_mean(*a)),
         "mean": (0, 1, lambda a: mean(*a)),
