@@ -291,7 +291,10 @@ def region_tables(data, scene_list, seq_list, pair_list):
                     r = (q.get("regions") or {}).get(region) or {}
                     m, pooled = r.get("psnr_rgb") or {}, r.get("psnr_rgb_pooled") or {}
                     share = r.get("share", share)
-                cells.append(cell(num(m.get("mean")), m.get("ci95")) + " / " + fmt(num(pooled.get("value"))))
+                if num(m.get("mean")) is None:  # an empty region (e.g. no static pixels yet)
+                    cells.append("n/a")
+                else:
+                    cells.append(cell(num(m.get("mean")), m.get("ci95")) + " / " + fmt(num(pooled.get("value"))))
             print(f"| {s} | {region} | {fmt(100.0 * share, 1) + ' %' if share is not None else 'n/a'} | "
                   + " | ".join(cells) + " |")
     if not pair_list:
