@@ -470,6 +470,32 @@ TEST_F(Report, ReportPageIsCompleteAndOffline) {
     EXPECT_EQ(e.path().filename().string().find(".tmp"), std::string::npos) << e.path();
 }
 
+// Issue 24: with --regions motion the report has a Regions section - one stacked share bar per sequence, the
+// per-region table whose intervals are the JSON's - and the paired differences per region and pooled.
+TEST_F(Report, RegionsSectionWithShareBarsAndTable) {
+  std::string out;
+  ASSERT_EQ(run("--reference ref.####.exr good.####.exr noisy.####.exr --names phlm,taa --gbuffer g.####.exr "
+                "--regions motion --static-frames 2 --report rep",
+                &out),
+            0)
+      << out;
+  const std::string html = read_text(dir / "rep" / "index.html");
+  for (const char* part : {"<h2 id=\"regions\">Regions</h2>", "<table class=\"regions\">", "<div class=\"share\">",
+                           "<span class=\"static\"", "<span class=\"moving\"", "<span class=\"disoccluded\"",
+                           "<th class=\"name\">region</th>", "psnr_rgb_pooled"})
+    EXPECT_NE(html.find(part), std::string::npos) << part;
+  std::size_t bars = 0;
+  for (auto at = html.find("<div class=\"share\">"); at != std::string::npos; at = html.find("<div class=\"share\">", at + 1))
+    ++bars;
+  EXPECT_EQ(bars, 2u);
+  const auto j = nlohmann::json::parse(read_text(dir / "rep" / "metrics.json"));
+  for (const auto& s : j["sequences"]) {
+    const auto& ci = s["regions"]["disoccluded"]["psnr_rgb"]["ci95"];
+    const std::string cell = "[" + format_number(ci[0].get<double>(), 4) + ", " + format_number(ci[1].get<double>(), 4) + "]";
+    EXPECT_NE(html.find(cell), std::string::npos) << s["name"] << " " << cell;
+  }
+}
+
 // The report in a browser: headless Chromium loads the page from disk, renders it to a PNG and dumps its DOM.
 // The screenshot is not blank (many colours, much non-white: tables, charts, pictures), every <img> finished
 // loading (the page's own script counts them into data-images-complete), and the page has its tables, charts,
