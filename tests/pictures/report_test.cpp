@@ -19,6 +19,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <random>
 #include <regex>
 #include <set>
@@ -494,6 +495,37 @@ TEST_F(Report, RegionsSectionWithShareBarsAndTable) {
     const std::string cell = "[" + format_number(ci[0].get<double>(), 4) + ", " + format_number(ci[1].get<double>(), 4) + "]";
     EXPECT_NE(html.find(cell), std::string::npos) << s["name"] << " " << cell;
   }
+}
+
+// The charts of --regions: the shares per frame (summing to 100 %) and PSNR per frame in each region.
+TEST_F(Report, RegionChartsFromTheReport) {
+  ComparisonSetup s = setup({"good", "noisy"}, {"phlm", "taa"});
+  s.regions = true;
+  s.region_options.static_frames = 2;
+  auto report = compare_sequences(s);
+  ASSERT_TRUE(report) << report.error().message;
+  const auto charts = comparison_charts(*report, (dir / "c.png").string(), "scene");
+  std::map<std::string, const Chart*> by;
+  for (const auto& [path, chart] : charts) by[fs::path(path).filename().string()] = &chart;
+  ASSERT_TRUE(by.count("c-regions.png"));
+  const Chart& shares = *by["c-regions.png"];
+  ASSERT_EQ(shares.series.size(), 3u);
+  EXPECT_EQ(shares.series[0].name, "static");
+  for (std::size_t k = 0; k < shares.series[0].y.size(); ++k)
+    EXPECT_NEAR(shares.series[0].y[k] + shares.series[1].y[k] + shares.series[2].y[k], 100.0, 1e-9) << k;
+  EXPECT_EQ(shares.series[2].y.front(), 100.0);  // the first frame has no history: all disoccluded
+  for (const char* region : {"static", "moving", "disoccluded"}) {
+    const std::string name = std::string("c-psnr-") + region + ".png";
+    ASSERT_TRUE(by.count(name)) << name;
+    EXPECT_EQ(by[name]->series.size(), 2u);
+    EXPECT_NE(by[name]->title.find(region), std::string::npos);
+  }
+  // Without regions, none of them.
+  s.regions = false;
+  auto plain = compare_sequences(s);
+  ASSERT_TRUE(plain);
+  for (const auto& [path, chart] : comparison_charts(*plain, (dir / "c.png").string()))
+    EXPECT_EQ(fs::path(path).filename().string().find("region"), std::string::npos) << path;
 }
 
 // The report in a browser: headless Chromium loads the page from disk, renders it to a PNG and dumps its DOM.
