@@ -106,7 +106,8 @@ int main(int argc, char** argv) {
           Param::text("--plot",
                       "Charts F.EXT, EXT = png, svg or pdf: F (PSNR per frame), F-psnr-y, F-ssim, F-flicker, F-flip "
                       "(with --flip), F-psnr-latency (with --latency-aware), F-speed (--speed-metric against the "
-                      "methods' own compute time)",
+                      "methods' own compute time); with --regions motion F-regions and F-psnr-static, -moving, "
+                      "-disoccluded",
                       &out.plot),
           Param::text("--title", "Title of the charts, the contact sheet and the report (e.g. the scene)", &out.title),
           Param::text("--error-maps",

@@ -106,9 +106,11 @@ void metric_table(std::ostringstream& out, const ComparisonReport& r) {
 // with its interval, pooled PSNR with its interval) for each sequence.
 void region_section(std::ostringstream& out, const ComparisonReport& r) {
   if (!r.regions || r.sequences.empty()) return;
+  char tolerance[32];
+  std::snprintf(tolerance, sizeof tolerance, "%g", r.region_options.static_tolerance);
   out << "<h2 id=\"regions\">Regions</h2>\n<p class=\"note\">From the G-buffer (docs/compare.md, Regions): "
          "<b>static</b> = zero motion, history found and the reference's luminance unchanged (within "
-      << format_number(r.region_options.static_tolerance, 4) << ") for " << r.region_options.static_frames
+      << tolerance << ") for " << r.region_options.static_frames
       << " frames; <b>disoccluded</b> = no history (the reprojection's off-screen or depth/id test fails, or no previous "
          "frame); <b>moving</b> = the rest. Each value is the mean over the frames where the region has pixels, with its "
          "95 % interval; <code>_pooled</code> is the PSNR of the region's squared error pooled over all its pixels of "
