@@ -57,7 +57,7 @@ enum : int { kRegionStatic = 0, kRegionMoving = 1, kRegionDisoccluded = 2, kRegi
 // "static", "moving", "disoccluded"; "all" for kAllRegions.
 const char* region_name(int region);
 // Motion below this (pixels, |x| and |y|) is zero: the float rounding of a static surface's reprojection.
-inline constexpr float kStaticMotion = 1e-3f;
+inline constexpr double kStaticMotion = 1e-3;
 
 struct RegionOptions {
   int static_frames = 10;          // --static-frames: frames the reference must have been unchanged
