@@ -1,8 +1,9 @@
 // Sequence comparison, the engine of the `compare` tool: streams a reference and any number of test
 // sequences frame by frame (only the current frame and the previous frame's luminance are in memory), measures
-// every metric of the registry per frame and per test, optionally inside and outside a mask layer, writes error
-// maps, and turns the results into CSV, JSON, a summary table, charts and threshold checks. docs/compare.md
-// defines every number.
+// every metric of the registry per frame and per test, optionally inside and outside a mask layer and per region
+// of the frame (static / moving / disoccluded from the G-buffer, --regions motion), writes error maps, and turns
+// the results into CSV, JSON, a summary table (with the pooled PSNR beside the mean of frames), charts and
+// threshold checks. docs/compare.md defines every number.
 //
 // The metric set is open: a metric is one entry of the registry (metric_registry()) - its name, label, unit,
 // the per-frame measure, the CSV columns it writes, whether higher is better, its threshold option
