@@ -784,6 +784,9 @@ TEST(Regions, PerRegionAndPooledValuesOnAHandMadeSequence) {
     g.add_channel("motion.Y", 0.0f);
     g.add_channel("depth.Z", 1.0f);
     std::uint32_t* id = g.add_uint_channel("id", 1);
+    float* inside = g.add_channel("half", 0.0f);  // a mask for --mask beside the regions: the left half
+    for (int y = 0; y < h; ++y)
+      for (int x = 0; x < w / 2; ++x) inside[y * w + x] = 1.0f;
     if (f == 1)
       for (int y = 0; y < h; ++y)
         for (int x = 0; x < w; ++x) {
@@ -897,6 +900,39 @@ TEST(Regions, PerRegionAndPooledValuesOnAHandMadeSequence) {
   const std::string table = summary_table(*rep);
   EXPECT_NE(table.find("psnr_rgb_pooled"), std::string::npos) << table;
   EXPECT_NE(table.find("disoccluded"), std::string::npos) << table;
+
+  // --mask keeps working beside the regions: its columns hold values on the `all` rows, nothing on region rows,
+  // and the region values do not change.
+  setup.mask = "half";
+  auto masked = compare_sequences(setup);
+  ASSERT_TRUE(masked) << masked.error().message;
+  const FrameMetrics& m1 = masked->sequences[0].frames[1];
+  EXPECT_EQ(m1.sample("psnr_rgb")->regions, p1->regions);
+  EXPECT_NEAR(m1.mask_fraction, 0.5, 1e-12);
+  EXPECT_NEAR(m1.sample("psnr_rgb")->inside, -10.0 * std::log10((0.01 + 0.04 / 2.0) / 1.5), 1e-5);  // columns 0-5
+  ASSERT_TRUE(write_comparison_csv(*masked, csv_path));
+  std::istringstream masked_csv(read_text(csv_path));
+  std::string header, all_row, static_row;
+  std::getline(masked_csv, header);
+  std::getline(masked_csv, all_row);     // frame 0, t, all
+  for (int k = 0; k < 9; ++k) std::getline(masked_csv, static_row);  // past frame 0 (2 x 4 rows): frame 1, t, static
+  auto column = [](const std::string& line, std::size_t k) {
+    std::stringstream in(line);
+    std::string cell;
+    for (std::size_t i = 0; i <= k && std::getline(in, cell, ','); ++i) {}
+    return cell;
+  };
+  std::size_t in_column = 0;
+  {
+    std::stringstream in(header);
+    std::string cell;
+    for (std::size_t i = 0; std::getline(in, cell, ','); ++i)
+      if (cell == "psnr_rgb_in_db") in_column = i;
+  }
+  ASSERT_GT(in_column, 0u) << header;
+  EXPECT_EQ(static_row.rfind("1,t,static,", 0), 0u) << static_row;
+  EXPECT_FALSE(column(all_row, in_column).empty()) << all_row;
+  EXPECT_TRUE(column(static_row, in_column).empty()) << static_row;
 }
 
 TEST(Regions, NeedTheGbufferWithDepthAndIds) {
