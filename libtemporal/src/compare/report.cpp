@@ -110,10 +110,13 @@ std::vector<CsvColumn> csv_layout(const ComparisonReport& report) {
   cols.push_back({"frame", [](const SequenceReport&, const FrameMetrics& f, int) { return std::to_string(f.frame); }});
   cols.push_back({"sequence", [](const SequenceReport& s, const FrameMetrics&, int) { return csv_quote(s.name); }});
   if (report.regions) {
-    cols.push_back({"region", [](const SequenceReport&, const FrameMetrics&, int r) { return std::string(region_name(r)); }});
+    cols.push_back({"region", [](const SequenceReport&, const FrameMetrics&, int r) {
+                      return std::string(region_name(r));
+                    }});
     cols.push_back({"region_share", [](const SequenceReport&, const FrameMetrics& f, int r) {
                       if (r == kAllRegions) return field(1.0);
-                      return field(f.valid_pixels ? double(f.region_pixels[std::size_t(r)]) / double(f.valid_pixels) : kNaN);
+                      if (!f.valid_pixels) return field(kNaN);
+                      return field(double(f.region_pixels[std::size_t(r)]) / double(f.valid_pixels));
                     }});
   }
   auto value = [&](const MetricDefinition* d, std::size_t k) {
@@ -125,8 +128,9 @@ std::vector<CsvColumn> csv_layout(const ComparisonReport& report) {
   };
   auto inside_outside = [&](const MetricDefinition* d) {
     for (const bool in : {true, false})
-      cols.push_back({d->mask_columns[in ? 0 : 1], [name = d->name, in](const SequenceReport&, const FrameMetrics& f, int r) {
-                        const MetricSample* s = r == kAllRegions ? f.sample(name) : nullptr;
+      cols.push_back({d->mask_columns[in ? 0 : 1],
+                      [name = d->name, in](const SequenceReport&, const FrameMetrics& f, int r) {
+                        const MetricSample* s = r == kAllRegions ? f.sample(name) : nullptr;  // the mask: whole rows
                         return field(s ? (in ? s->inside : s->outside) : kNaN);
                       }});
   };
@@ -141,10 +145,13 @@ std::vector<CsvColumn> csv_layout(const ComparisonReport& report) {
                   }});
   // Facts of the whole frame: on its `all` row only.
   auto whole = [](std::function<std::string(const FrameMetrics&)> get) {
-    return [get](const SequenceReport&, const FrameMetrics& f, int r) { return r == kAllRegions ? get(f) : std::string(); };
+    return [get](const SequenceReport&, const FrameMetrics& f, int r) {
+      return r == kAllRegions ? get(f) : std::string();
+    };
   };
   cols.push_back({"nonfinite_test", whole([](const FrameMetrics& f) { return std::to_string(f.nonfinite_test); })});
-  cols.push_back({"nonfinite_reference", whole([](const FrameMetrics& f) { return std::to_string(f.nonfinite_reference); })});
+  cols.push_back(
+      {"nonfinite_reference", whole([](const FrameMetrics& f) { return std::to_string(f.nonfinite_reference); })});
   cols.push_back({"compute_ms", whole([](const FrameMetrics& f) { return field(f.compute_ms, 8); })});
   cols.push_back({"metrics_ms", whole([](const FrameMetrics& f) { return field(f.metrics_ms, 5); })});
   if (mask) {
@@ -224,7 +231,8 @@ nlohmann::ordered_json metric_json(const ComparisonReport& report, const Sequenc
 
 // The pooled PSNR of `metric` in `region` (pooled_summary): the value over all pixels of all frames, its 95 %
 // block-bootstrap interval and the frames that entered it.
-nlohmann::ordered_json pooled_json(const SequenceReport& s, const std::string& metric, int region, const BootstrapOptions& o) {
+nlohmann::ordered_json pooled_json(const SequenceReport& s, const std::string& metric, int region,
+                                   const BootstrapOptions& o) {
   const MeanInterval m = pooled_summary(s, metric, region, o);
   if (m.count == 0) return nullptr;
   return {{"value", jnum(m.mean)}, {"ci95", jinterval(m.ci)}, {"frames", m.count}};
@@ -453,7 +461,8 @@ std::string summary_table(const ComparisonReport& report) {
       for (const auto* d : defs)
         put(cell(series_mean(region_series(s, d->name, r)), d->table_format), d->table_width, false);
       for (const auto* d : pooled)
-        put(cell(pooled_psnr(region_series(s, d->name, r), region_weights(s, r)), d->table_format), pooled_width(d), false);
+        put(cell(pooled_psnr(region_series(s, d->name, r), region_weights(s, r)), d->table_format), pooled_width(d),
+            false);
       out += '\n';
     }
   return out;
