@@ -50,7 +50,7 @@ if [[ "${HTML_REPORT:-1}" != 0 ]]; then
     names+=",$m"
   done
   "$(tool_path compare)" --reference "$d/render/reference.####.exr" "${tests[@]}" --names "$names" \
-    --gbuffer "$d/render/gbuffer.####.exr" --flip ldr \
+    --gbuffer "$d/render/gbuffer.####.exr" --regions motion --flip ldr \
     --title "$scene_name, filter-phlm (seed 003), $SIZE, 1 spp against 16 spp" --report "$REPORT/report" > /dev/null
   html="$REPORT/report/index.html"
   say "HTML report written in $(( $(date +%s) - report_start )) s"

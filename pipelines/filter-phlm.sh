@@ -22,7 +22,10 @@
 #   REUSE_RENDER=1 (keep an existing render folder instead of rendering again, e.g. after changing only the
 #   filters), REUSE_OUTPUTS=1 (keep existing filtered sequences: measure again only), WARMUP (frames compare
 #   reports apart as warm-up, default 10 = 1 / TAA's alpha; only when compare has --warmup), PAIRS (paired differences printed, "A:B,..."; default: phlm and taa against each other, the input
-#   and the previous TAA).
+#   and the previous TAA), REGIONS (compare --regions: motion (default) or none), STATIC_FRAMES (compare
+#   --static-frames, default 10), NOISE_FLOOR_FRAMES (default 3; 0: none): the first N frames of the reference are
+#   also rendered at 4x REFERENCE_SPP and compare scores the reference against them: the reference's noise floor
+#   (PSNR(reference, 4x reference)), printed above each scene's table; a best score within 10 dB of it is flagged.
 #
 # The comparison target: render-gbuffer's `color` is the shading payload's R,G,B at one sample per pixel with
 # the chosen jitter, and its `reference` is the same payload's R,G,B averaged over --reference-spp samples at
@@ -46,6 +49,9 @@ VARIANTS="${VARIANTS-taa-0.1 taa --taa-alpha 0.1
 taa-2014 taa --taa-velocity centre --taa-clip minmax --taa-alpha 0.04}"
 RENDERS="${RENDERS:-$OUT}"
 WARMUP="${WARMUP:-10}"
+REGIONS="${REGIONS:-motion}"
+NOISE_FLOOR_FRAMES="${NOISE_FLOOR_FRAMES:-3}"
+STATIC_FRAMES="${STATIC_FRAMES:-10}"
 PAIRS="${PAIRS:-phlm:taa,phlm:taa-0.1,phlm:input,taa:input,taa:taa-0.1,phlm:fxaa,phlm:ema,taa-0.1:taa-2014}"
 
 require_tools render-gbuffer filter-phlm compare
@@ -76,6 +82,11 @@ while read -r n m args; do [[ -n "$n" ]] && runs+=("$n --method $m $args"); done
 compare_args=()
 compare_help="$("$compare" --help 2>/dev/null || true)"
 if [[ "$compare_help" == *--warmup* ]]; then compare_args+=(--warmup "$WARMUP"); fi
+# Every metric also per region (static / moving / disoccluded, from the G-buffer; docs/compare.md "Regions"): the
+# tables show where a method wins and where it loses, not only the whole-frame mean.
+if [[ "$REGIONS" != none && "$compare_help" == *--regions* ]]; then
+  compare_args+=(--regions "$REGIONS" --static-frames "$STATIC_FRAMES")
+fi
 {
   echo "# filter-phlm: seed 003 Table 2 on the built-in scenes"
   echo
@@ -118,6 +129,23 @@ for scene in "${scenes[@]}"; do
       --out "$dir/$n/$n.####.exr" $args $FILTER_ARGS
   done
 
+  # The reference's noise floor: its first NOISE_FLOOR_FRAMES frames at 4x the samples, scored by compare.
+  floor_json=""
+  if [[ "$NOISE_FLOOR_FRAMES" -gt 0 ]]; then
+    first="${FRAMES%%-*}"
+    floor_frames="$first-$(( first + NOISE_FLOOR_FRAMES - 1 ))"
+    floor_dir="$RENDERS/$name/render-4x"
+    if [[ ! ( "$REUSE_RENDER" == 1 && -d "$floor_dir" ) ]]; then
+      echo "== $name: the reference at $(( 4 * REFERENCE_SPP )) spp, frames $floor_frames (noise floor)" >&2
+      # shellcheck disable=SC2086
+      "$render" "$scene" --out "$floor_dir" --size "$SIZE" --fps "$FPS" --frames "$floor_frames" \
+        --outputs reference --jitter random --reference-spp $(( 4 * REFERENCE_SPP )) $RENDER_ARGS
+    fi
+    "$compare" --reference "$floor_dir/reference.####.exr" "$render_dir/reference.####.exr" --names reference \
+      --frames "$floor_frames" --json "$dir/noise-floor.json" > /dev/null
+    floor_json="$dir/noise-floor.json"
+  fi
+
   echo "== $name: compare" >&2
   "$compare" --reference "$render_dir/reference.####.exr" "${tests[@]}" --names "$seq_names" \
     --gbuffer "$render_dir/gbuffer.####.exr" --csv "$dir/metrics.csv" --json "$dir/metrics.json" \
@@ -126,6 +154,10 @@ for scene in "${scenes[@]}"; do
   {
     echo "## $name"
     echo
+    if [[ -n "$floor_json" ]]; then
+      python3 "$TABLES" noise-floor "$floor_json" "$dir/metrics.json" "$REFERENCE_SPP" "$(( 4 * REFERENCE_SPP ))"
+      echo
+    fi
     echo '```'
     cat "$dir/table.txt"
     echo '```'

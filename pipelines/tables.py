@@ -9,7 +9,9 @@ Tables:
       per scene (OUT_DIR/SCENE/metrics.json): mean PSNR (RGB) over frames with its 95% interval and the
       steady-state mean (after compare's --warmup frames), mean flicker; the mean of those over the scenes (not
       compare's: one compare run sees one scene); then the paired differences A - B (PSNR, and flicker) with
-      their 95% intervals for each PAIR "A:B" (names as given to compare --names)
+      their 95% intervals for each PAIR "A:B" (names as given to compare --names); when compare ran with
+      --regions motion, a table per region (share, mean PSNR [95%] / pooled PSNR) and the paired differences per
+      region
   tables.py scenes-by-row OUT_DIR ...
       the same, with the paired differences one row per pair and one column per scene, PSNR only (ablations)
   tables.py upsample-st SCENE_DIR SHADE_LOW_MS SHADE_FULL_MS [SS_JSON SS_LABEL]
@@ -31,6 +33,10 @@ Tables:
       rows "scene,score,metric,a,b,frames,mean_difference_db,ci_low,ci_high" of compare's paired differences
   tables.py morph-summary SUMMARY.csv
       morph-120hz.sh's summary table (Markdown) from its summary.csv
+  tables.py noise-floor FLOOR_JSON METRICS_JSON SPP SPP4
+      the reference's noise floor: compare's PSNR (RGB) of the SPP-spp reference against the SPP4-spp one
+      (FLOOR_JSON: mean over its frames with the 95% interval, and pooled), and whether the best mean PSNR of
+      METRICS_JSON comes within 10 dB of it (then the table cannot rank methods finer than the reference's noise)
 Numbers compare does not compute (see that section):
   tables.py csv-mean CSV COLUMN [DIGITS]          mean of a column (render-gbuffer's timings.csv)
   tables.py pass-ms-mean TIMINGS.csv [DIGITS]     mean over frames of the sum of render-gbuffer's pass columns
@@ -176,6 +182,7 @@ def scenes(out_dir, scene_list, seq_list, pair_list, by_row=False):
         means.append(f"{fmt(mp)} / {fmt(mf, 4)}")
     out.append("| mean of the scenes | " + " | ".join(means) + " |")
     print("\n".join(out))
+    region_tables(data, scene_list, seq_list, pair_list)
     if not pair_list:
         return
     if by_row:
@@ -197,7 +204,7 @@ def scenes(out_dir, scene_list, seq_list, pair_list, by_row=False):
                 for key, digits in (("psnr_rgb", 2), ("flicker", 4)):
                     hit = None
                     for p in paired:
-                        if p.get("metric") == key and {p.get("a"), p.get("b")} == {a, b}:
+                        if p.get("metric") == key and {p.get("a"), p.get("b")} == {a, b} and whole_frame(p):
                             hit = p
                             break
                     if hit is not None and part == "steady":
@@ -214,10 +221,10 @@ def scenes(out_dir, scene_list, seq_list, pair_list, by_row=False):
             print(f"| {s} | " + " | ".join(cells) + " |")
 
 
-def paired_value(paired, key, a, b, part):
+def paired_value(paired, key, a, b, part, region="all"):
     """(mean of a - b, sorted 95% interval or None) from compare's `paired`, over all frames or the steady state."""
     for p in paired or []:
-        if p.get("metric") == key and {p.get("a"), p.get("b")} == {a, b}:
+        if p.get("metric") == key and {p.get("a"), p.get("b")} == {a, b} and p.get("region", "all") == region:
             sign = 1.0 if p["a"] == a else -1.0
             hit = p.get("steady") if part == "steady" else p
             if hit is None or hit.get("mean_difference") is None:
@@ -245,9 +252,64 @@ def pairs_by_row(data, scene_list, pair_list):
 def _orient(paired, key, a, b):
     """True when compare's entry for {a, b} and `key` is a - b (not b - a)."""
     for p in paired:
-        if p.get("metric") == key and {p.get("a"), p.get("b")} == {a, b}:
+        if p.get("metric") == key and {p.get("a"), p.get("b")} == {a, b} and whole_frame(p):
             return p["a"] == a
     return True
+
+
+def whole_frame(p):
+    """True for a paired entry of the whole frame (compare --regions adds entries per region)."""
+    return p.get("region", "all") == "all"
+
+
+REGIONS = ("static", "moving", "disoccluded")
+
+
+def region_tables(data, scene_list, seq_list, pair_list):
+    """With compare --regions motion (docs/compare.md, Regions): per scene and region the pixel share, then per
+    sequence the mean PSNR (RGB) over frames [95% interval] / the pooled PSNR (PSNR of the pooled squared error);
+    then the paired differences A - B of the mean PSNR per region. Nothing when no scene has regions."""
+    if not any("regions" in q for s in scene_list for q in data[s]["sequences"]):
+        return
+    print()
+    print("Per region (compare --regions motion): share of the pixels; mean PSNR (RGB, dB) over frames [95% interval]"
+          " / pooled PSNR (of the squared error over all the region's pixels and frames):\n")
+    print("| scene | region | share | " + " | ".join(seq_list) + " |")
+    print("|---|---|---|" + "---|" * len(seq_list))
+    for s in scene_list:
+        by = {q["name"]: q for q in data[s]["sequences"]}
+        for region in ("all",) + REGIONS:
+            share, cells = None, []
+            for name in seq_list:
+                q = by.get(name)
+                if q is None:
+                    cells.append("")
+                    continue
+                if region == "all":
+                    m, pooled, share = q.get("psnr_rgb") or {}, q.get("psnr_rgb_pooled") or {}, 1.0
+                else:
+                    r = (q.get("regions") or {}).get(region) or {}
+                    m, pooled = r.get("psnr_rgb") or {}, r.get("psnr_rgb_pooled") or {}
+                    share = r.get("share", share)
+                if num(m.get("mean")) is None:  # an empty region (e.g. no static pixels yet)
+                    cells.append("n/a")
+                else:
+                    cells.append(cell(num(m.get("mean")), m.get("ci95")) + " / " + fmt(num(pooled.get("value"))))
+            print(f"| {s} | {region} | {fmt(100.0 * share, 1) + ' %' if share is not None else 'n/a'} | "
+                  + " | ".join(cells) + " |")
+    if not pair_list:
+        return
+    print()
+    print("Paired differences A - B of the mean PSNR (RGB, dB) per region [95% interval] (compare's `paired`):\n")
+    print("| scene | region | " + " | ".join(f"{a} - {b}" for a, b in pair_list) + " |")
+    print("|---|---|" + "---|" * len(pair_list))
+    for s in scene_list:
+        for region in REGIONS:
+            cells = []
+            for a, b in pair_list:
+                d, ci = paired_value(data[s].get("paired"), "psnr_rgb", a, b, "all", region)
+                cells.append(cell(d, ci, 2, sign=True) if d is not None else "n/a")
+            print(f"| {s} | {region} | " + " | ".join(cells) + " |")
 
 
 def upsample_st(scene_dir, low, full, ss_json=None, ss_label=None):
@@ -321,11 +383,32 @@ def paired_rows(path, scene, score, key):
     def f(v):
         return "" if v is None or isinstance(v, str) else "%.3f" % v
     for p in json.load(open(path)).get("paired", []):
-        if p["metric"] != key:
+        if p["metric"] != key or not whole_frame(p):
             continue
         ci = p.get("ci95") or [None, None]
         print(",".join([scene, score, p["metric"], p["a"], p["b"], str(p["frames"]), f(p["mean_difference"]),
                         f(ci[0]), f(ci[1])]))
+
+
+def noise_floor(floor_path, metrics_path, spp, spp4):
+    q = json.load(open(floor_path))["sequences"][0]
+    m = q.get("psnr_rgb") or {}
+    floor = num(m.get("mean"))
+    pooled = num((q.get("psnr_rgb_pooled") or {}).get("value"))
+    line = (f"Noise floor: PSNR (RGB) of the {spp}-spp reference against a {spp4}-spp render of its first "
+            f"{m.get('frames', 0)} frames: {cell(floor, m.get('ci95'))} dB (pooled {fmt(pooled)} dB).")
+    best = None
+    for s in json.load(open(metrics_path))["sequences"]:
+        v = num((s.get("psnr_rgb") or {}).get("mean"))
+        if v is not None and math.isfinite(v) and (best is None or v > best[1]):
+            best = (s["name"], v)
+    if best is not None and floor is not None and math.isfinite(floor):
+        if best[1] > floor - 10.0:
+            line += (f" The best mean PSNR ({best[0]}, {fmt(best[1])} dB) is within 10 dB of it: differences between"
+                     " methods near the top are partly the reference's noise.")
+        else:
+            line += f" The best mean PSNR ({best[0]}, {fmt(best[1])} dB) is {fmt(floor - best[1])} dB below it."
+    print(line)
 
 
 def morph_summary(path):
@@ -447,6 +530,7 @@ def main(argv):
         "value": (3, 4, lambda a: value(*a)),
         "paired-rows": (4, 4, lambda a: paired_rows(*a)),
         "morph-summary": (1, 1, lambda a: morph_summary(a[0])),
+        "noise-floor": (4, 4, lambda a: noise_floor(*a)),
         "csv-mean": (2, 3, lambda a: csv_mean(*a)),
         "pass-ms-mean": (1, 2, lambda a: pass_ms_mean(*a)),
         "mean": (0, 1, lambda a: mean(*a)),

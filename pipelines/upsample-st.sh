@@ -26,7 +26,8 @@
 #   as the warm-up, default FACTOR^2: the pattern's length), NOISE_AVERAGED_SPP (default 0; N > 0 also renders the
 #   noise-averaged reference - N samples at every pixel centre, each with its own SSAO pattern and VPL set,
 #   render-gbuffer --reference-jitter none - and scores every method against it too: the target of methods that
-#   accumulate, issue 15 item 6), RENDERS (folder holding SCENE/render, default OUT_DIR), REUSE_RENDER=1 (keep an
+#   accumulate, issue 15 item 6), REGIONS (compare --regions for the main comparison: motion (default) or none;
+#   STATIC_FRAMES its --static-frames, default 10), RENDERS (folder holding SCENE/render, default OUT_DIR), REUSE_RENDER=1 (keep an
 #   existing render folder).
 #
 # Ground truth: the issue and the paper's Figure 8 measure against full-resolution rendering of the same payload
@@ -66,6 +67,12 @@ require_tools render-gbuffer upsample-st compare
 render="$(tool_path render-gbuffer)"
 upsample="$(tool_path upsample-st)"
 compare="$(tool_path compare)"
+# Every metric also per region (static / moving / disoccluded, from the G-buffer; docs/compare.md "Regions").
+REGIONS="${REGIONS:-motion}"
+region_args=()
+if [[ "$REGIONS" != none && "$("$compare" --help 2>/dev/null || true)" == *--regions* ]]; then
+  region_args=(--regions "$REGIONS" --static-frames "${STATIC_FRAMES:-10}")
+fi
 
 # Every run: "NAME ARGUMENTS" (METHODS through the method table, then the VARIANTS lines as given).
 runs=()
@@ -154,7 +161,7 @@ for scene in "${scenes[@]}"; do
   echo "== $name: compare against the full-resolution payload" >&2
   "$compare" --reference "$render_dir/color.####.exr" "${tests[@]}" --names "$seq_names" \
     --gbuffer "$render_dir/gbuffer.####.exr" --csv "$dir/metrics.csv" --json "$dir/metrics.json" \
-    --warmup "$WARMUP" --plot "$dir/psnr.png" | tee "$dir/compare.txt"
+    --warmup "$WARMUP" --plot "$dir/psnr.png" "${region_args[@]}" | tee "$dir/compare.txt"
   if [[ "$REFERENCE_SPP" -gt 0 ]]; then
     echo "== $name: compare against the $REFERENCE_SPP-spp reference" >&2
     "$compare" --reference "$render_dir/reference.####.exr" "${tests[@]}" --names "$seq_names" \

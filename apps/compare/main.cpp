@@ -28,7 +28,7 @@ int main(int argc, char** argv) {
   ComparisonSetup setup;
   CompareOutputs out;
   PictureOptions& pic = out.pictures;
-  std::string frames, peak = "1", fail_on = "mean", profile = "row", flip = flip_mode_name(setup.flip);
+  std::string frames, peak = "1", fail_on = "mean", profile = "row", flip = flip_mode_name(setup.flip), regions = "none";
   std::vector<std::string> crops;
   std::optional<int> sheet_frame;
   tool.add_params({Param::list("tests", "Test sequences (one or more), e.g. taa.####.exr phlm.####.exr", &setup.tests)});
@@ -78,6 +78,20 @@ int main(int argc, char** argv) {
                           "FLIP's viewing condition in pixels per degree of visual angle (default: 0.7 m from a 0.7 m "
                           "wide 3840-pixel screen)",
                           &setup.flip_options.pixels_per_degree),
+          Param::choice("--regions",
+                        "Every metric also per region: motion = static (zero motion, history, reference unchanged for "
+                        "--static-frames frames), moving, disoccluded (the reprojection's depth/id test fails), from "
+                        "--gbuffer (motion, depth, id). CSV rows per region, JSON `regions`, a region table",
+                        &regions, {"none", "motion"}),
+          Param::integer("--static-frames",
+                         "Frames the reference must have been unchanged (and the pixel still, with history) for the "
+                         "pixel to be static",
+                         &setup.region_options.static_frames, 1, 65535),
+          Param{.flag = "--static-tolerance",
+                .help = "Largest frame-to-frame change of the reference's luminance (pixel units) that counts as "
+                        "unchanged for the static region (noise of a Monte-Carlo reference)",
+                .value = &setup.region_options.static_tolerance,
+                .min = 0.0},
           Param::text("--speed-metric",
                       "Metric judged against compute time: the speed chart's y axis and the JSON's `pareto` flags "
                       "(compare --list-metrics)",
@@ -92,7 +106,8 @@ int main(int argc, char** argv) {
           Param::text("--plot",
                       "Charts F.EXT, EXT = png, svg or pdf: F (PSNR per frame), F-psnr-y, F-ssim, F-flicker, F-flip "
                       "(with --flip), F-psnr-latency (with --latency-aware), F-speed (--speed-metric against the "
-                      "methods' own compute time)",
+                      "methods' own compute time); with --regions motion F-regions and F-psnr-static, -moving, "
+                      "-disoccluded",
                       &out.plot),
           Param::text("--title", "Title of the charts, the contact sheet and the report (e.g. the scene)", &out.title),
           Param::text("--error-maps",
@@ -178,6 +193,7 @@ int main(int argc, char** argv) {
       setup.frames = *range;
     }
     if (auto st = set_peak(peak, setup); !st) return st;
+    setup.regions = regions == "motion";
     setup.flip = flip == "ldr" ? FlipMode::Ldr : flip == "hdr" ? FlipMode::Hdr : FlipMode::Off;  // checked: a choice
     for (const auto& c : crops) {
       auto rect = parse_crop(c);

@@ -318,6 +318,85 @@ TEST_F(CompareCli, ShardsMergeIntoTheSingleRunExactly) {
   EXPECT_NE(out.find("--reference"), std::string::npos) << out;
 }
 
+// Issue 24: --regions motion with its errors (no --gbuffer, a G-buffer without depth and ids, a G-buffer of another
+// size), the CSV's region rows and JSON's regions, and shards that merge into the single run (the static test looks
+// back --static-frames frames, which a shard primes).
+TEST_F(CompareCli, RegionsFromTheGbuffer) {
+  for (int f = 1; f <= 3; ++f) {
+    char digits[8];
+    std::snprintf(digits, sizeof digits, "%04d", f);
+    Image g(64, 40), small(32, 20);
+    float* mx = g.add_channel("motion.X", 0.0f);
+    g.add_channel("motion.Y", 0.0f);
+    g.add_channel("depth.Z", 2.0f);
+    g.add_uint_channel("id", 1);
+    for (int y = 0; y < 40; ++y)
+      for (int x = 40; x < 64; ++x) mx[y * 64 + x] = -0.5f;  // a moving part on the right
+    for (const char* c : {"motion.X", "motion.Y", "depth.Z"}) small.add_channel(c, 0.0f);
+    small.add_uint_channel("id", 1);
+    ASSERT_TRUE(write_exr((dir_ / (std::string("gd.") + digits + ".exr")).string(), g));
+    ASSERT_TRUE(write_exr((dir_ / (std::string("gs.") + digits + ".exr")).string(), small));
+  }
+  std::string out;
+  EXPECT_EQ(run("--reference ref.####.exr a.####.exr --regions motion", &out), 1) << out;
+  EXPECT_NE(out.find("--regions motion needs --gbuffer"), std::string::npos) << out;
+  EXPECT_EQ(run("--reference ref.####.exr a.####.exr --regions motion --gbuffer g.####.exr", &out), 2) << out;
+  EXPECT_NE(out.find("depth.Z"), std::string::npos) << out;
+  EXPECT_EQ(run("--reference ref.####.exr a.####.exr --regions motion --gbuffer gs.####.exr", &out), 2) << out;
+  EXPECT_NE(out.find("G-buffer is 32x20"), std::string::npos) << out;
+  EXPECT_EQ(run("--reference ref.####.exr a.####.exr --regions plenty --gbuffer gd.####.exr", &out), 1) << out;
+  EXPECT_EQ(run("--reference ref.####.exr a.####.exr --regions motion --gbuffer gd.####.exr --static-frames 0", &out), 1)
+      << out;
+  EXPECT_EQ(run("--reference ref.####.exr a.####.exr --regions motion --gbuffer gd.####.exr --static-tolerance -1", &out),
+            1) << out;
+
+  const std::string common =
+      "--reference ref.####.exr a.####.exr b.####.exr --gbuffer gd.####.exr --regions motion --static-frames 2";
+  ASSERT_EQ(run(common + " --csv r.csv --json r.json", &out), 0) << out;
+  EXPECT_NE(out.find("psnr_rgb_pooled"), std::string::npos) << out;
+  EXPECT_NE(out.find("static"), std::string::npos) << out;
+  const auto csv = read_text(dir_ / "r.csv");
+  std::istringstream lines(csv);
+  std::string line;
+  std::vector<std::string> rows;
+  while (std::getline(lines, line)) rows.push_back(line);
+  ASSERT_EQ(rows.size(), 1u + 3 * 2 * 4) << csv;
+  EXPECT_EQ(rows[0].rfind("frame,sequence,region,region_share,psnr_rgb_db,", 0), 0u) << rows[0];
+  EXPECT_EQ(rows[1].rfind("1,a,all,1,", 0), 0u) << rows[1];
+  EXPECT_EQ(rows[2].rfind("1,a,static,0,", 0), 0u) << rows[2];        // no previous frame: nothing static,
+  EXPECT_EQ(rows[4].rfind("1,a,disoccluded,1,", 0), 0u) << rows[4];   // everything disoccluded
+  // Frame 3: still for 2 frames on the left (40 of 64 columns) -> static; the right moves.
+  EXPECT_EQ(rows[18].rfind("3,a,static,0.625,", 0), 0u) << rows[18];
+  EXPECT_EQ(rows[19].rfind("3,a,moving,0.375,", 0), 0u) << rows[19];
+  const auto j = nlohmann::json::parse(read_text(dir_ / "r.json"));
+  EXPECT_EQ(j["regions"]["kind"], "motion");
+  EXPECT_EQ(j["regions"]["static_frames"], 2);
+  const auto& regions = j["sequences"][0]["regions"];
+  double share = 0.0;
+  for (const char* r : {"static", "moving", "disoccluded"}) {
+    ASSERT_TRUE(regions.contains(r)) << r;
+    share += regions[r]["share"].get<double>();
+    EXPECT_TRUE(regions[r].contains("psnr_rgb_pooled")) << r;
+  }
+  EXPECT_NEAR(share, 1.0, 1e-12);
+  EXPECT_TRUE(j["sequences"][0].contains("psnr_rgb_pooled"));
+  EXPECT_TRUE(j["sequences"][0].contains("psnr_y_pooled"));
+
+  // Shards: frames 1-2 and 3 (primed from 1 and 2) merge into the single run exactly.
+  ASSERT_EQ(run(common + " --frames 1-2 --csv s1.csv", &out), 0) << out;
+  ASSERT_EQ(run(common + " --frames 3-3 --csv s2.csv", &out), 0) << out;
+  ASSERT_EQ(run("--merge s1.csv s2.csv --json merged.json", &out), 0) << out;
+  const auto merged = nlohmann::json::parse(read_text(dir_ / "merged.json"));
+  for (std::size_t s = 0; s < 2; ++s) {
+    EXPECT_EQ(j["sequences"][s]["regions"], merged["sequences"][s]["regions"]) << s;
+    EXPECT_EQ(j["sequences"][s]["psnr_rgb_pooled"], merged["sequences"][s]["psnr_rgb_pooled"]) << s;
+  }
+  EXPECT_EQ(j["paired"], merged["paired"]);
+  // A shard with regions and one without do not merge.
+  ASSERT_EQ(run("--reference ref.####.exr a.####.exr b.####.exr --frames 3-3 --csv plain.csv", &out), 0) << out;
+  EXPECT_EQ(run("--merge s1.csv plain.csv --json never.json", &out), 2) << out;
+}
+
 // Issue 21: the registry is the one list of metrics (--list-metrics), and the JSON flags the Pareto front of compute
 // time against --speed-metric (the speed chart's front), so that scripts read it instead of recomputing it.
 TEST_F(CompareCli, ListsMetricsAndFlagsTheParetoFront) {

@@ -506,10 +506,11 @@ TEST(Comparison, FlipOffLeavesTheOutputsAsTheyWere) {
   EXPECT_FALSE(j.contains("flip"));
   EXPECT_FALSE(j["sequences"][0].contains("flip"));
   EXPECT_EQ(j["thresholds"].size(), 4u);  // psnr_rgb, ssim, flicker, judged_on
-  // The table's header as compare printed it before the registry (printf with fixed widths).
-  char header[160];
-  std::snprintf(header, sizeof header, "%-20s %7s %10s %10s %9s %11s %11s\n", "sequence", "frames", "psnr_rgb",
-                "psnr_y", "ssim", "flicker", "compute_ms");
+  // The table's header as compare printed it before the registry (printf with fixed widths), then (issue 24) the
+  // pooled PSNRs after compute_ms, so that the columns before keep their places.
+  char header[200];
+  std::snprintf(header, sizeof header, "%-20s %7s %10s %10s %9s %11s %11s %15s %13s\n", "sequence", "frames",
+                "psnr_rgb", "psnr_y", "ssim", "flicker", "compute_ms", "psnr_rgb_pooled", "psnr_y_pooled");
   const std::string table = summary_table(*report);
   EXPECT_EQ(table.rfind(header, 0), 0u) << table;
 }
@@ -668,6 +669,299 @@ TEST(SetPeak, NumbersMaxAndRefusals) {
     EXPECT_EQ(st.error().kind, ErrorKind::Usage) << bad;
     EXPECT_NE(st.error().message.find("--peak"), std::string::npos) << bad;
   }
+}
+
+// --- Regions and pooled PSNR (issue 24) ---------------------------------------------------------------------
+
+// 4x4, frame 1 against frame 0, one pixel of each kind the classification knows (S static, M moving, D
+// disoccluded):
+//   D S M D     (0,0): motion -1 px in x fetches off screen; column 2: motion -1 px (same surface, a hit);
+//   S S M D     column 3: rows 0-1 change material id, rows 2-3 depth 1 -> 2 (beyond the 5 % tolerance): the
+//   S S M D     depth/id test of temporal/core/reproject.h fails;
+//   S M M D     (1,3): still, but the reference's luminance changed by 0.5 > tolerance.
+TEST(Regions, HandClassifiedFourByFour) {
+  const int w = 4, h = 4;
+  const std::size_t n = 16;
+  std::vector<float> mx(n, 0.0f), my(n, 0.0f), z(n, 1.0f), pz(n, 1.0f), y(n, 0.3f), py(n, 0.3f);
+  std::vector<std::uint32_t> id(n, 1), pid(n, 1);
+  mx[0] = -1.0f;
+  for (int r = 0; r < h; ++r) mx[std::size_t(r * w + 2)] = -1.0f;
+  id[3] = id[7] = 2;
+  z[11] = z[15] = 2.0f;
+  y[13] = 0.8f;
+  RegionInputs in;
+  in.width = w;
+  in.height = h;
+  in.motion_x = mx.data();
+  in.motion_y = my.data();
+  in.depth = z.data();
+  in.id = id.data();
+  in.previous_depth = pz.data();
+  in.previous_id = pid.data();
+  in.reference_y = y.data();
+  in.previous_reference_y = py.data();
+  RegionOptions o;
+  o.static_frames = 2;
+  std::vector<std::uint16_t> still(n, 0);
+  std::vector<std::uint8_t> labels(n, 99);
+  // Frame 0: no previous frame, so no history anywhere.
+  in.has_previous = false;
+  classify_regions(in, o, still, labels);
+  for (std::size_t i = 0; i < n; ++i) EXPECT_EQ(labels[i], kRegionDisoccluded) << i;
+  const char* expected = "DSMD" "SSMD" "SSMD" "SMMD";
+  auto code = [](std::uint8_t l) { return l == kRegionStatic ? 'S' : l == kRegionMoving ? 'M' : 'D'; };
+  // Frame 1: the still pixels have been still for 1 frame, fewer than --static-frames 2: moving.
+  in.has_previous = true;
+  y[13] = 0.8f;
+  classify_regions(in, o, still, labels);
+  for (std::size_t i = 0; i < n; ++i) EXPECT_EQ(code(labels[i]), expected[i] == 'S' ? 'M' : expected[i]) << i;
+  // Frame 2, same inputs but the reference of (1,3) unchanged since frame 1 (still 1 there): the others reach 2.
+  py[13] = 0.8f;
+  classify_regions(in, o, still, labels);
+  for (std::size_t i = 0; i < n; ++i) EXPECT_EQ(code(labels[i]), expected[i]) << i;
+  EXPECT_EQ(still[13], 1);
+  EXPECT_EQ(still[5], 2);
+  // A camera cut (no history) resets every count.
+  in.has_previous = false;
+  classify_regions(in, o, still, labels);
+  EXPECT_EQ(still[5], 0);
+}
+
+TEST(Regions, PooledPsnrIsThePsnrOfThePooledSquaredError) {
+  // Two frames at 20 dB (MSE 0.01) and 10 dB (MSE 0.1), equal pixels: pooled MSE 0.055 -> 12.5964 dB, while the
+  // mean of the frames' PSNRs is 15 dB.
+  const std::vector<double> p = {20.0, 10.0}, w = {100.0, 100.0};
+  EXPECT_NEAR(pooled_psnr(p, w), -10.0 * std::log10(0.055), 1e-12);
+  // Weights are pixel counts: 300 pixels at MSE 0.01 and 100 at 0.1 -> (3 + 10) / 400.
+  EXPECT_NEAR(pooled_psnr(p, std::vector<double>{300.0, 100.0}), -10.0 * std::log10(13.0 / 400.0), 1e-12);
+  // The firefly case: 19 frames at 40 dB and one at 15 dB. Mean of PSNRs 38.75 dB; pooled 27.76 dB.
+  std::vector<double> ff(20, 40.0), fw(20, 1.0);
+  ff[7] = 15.0;
+  EXPECT_NEAR(pooled_psnr(ff, fw), -10.0 * std::log10((19 * 1e-4 + std::pow(10.0, -1.5)) / 20.0), 1e-9);
+  // +inf frames add no error, NaN frames and empty weights are left out, one -inf frame makes it -inf.
+  EXPECT_NEAR(pooled_psnr(std::vector<double>{20.0, INFINITY, NAN}, std::vector<double>{1.0, 1.0, 1.0}),
+              -10.0 * std::log10(0.005), 1e-12);
+  EXPECT_TRUE(std::isinf(pooled_psnr(std::vector<double>{INFINITY}, std::vector<double>{1.0})));
+  EXPECT_EQ(pooled_psnr(std::vector<double>{20.0, -INFINITY}, std::vector<double>{1.0, 1.0}), -INFINITY);
+  EXPECT_TRUE(std::isnan(pooled_psnr(std::vector<double>{20.0}, std::vector<double>{0.0})));
+  // The interval holds the value; a constant series has a zero-width interval; the paired difference of a series with
+  // itself is 0.
+  const MeanInterval m = bootstrap_pooled_psnr(ff, fw);
+  EXPECT_EQ(m.count, 20u);
+  EXPECT_DOUBLE_EQ(m.mean, pooled_psnr(ff, fw));
+  EXPECT_LE(m.ci.low, m.mean);
+  EXPECT_GE(m.ci.high, m.mean);
+  EXPECT_LT(m.ci.low, m.ci.high);
+  const MeanInterval c = bootstrap_pooled_psnr(std::vector<double>(10, 30.0), std::vector<double>(10, 5.0));
+  EXPECT_NEAR(c.ci.low, 30.0, 1e-9);
+  EXPECT_NEAR(c.ci.high, 30.0, 1e-9);
+  const MeanInterval d = bootstrap_pooled_psnr_difference(ff, fw, ff, fw);
+  EXPECT_EQ(d.mean, 0.0);
+  EXPECT_EQ(d.ci.low, 0.0);
+  EXPECT_EQ(d.ci.high, 0.0);
+}
+
+// 12x12 (the SSIM window needs 11x11), two frames, reference 0.5 everywhere and unchanged; the G-buffer's depth is
+// 1 and ids 1, except at frame 1 columns 8-11 change id (disoccluded) and columns 4-7 move by -1 px in x (a hit:
+// moving); columns 0-3 are static (--static-frames 1). The test errs by 0.1 on every channel at frame 0 (all
+// disoccluded: no previous frame), and at frame 1 by 0.1 / 0.2 / 0.4 in the static / moving / disoccluded columns.
+//   frame 1 PSNR: static 20 dB, moving 10 log10(1/0.04) = 13.979 dB, disoccluded 10 log10(1/0.16) = 7.959 dB,
+//                 all: MSE (0.01 + 0.04 + 0.16) / 3 = 0.07 -> 11.549 dB; frame 0: 20 dB (all and disoccluded).
+//   psnr_rgb (mean of frames) = (20 + 11.549) / 2 = 15.775 dB; psnr_rgb_pooled: MSE (0.01 + 0.07) / 2 = 0.04 ->
+//   13.979 dB; disoccluded pooled: (144 x 0.01 + 48 x 0.16) / 192 = 0.0475 -> 13.233 dB.
+TEST(Regions, PerRegionAndPooledValuesOnAHandMadeSequence) {
+  const auto dir = test::scratch_dir("comparison-regions");
+  const int w = 12, h = 12;
+  for (int f = 0; f < 2; ++f) {
+    Image ref(w, h), t(w, h), g(w, h);
+    for (const char* c : {"R", "G", "B"}) {
+      ref.add_channel(c, 0.5f);
+      float* tp = t.add_channel(c);
+      for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x) tp[y * w + x] = 0.5f + (f == 0 ? 0.1f : x < 4 ? 0.1f : x < 8 ? 0.2f : 0.4f);
+    }
+    float* mx = g.add_channel("motion.X", 0.0f);
+    g.add_channel("motion.Y", 0.0f);
+    g.add_channel("depth.Z", 1.0f);
+    std::uint32_t* id = g.add_uint_channel("id", 1);
+    float* inside = g.add_channel("half", 0.0f);  // a mask for --mask beside the regions: the left half
+    for (int y = 0; y < h; ++y)
+      for (int x = 0; x < w / 2; ++x) inside[y * w + x] = 1.0f;
+    if (f == 1)
+      for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x) {
+          if (x >= 4 && x < 8) mx[y * w + x] = -1.0f;
+          if (x >= 8) id[y * w + x] = 2;
+        }
+    write_frame(dir, "ref", f, ref);
+    write_frame(dir, "t", f, t);
+    write_frame(dir, "g", f, g);
+  }
+  // A second test, better everywhere by a constant 0.05: paired differences per region.
+  for (int f = 0; f < 2; ++f) {
+    Image u(w, h);
+    for (const char* c : {"R", "G", "B"}) u.add_channel(c, 0.55f);
+    write_frame(dir, "u", f, u);
+  }
+  ComparisonSetup setup;
+  setup.reference = pattern(dir, "ref");
+  setup.tests = {pattern(dir, "t"), pattern(dir, "u")};
+  setup.gbuffer = pattern(dir, "g");
+  setup.regions = true;
+  setup.region_options.static_frames = 1;
+  auto rep = compare_sequences(setup);
+  ASSERT_TRUE(rep) << rep.error().message;
+  const SequenceReport& s = rep->sequences[0];
+  ASSERT_EQ(s.frames.size(), 2u);
+  const FrameMetrics& f0 = s.frames[0];
+  const FrameMetrics& f1 = s.frames[1];
+  EXPECT_EQ(f0.region_pixels, (std::array<std::size_t, 3>{0, 0, 144}));
+  EXPECT_EQ(f1.region_pixels, (std::array<std::size_t, 3>{48, 48, 48}));
+  const auto* p0 = f0.sample("psnr_rgb");
+  const auto* p1 = f1.sample("psnr_rgb");
+  EXPECT_TRUE(std::isnan(p0->regions[kRegionStatic]));
+  EXPECT_NEAR(p0->regions[kRegionDisoccluded], 20.0, 1e-5);
+  EXPECT_NEAR(p1->regions[kRegionStatic], 20.0, 1e-5);
+  EXPECT_NEAR(p1->regions[kRegionMoving], -10.0 * std::log10(0.04), 1e-5);
+  EXPECT_NEAR(p1->regions[kRegionDisoccluded], -10.0 * std::log10(0.16), 1e-5);
+  EXPECT_NEAR(p1->values[0], -10.0 * std::log10(0.07), 1e-5);
+  // Luminance errs by the same amounts (R = G = B): the same values.
+  EXPECT_NEAR(f1.sample("psnr_y")->regions[kRegionMoving], -10.0 * std::log10(0.04), 1e-4);
+  // Mean of frames against pooled, whole frame and per region.
+  EXPECT_NEAR(summarize(s, "psnr_rgb").mean, (20.0 - 10.0 * std::log10(0.07)) / 2.0, 1e-5);
+  EXPECT_NEAR(pooled_summary(s, "psnr_rgb", kAllRegions, {}).mean, -10.0 * std::log10(0.04), 1e-5);
+  EXPECT_NEAR(pooled_summary(s, "psnr_rgb", kRegionDisoccluded, {}).mean, -10.0 * std::log10(0.0475), 1e-5);
+  EXPECT_NEAR(pooled_summary(s, "psnr_rgb", kRegionStatic, {}).mean, 20.0, 1e-5);
+  // The pooled error of `all` is the share-weighted combination of the regions' pooled errors, shares summing to 1.
+  double share = 0.0, combined = 0.0;
+  for (int r = 0; r < kRegionCount; ++r) {
+    share += region_share(s, r);
+    combined += region_share(s, r) * std::pow(10.0, -pooled_summary(s, "psnr_rgb", r, {}).mean / 10.0);
+  }
+  EXPECT_NEAR(share, 1.0, 1e-12);
+  // (The whole-frame kernel sums float differences, the region sums double ones: 1e-7 dB apart.)
+  EXPECT_NEAR(-10.0 * std::log10(combined), pooled_summary(s, "psnr_rgb", kAllRegions, {}).mean, 1e-6);
+  // SSIM per region: by window centre. At 12x12 the only full 11x11 windows are centred at x, y = 5, 6, in the
+  // moving columns: SSIM has a value there and none in the other regions, and it is the whole frame's.
+  const auto* ss = f1.sample("ssim");
+  ASSERT_NE(ss, nullptr);
+  EXPECT_TRUE(std::isnan(ss->regions[kRegionStatic]));
+  EXPECT_TRUE(std::isnan(ss->regions[kRegionDisoccluded]));
+  EXPECT_NEAR(ss->regions[kRegionMoving], ss->values[0], 1e-12);
+  // Flicker: none where disoccluded (no history there), a value where moving.
+  const auto* fl = f1.sample("flicker");
+  EXPECT_TRUE(std::isnan(fl->regions[kRegionDisoccluded]));
+  EXPECT_FALSE(std::isnan(fl->regions[kRegionMoving]));
+
+  // CSV: a region column, one row per region, region rows read back into the same values (merge).
+  const auto csv_path = (dir / "r.csv").string();
+  ASSERT_TRUE(write_comparison_csv(*rep, csv_path));
+  const auto csv = read_text(csv_path);
+  EXPECT_EQ(csv.rfind("frame,sequence,region,region_share,psnr_rgb_db,", 0), 0u) << csv;
+  EXPECT_NE(csv.find("\n1,t,static,0.3333333333333333,"), std::string::npos) << csv;
+  EXPECT_NE(csv.find("\n1,t,all,1,"), std::string::npos) << csv;
+  std::size_t rows = 0;
+  for (char c : csv) rows += c == '\n';
+  EXPECT_EQ(rows, 1u + 2 * 2 * 4);
+  auto back = read_comparison_csv(csv_path);
+  ASSERT_TRUE(back) << back.error().message;
+  EXPECT_TRUE(back->regions);
+  ASSERT_EQ(back->sequences[0].frames.size(), 2u);
+  EXPECT_EQ(back->sequences[0].frames[1].region_pixels, f1.region_pixels);
+  EXPECT_EQ(back->sequences[0].frames[1].sample("psnr_rgb")->regions, p1->regions);
+  EXPECT_EQ(back->sequences[0].frames[1].value("psnr_rgb"), p1->values[0]);
+
+  // JSON: pooled beside the mean, regions with shares, per-region paired differences.
+  const auto json_path = (dir / "r.json").string();
+  ASSERT_TRUE(write_comparison_json(*rep, {}, {}, "test", "", json_path));
+  const auto j = nlohmann::json::parse(read_text(json_path));
+  EXPECT_EQ(j["regions"]["static_frames"], 1);
+  const auto& js = j["sequences"][0];
+  EXPECT_NEAR(js["psnr_rgb_pooled"]["value"].get<double>(), -10.0 * std::log10(0.04), 1e-5);
+  EXPECT_EQ(js["psnr_rgb_pooled"]["ci95"].size(), 2u);
+  EXPECT_NEAR(js["regions"]["moving"]["share"].get<double>(), 48.0 / 288.0, 1e-12);
+  EXPECT_NEAR(js["regions"]["moving"]["psnr_rgb"]["mean"].get<double>(), -10.0 * std::log10(0.04), 1e-5);
+  EXPECT_EQ(js["regions"]["moving"]["psnr_rgb"]["frames"], 1);
+  EXPECT_NEAR(js["regions"]["disoccluded"]["psnr_rgb_pooled"]["value"].get<double>(), -10.0 * std::log10(0.0475), 1e-5);
+  bool region_pair = false, pooled_pair = false;
+  for (const auto& p : j["paired"]) {
+    if (p["region"] == "disoccluded" && p["metric"] == "psnr_rgb") {
+      region_pair = true;  // t errs by 0.4 there, u by 0.05: t is worse
+      EXPECT_LT(p["mean_difference"].get<double>(), 0.0);
+    }
+    if (p["region"] == "all" && p["metric"] == "psnr_rgb_pooled") {
+      pooled_pair = true;
+      EXPECT_NEAR(p["difference"].get<double>(), -10.0 * std::log10(0.04) - -10.0 * std::log10(0.0025), 1e-4);
+    }
+  }
+  EXPECT_TRUE(region_pair);
+  EXPECT_TRUE(pooled_pair);
+  // The summary table has a pooled column and a region table.
+  const std::string table = summary_table(*rep);
+  EXPECT_NE(table.find("psnr_rgb_pooled"), std::string::npos) << table;
+  EXPECT_NE(table.find("disoccluded"), std::string::npos) << table;
+
+  // --mask keeps working beside the regions: its columns hold values on the `all` rows, nothing on region rows,
+  // and the region values do not change.
+  setup.mask = "half";
+  auto masked = compare_sequences(setup);
+  ASSERT_TRUE(masked) << masked.error().message;
+  const FrameMetrics& m1 = masked->sequences[0].frames[1];
+  EXPECT_EQ(m1.sample("psnr_rgb")->regions, p1->regions);
+  EXPECT_NEAR(m1.mask_fraction, 0.5, 1e-12);
+  EXPECT_NEAR(m1.sample("psnr_rgb")->inside, -10.0 * std::log10((0.01 + 0.04 / 2.0) / 1.5), 1e-5);  // columns 0-5
+  ASSERT_TRUE(write_comparison_csv(*masked, csv_path));
+  std::istringstream masked_csv(read_text(csv_path));
+  std::string header, all_row, static_row;
+  std::getline(masked_csv, header);
+  std::getline(masked_csv, all_row);     // frame 0, t, all
+  for (int k = 0; k < 9; ++k) std::getline(masked_csv, static_row);  // past frame 0 (2 x 4 rows): frame 1, t, static
+  auto column = [](const std::string& line, std::size_t k) {
+    std::stringstream in(line);
+    std::string cell;
+    for (std::size_t i = 0; i <= k && std::getline(in, cell, ','); ++i) {}
+    return cell;
+  };
+  std::size_t in_column = 0;
+  {
+    std::stringstream in(header);
+    std::string cell;
+    for (std::size_t i = 0; std::getline(in, cell, ','); ++i)
+      if (cell == "psnr_rgb_in_db") in_column = i;
+  }
+  ASSERT_GT(in_column, 0u) << header;
+  EXPECT_EQ(static_row.rfind("1,t,static,", 0), 0u) << static_row;
+  EXPECT_FALSE(column(all_row, in_column).empty()) << all_row;
+  EXPECT_TRUE(column(static_row, in_column).empty()) << static_row;
+}
+
+TEST(Regions, NeedTheGbufferWithDepthAndIds) {
+  const auto dir = test::scratch_dir("comparison-regions-errors");
+  for (int f = 0; f < 2; ++f) {
+    write_frame(dir, "ref", f, noise_image(12, 12, 1));
+    write_frame(dir, "t", f, noise_image(12, 12, 2));
+    Image g(12, 12);
+    g.add_channel("motion.X", 0.0f);
+    g.add_channel("motion.Y", 0.0f);
+    write_frame(dir, "g", f, g);
+  }
+  ComparisonSetup setup;
+  setup.reference = pattern(dir, "ref");
+  setup.tests = {pattern(dir, "t")};
+  setup.regions = true;
+  auto none = compare_sequences(setup);
+  ASSERT_FALSE(none);
+  EXPECT_EQ(none.error().kind, ErrorKind::Usage);
+  EXPECT_NE(none.error().message.find("--gbuffer"), std::string::npos) << none.error().message;
+  setup.gbuffer = pattern(dir, "g");
+  auto flat = compare_sequences(setup);
+  ASSERT_FALSE(flat);
+  EXPECT_EQ(flat.error().kind, ErrorKind::Input);
+  EXPECT_NE(flat.error().message.find("depth.Z"), std::string::npos) << flat.error().message;
+  setup.region_options.static_frames = 0;
+  auto zero = compare_sequences(setup);
+  ASSERT_FALSE(zero);
+  EXPECT_EQ(zero.error().kind, ErrorKind::Usage);
 }
 
 }  // namespace

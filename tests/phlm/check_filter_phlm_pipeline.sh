@@ -2,7 +2,8 @@
 # Smoke test of pipelines/filter-phlm.sh and pipelines/filter-phlm-ablation.sh: a tiny render of the built-in fence
 # scene (64x48, 6 frames, 2-spp reference), every method and the default variants, then the ablation on the same
 # render. Checks the Table 2 summary (a row per scene with a finite PSNR for every sequence, the mean row, the
-# paired-difference table) and the ablation's paired table.
+# paired-difference table, the noise floor, the region table and its paired differences) and the ablation's paired
+# table.
 # Usage: check_filter_phlm_pipeline.sh BUILD_DIR OUT_DIR
 set -euo pipefail
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)"
@@ -25,6 +26,14 @@ awk -F'|' '{ for (i = 3; i < NF; ++i) { v = $i + 0; if (!(v > 5 && v < 100)) { p
 grep -qE '^\| mean of the scenes \|' "$summary" || fail "no mean row" "$summary"
 grep -qE '^\| scene \| phlm - taa: PSNR dB / flicker \|' "$summary" || fail "no paired-difference table" "$summary"
 [[ -f "$out/table2/fence/psnr.png" && -f "$out/table2/fence/metrics.json" ]] || fail "no chart or JSON"
+# Issue 24: the reference's noise floor above the scene's table, and the per-region table and paired differences
+# (6 frames are fewer than --static-frames 10: the static share is 0 %, the rows are there).
+grep -qE '^Noise floor: PSNR \(RGB\) of the 2-spp reference against a 8-spp render of its first 3 frames: [0-9.]+ ' \
+  "$summary" || fail "no noise-floor line" "$summary"
+for region in all static moving disoccluded; do
+  grep -qE "^\| fence \| $region \| [0-9.]+ % \|" "$summary" || fail "no $region row in the region table" "$summary"
+done
+grep -qE '^\| fence \| disoccluded \| [+-][0-9.]+ \[' "$summary" || fail "no per-region paired differences" "$summary"
 # The ablation reuses the render.
 SIZE=64x48 FRAMES=0-5 WARMUP=2 RENDERS="$out/table2" \
   bash "$here/pipelines/filter-phlm-ablation.sh" "$build" "$out/ablation" "$here/assets/scenes/fence.glb" \

@@ -20,6 +20,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <random>
 #include <regex>
 #include <set>
@@ -581,6 +582,63 @@ TEST_F(Report, ReportPageIsCompleteAndOffline) {
   EXPECT_NE(probe.find("r_frame_rate=40/1"), std::string::npos) << probe;
   for (const auto& e : fs::recursive_directory_iterator(d))
     EXPECT_EQ(e.path().filename().string().find(".tmp"), std::string::npos) << e.path();
+}
+
+// Issue 24: with --regions motion the report has a Regions section - one stacked share bar per sequence, the
+// per-region table whose intervals are the JSON's - and the paired differences per region and pooled.
+TEST_F(Report, RegionsSectionWithShareBarsAndTable) {
+  std::string out;
+  ASSERT_EQ(run("--reference ref.####.exr good.####.exr noisy.####.exr --names phlm,taa --gbuffer g.####.exr "
+                "--regions motion --static-frames 2 --report rep",
+                &out),
+            0)
+      << out;
+  const std::string html = read_text(dir / "rep" / "index.html");
+  for (const char* part : {"<h2 id=\"regions\">Regions</h2>", "<table class=\"regions\">", "<div class=\"share\">",
+                           "<span class=\"static\"", "<span class=\"moving\"", "<span class=\"disoccluded\"",
+                           "<th class=\"name\">region</th>", "psnr_rgb_pooled"})
+    EXPECT_NE(html.find(part), std::string::npos) << part;
+  std::size_t bars = 0;
+  for (auto at = html.find("<div class=\"share\">"); at != std::string::npos; at = html.find("<div class=\"share\">", at + 1))
+    ++bars;
+  EXPECT_EQ(bars, 2u);
+  const auto j = nlohmann::json::parse(read_text(dir / "rep" / "metrics.json"));
+  for (const auto& s : j["sequences"]) {
+    const auto& ci = s["regions"]["disoccluded"]["psnr_rgb"]["ci95"];
+    const std::string cell = "[" + format_number(ci[0].get<double>(), 4) + ", " + format_number(ci[1].get<double>(), 4) + "]";
+    EXPECT_NE(html.find(cell), std::string::npos) << s["name"] << " " << cell;
+  }
+}
+
+// The charts of --regions: the shares per frame (summing to 100 %) and PSNR per frame in each region.
+TEST_F(Report, RegionChartsFromTheReport) {
+  ComparisonSetup s = setup({"good", "noisy"}, {"phlm", "taa"});
+  s.regions = true;
+  s.region_options.static_frames = 2;
+  auto report = compare_sequences(s);
+  ASSERT_TRUE(report) << report.error().message;
+  const auto charts = comparison_charts(*report, (dir / "c.png").string(), "scene");
+  std::map<std::string, const Chart*> by;
+  for (const auto& [path, chart] : charts) by[fs::path(path).filename().string()] = &chart;
+  ASSERT_TRUE(by.count("c-regions.png"));
+  const Chart& shares = *by["c-regions.png"];
+  ASSERT_EQ(shares.series.size(), 3u);
+  EXPECT_EQ(shares.series[0].name, "static");
+  for (std::size_t k = 0; k < shares.series[0].y.size(); ++k)
+    EXPECT_NEAR(shares.series[0].y[k] + shares.series[1].y[k] + shares.series[2].y[k], 100.0, 1e-9) << k;
+  EXPECT_EQ(shares.series[2].y.front(), 100.0);  // the first frame has no history: all disoccluded
+  for (const char* region : {"static", "moving", "disoccluded"}) {
+    const std::string name = std::string("c-psnr-") + region + ".png";
+    ASSERT_TRUE(by.count(name)) << name;
+    EXPECT_EQ(by[name]->series.size(), 2u);
+    EXPECT_NE(by[name]->title.find(region), std::string::npos);
+  }
+  // Without regions, none of them.
+  s.regions = false;
+  auto plain = compare_sequences(s);
+  ASSERT_TRUE(plain);
+  for (const auto& [path, chart] : comparison_charts(*plain, (dir / "c.png").string()))
+    EXPECT_EQ(fs::path(path).filename().string().find("region"), std::string::npos) << path;
 }
 
 // The report in a browser: headless Chromium loads the page from disk, renders it to a PNG and dumps its DOM.

@@ -100,14 +100,22 @@ class Run {
     // every gap of a stepped list (--frames 0-47y3): each compared frame's flicker is its change from the frame
     // just before it, whichever frames are listed; without that frame on disk it has no flicker value (as after
     // a cut).
+    // With --regions the static test looks back static_frames frames, so that many frames before each gap are
+    // primed (as far as they are on disk and not compared anyway): a shard's regions equal a single run's.
+    const int prime_depth = setup_.regions ? std::max(1, setup_.region_options.static_frames) : 1;
     std::vector<int> order;
     std::vector<bool> primes;
     for (std::size_t i = 0; i < report_.frames.size(); ++i) {
       const int f = report_.frames[i];
       const bool gap_before = i == 0 ? bool(setup_.frames) : report_.frames[i - 1] != f - 1;
-      if (gap_before && previous_frame_exists(f - 1)) {
-        order.push_back(f - 1);
-        primes.push_back(true);
+      if (gap_before) {
+        const int floor = i == 0 ? std::numeric_limits<int>::min() : report_.frames[i - 1] + 1;
+        int first = f;  // the earliest frame of an unbroken run of frames on disk just before f
+        while (f - first < prime_depth && first - 1 >= floor && previous_frame_exists(first - 1)) --first;
+        for (int p = first; p < f; ++p) {
+          order.push_back(p);
+          primes.push_back(true);
+        }
       }
       order.push_back(f);
       primes.push_back(false);
@@ -188,6 +196,10 @@ class Run {
   }
   bool gbuf_geometry_ = false, have_prev_geometry_ = false;  // G-buffer depth and ids for the disocclusion test
   bool gbuf_warped_ = false;  // and prevDepth.Z, the expected previous depth (temporal/core/reproject.h)
+  // --regions: this frame's region of every pixel, the same as 0/1 planes, and the per-pixel count of still frames.
+  std::vector<std::uint8_t> labels_;
+  std::vector<std::uint16_t> still_;
+  std::array<std::vector<float>, kRegionCount> region_masks_;
   std::vector<float> prev_z_;
   std::vector<std::uint32_t> prev_id_;
   ExrSelection ref_sel_, gbuf_sel_;
@@ -224,6 +236,15 @@ Status Run::open() {
   report_.warmup_frames = setup_.warmup_frames;
   report_.bootstrap = setup_.bootstrap;
   report_.speed_metric = setup_.speed_metric;
+  report_.regions = setup_.regions;
+  report_.region_options = setup_.region_options;
+  if (setup_.regions && setup_.gbuffer.empty())
+    return Error::usage("--regions motion needs --gbuffer G.####.exr: the regions come from the G-buffer's motion, "
+                        "depth and ids");
+  if (setup_.region_options.static_frames < 1 || setup_.region_options.static_frames > 65535)
+    return Error::usage("--static-frames must be a whole number of frames from 1 to 65535");
+  if (!(setup_.region_options.static_tolerance >= 0.0) || !std::isfinite(setup_.region_options.static_tolerance))
+    return Error::usage("--static-tolerance must be a finite number >= 0 (a luminance change in pixel units)");
   report_.peak = setup_.peak;
   report_.peak_from_data = setup_.peak_from_data;
   report_.flip = setup_.flip;
@@ -272,6 +293,10 @@ Status Run::open() {
     gbuf_warped_ = gbuf_geometry_ && std::find(c.begin(), c.end(), "prevDepth.Z") != c.end();
     if (gbuf_warped_) gbuf_sel_.layers.push_back("prevDepth");
     report_.disocclusion_tested = gbuf_geometry_;
+    if (setup_.regions && !gbuf_geometry_)
+      return Error::input(gbuf_pattern_->path(report_.frames.front()),
+                          "has no depth.Z or no uint id channel: --regions motion needs them for the disocclusion "
+                          "test (temporal/core/reproject.h); render the G-buffer with render-gbuffer, or drop --regions");
   }
   if (gbuf_mask_) gbuf_sel_.layers.push_back(setup_.mask);
   if (gbuf_pattern_ && hooks_.frame && !hooks_.gbuffer_layers.empty()) {  // what the pictures show, when present
@@ -362,6 +387,11 @@ Status Run::reference_frame(std::size_t fi, int frame) {
     for (auto* v : {&ref_y_, &ref_prev_y_, &ref_delta_, &warped_}) v->resize(n_);
     ref_valid_.resize(n_);
     valid_.resize(n_);
+    if (setup_.regions) {
+      labels_.assign(n_, std::uint8_t(kRegionDisoccluded));
+      still_.assign(n_, 0);
+      for (auto& m : region_masks_) m.assign(n_, 0.0f);
+    }
     for (auto& t : tests_) {
       t.y.resize(n_);
       t.prev_y.resize(n_);
@@ -426,6 +456,25 @@ Status Run::reference_frame(std::size_t fi, int frame) {
     }
     reproject::warp_planes(fr, previous, warped_out);
     temporal_delta(ref_y_.data(), warped_.data(), n_, ref_delta_.data());
+  }
+  if (setup_.regions) {
+    // Classified before this frame's geometry replaces the previous one (the disocclusion test compares them).
+    RegionInputs ri;
+    ri.width = width_;
+    ri.height = height_;
+    ri.motion_x = gbuf_->plane("motion.X");
+    ri.motion_y = gbuf_->plane("motion.Y");
+    ri.depth = gbuf_->plane("depth.Z");
+    ri.warped_depth = gbuf_warped_ ? gbuf_->plane("prevDepth.Z") : nullptr;
+    ri.id = gbuf_->uint_plane("id");
+    ri.previous_depth = have_prev_geometry_ ? prev_z_.data() : nullptr;
+    ri.previous_id = have_prev_geometry_ ? prev_id_.data() : nullptr;
+    ri.has_previous = history_ && have_prev_geometry_;
+    ri.reference_y = ref_y_.data();
+    ri.previous_reference_y = ref_prev_y_.data();
+    classify_regions(ri, setup_.region_options, still_, labels_);
+    for (int r = 0; r < kRegionCount; ++r)
+      for (std::size_t i = 0; i < n_; ++i) region_masks_[std::size_t(r)][i] = labels_[i] == r ? 1.0f : 0.0f;
   }
   if (gbuf_geometry_ && gbuf_) {  // the previous frame's geometry for the next frame's disocclusion test
     const float* z = gbuf_->plane("depth.Z");
@@ -527,6 +576,10 @@ Status Run::test_frame(TestState& t, std::size_t fi, int frame) {
     m.has_mask = true;
     m.mask_fraction = m.valid_pixels ? double(inside) / double(m.valid_pixels) : 0.0;
   }
+  if (setup_.regions) {
+    m.has_regions = true;
+    for (std::size_t i = 0; i < n_; ++i) m.region_pixels[labels_[i]] += valid_[i];
+  }
   luminance_plane(planes, n_, t.y.data());
   const bool change = history_ && t.has_prev;
   if (change) temporal_delta(t.y.data(), t.delta.data(), n_, t.delta.data());  // t.delta held the warped history
@@ -605,6 +658,10 @@ FrameInputs Run::inputs(TestState& t, int frame, std::span<const float* const> p
   in.valid = valid_.data();
   in.mask = mask;
   in.peak = peak;
+  if (setup_.regions) {
+    in.regions = labels_.data();
+    for (std::size_t r = 0; r < kRegionCount; ++r) in.region_masks[r] = region_masks_[r].data();
+  }
   in.test_change = change ? t.delta.data() : nullptr;
   in.reference_change = change ? ref_delta_.data() : nullptr;
   in.maps = maps;

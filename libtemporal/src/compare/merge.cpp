@@ -61,7 +61,7 @@ bool parse_number(const std::string& text, double& v) {
 
 // Where a CSV column goes in FrameMetrics.
 struct Slot {
-  enum Kind { Frame, Sequence, Value, Inside, Outside, Peak, Valid, NonfiniteTest, NonfiniteRef, Compute, MetricsMs, MaskFraction, Unknown };
+  enum Kind { Frame, Sequence, Region, RegionShare, Value, Inside, Outside, Peak, Valid, NonfiniteTest, NonfiniteRef, Compute, MetricsMs, MaskFraction, Unknown };
   Kind kind = Unknown;
   std::string metric;
   std::size_t column = 0;
@@ -71,7 +71,8 @@ Slot slot_of(const std::string& header) {
   static const std::map<std::string, Slot::Kind> fixed = {
       {"frame", Slot::Frame},          {"sequence", Slot::Sequence},          {"peak", Slot::Peak},
       {"valid_pixels", Slot::Valid},   {"nonfinite_test", Slot::NonfiniteTest}, {"nonfinite_reference", Slot::NonfiniteRef},
-      {"compute_ms", Slot::Compute},   {"metrics_ms", Slot::MetricsMs},       {"mask_fraction", Slot::MaskFraction}};
+      {"compute_ms", Slot::Compute},   {"metrics_ms", Slot::MetricsMs},       {"mask_fraction", Slot::MaskFraction},
+      {"region", Slot::Region},        {"region_share", Slot::RegionShare}};
   if (auto it = fixed.find(header); it != fixed.end()) return {it->second, {}, 0};
   for (const auto& d : metric_registry()) {
     for (std::size_t k = 0; k < d.columns.size(); ++k)
@@ -102,8 +103,10 @@ Expected<ComparisonReport> read_comparison_csv(const std::string& path) {
   for (const auto& s : slots)
     if (s.kind == Slot::Value && std::find(report.metrics.begin(), report.metrics.end(), s.metric) == report.metrics.end())
       report.metrics.push_back(s.metric);
-  for (const auto& s : slots)
+  for (const auto& s : slots) {
     if (s.kind == Slot::MaskFraction) report.mask = "(merged)";
+    if (s.kind == Slot::Region) report.regions = true;
+  }
   std::map<std::string, std::size_t> index;  // sequence name -> report.sequences position
   for (int row = 2; std::getline(in, line); ++row) {
     if (line.empty()) continue;
@@ -113,10 +116,19 @@ Expected<ComparisonReport> read_comparison_csv(const std::string& path) {
                                     std::to_string(headers.size()));
     FrameMetrics f;
     std::string name;
+    int region = kAllRegions;
     for (std::size_t c = 0; c < cells.size(); ++c) {
       const Slot& s = slots[c];
       if (s.kind == Slot::Sequence) {
         name = cells[c];
+        continue;
+      }
+      if (s.kind == Slot::Region) {
+        for (int r = 0; r < kRegionCount; ++r)
+          if (cells[c] == region_name(r)) region = r;
+        if (region == kAllRegions && cells[c] != "all")
+          return Error::input(path, "row " + std::to_string(row) + ": region '" + cells[c] +
+                                        "' is not all, static, moving or disoccluded");
         continue;
       }
       double v = 0.0;
@@ -133,14 +145,31 @@ Expected<ComparisonReport> read_comparison_csv(const std::string& path) {
         case Slot::Inside: f.ensure_sample(s.metric).inside = v; break;
         case Slot::Outside: f.ensure_sample(s.metric).outside = v; break;
         case Slot::Peak: f.peak = v; break;
-        case Slot::Valid: f.valid_pixels = std::size_t(v); break;
-        case Slot::NonfiniteTest: f.nonfinite_test = std::size_t(v); break;
-        case Slot::NonfiniteRef: f.nonfinite_reference = std::size_t(v); break;
+        case Slot::Valid: if (!std::isnan(v)) f.valid_pixels = std::size_t(v); break;
+        case Slot::NonfiniteTest: if (!std::isnan(v)) f.nonfinite_test = std::size_t(v); break;
+        case Slot::NonfiniteRef: if (!std::isnan(v)) f.nonfinite_reference = std::size_t(v); break;
         case Slot::Compute: if (!std::isnan(v)) f.compute_ms = v; break;
         case Slot::MetricsMs: f.metrics_ms = std::isnan(v) ? 0.0 : v; break;
         case Slot::MaskFraction: f.has_mask = true; f.mask_fraction = v; break;
         default: break;
       }
+    }
+    if (region != kAllRegions) {
+      // A region row belongs to the `all` row of its sequence and frame written before it.
+      const auto at = index.find(name);
+      FrameMetrics* whole = nullptr;
+      if (at != index.end())
+        for (auto& g : report.sequences[at->second].frames)
+          if (g.frame == f.frame) whole = &g;
+      if (!whole)
+        return Error::input(path, "row " + std::to_string(row) + ": a " + region_name(region) +
+                                      " row without the `all` row of its frame and sequence before it");
+      whole->has_regions = true;
+      whole->region_pixels[std::size_t(region)] = f.valid_pixels;
+      for (const auto& sample : f.metrics)
+        whole->ensure_sample(sample.metric).regions[std::size_t(region)] =
+            sample.values.empty() ? kNaN : sample.values.front();
+      continue;
     }
     auto it = index.find(name);
     if (it == index.end()) {
@@ -171,6 +200,9 @@ Expected<ComparisonReport> merge_comparisons(const std::vector<ComparisonReport>
     if (part.metrics != merged.metrics)
       return Error::input(file, "measures other metrics than " + (names.empty() ? std::string("the first") : names[0]) +
                                     ": merge shards of one comparison (same compare options)");
+    if (part.regions != merged.regions)
+      return Error::input(file, std::string(part.regions ? "has" : "has no") + " region rows where the first shard " +
+                                    (merged.regions ? "has" : "has none") + ": give every shard the same --regions");
     if (part.sequences.size() != merged.sequences.size())
       return Error::input(file, "has " + std::to_string(part.sequences.size()) + " sequences, the first shard " +
                                     std::to_string(merged.sequences.size()));
@@ -211,6 +243,7 @@ Expected<ComparisonReport> merge_comparison_csvs(const std::vector<std::string>&
   merged->reference_layer = setup.reference_layer.empty() ? setup.layer : setup.reference_layer;
   merged->bootstrap = setup.bootstrap;
   merged->speed_metric = setup.speed_metric;
+  merged->region_options = setup.region_options;  // not in the CSV: the merge's own options name them
   return merged;
 }
 

@@ -22,6 +22,12 @@ class Flicker final : public FrameMeasure {
       if (f.pixels_inside) out.inside = f.rms_inside();
       if (f.pixels_outside) out.outside = f.rms_outside();
     }
+    if (in.regions)  // RMS over the region's pixels that have a value (none where disoccluded: no history)
+      for (std::size_t r = 0; r < kRegionCount; ++r) {
+        const FlickerResult p = flicker(in.test_change, in.reference_change, in.width, in.height, in.valid,
+                                        in.region_masks[r]);
+        if (p.pixels_inside) out.regions[r] = p.rms_inside();
+      }
     return {};
   }
 };

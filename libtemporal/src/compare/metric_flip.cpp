@@ -60,6 +60,16 @@ class Flip final : public FrameMeasure {
       out.inside = count[0] ? sum[0] / double(count[0]) : kNoValue;
       out.outside = count[1] ? sum[1] / double(count[1]) : kNoValue;
     }
+    if (in.regions) {  // the mean of the FLIP map over each region's valid pixels
+      std::array<double, kRegionCount> sum{};
+      std::array<std::size_t, kRegionCount> count{};
+      for (std::size_t i = 0; i < n; ++i) {
+        if (!in.valid[i]) continue;
+        sum[in.regions[i]] += map[i];
+        ++count[in.regions[i]];
+      }
+      for (std::size_t r = 0; r < kRegionCount; ++r) out.regions[r] = count[r] ? sum[r] / double(count[r]) : kNoValue;
+    }
     return {};
   }
 

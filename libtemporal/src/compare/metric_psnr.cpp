@@ -31,6 +31,7 @@ class PsnrRgb final : public FrameMeasure {
       out.inside = psnr_db(err.inside, in.peak);
       out.outside = psnr_db(err.outside, in.peak);
     }
+    if (in.regions) out.regions = region_psnr(in.test, in.reference, in);
     if (in.maps)
       for (std::size_t c = 0; c < in.test.size(); ++c)
         absolute_error(*in.maps, "error." + suffix_of(in.channels[c]), in.test[c], in.reference[c], in.valid);
@@ -50,6 +51,7 @@ class PsnrY final : public FrameMeasure {
       out.inside = psnr_db(err.inside, in.peak);
       out.outside = psnr_db(err.outside, in.peak);
     }
+    if (in.regions) out.regions = region_psnr({&ty, 1}, {&ry, 1}, in);
     if (in.maps) absolute_error(*in.maps, "error.Y", ty, ry, in.valid);
     return {};
   }
@@ -65,6 +67,7 @@ MetricDefinition psnr_rgb_metric() {
   d.columns = {{"psnr_rgb_db", ""}, {"mse_rgb", ""}};
   d.mask_columns = {"psnr_rgb_in_db", "psnr_rgb_out_db"};
   d.historical_csv = true;
+  d.pooled = true;
   d.threshold_option = "psnr";
   d.threshold_help = "Exit 3 when a sequence's PSNR (dB) is below this";
   d.chart = {"", "PSNR ({layer}) per frame", "PSNR (dB)", false, {}, {}};
@@ -82,6 +85,7 @@ MetricDefinition psnr_y_metric() {
   d.columns = {{"psnr_y_db", ""}};
   d.mask_columns = {"psnr_y_in_db", "psnr_y_out_db"};
   d.historical_csv = true;
+  d.pooled = true;
   d.chart = {"-psnr-y", "PSNR of luminance per frame", "PSNR of luminance (dB)", false, {}, {}};
   d.table_width = 10;
   d.table_format = "%.3f";

@@ -72,6 +72,18 @@ double mean_of(const SequenceReport& seq, Get get) {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
+// Mean of the values that are not NaN (as summarize: +inf stays +inf), NaN when none.
+double series_mean(const std::vector<double>& v) {
+  double sum = 0.0;
+  std::size_t n = 0;
+  for (const double x : v)
+    if (!std::isnan(x)) {
+      sum += x;
+      ++n;
+    }
+  return n ? sum / double(n) : kNaN;
+}
+
 // The measured metrics' definitions, in report order.
 std::vector<const MetricDefinition*> definitions_of(const ComparisonReport& report) {
   std::vector<const MetricDefinition*> out;
@@ -83,26 +95,42 @@ std::vector<const MetricDefinition*> definitions_of(const ComparisonReport& repo
 // The CSV layout (docs/compare.md, "Outputs"): the historical metrics' primary columns, their other columns,
 // the frame's facts, the mask columns of the historical metrics, then every other metric's columns and its mask
 // columns. Each cell is a function of the sequence and frame.
+// Each cell is a function of the sequence, the frame and the row's region (kAllRegions, or one region of
+// --regions: such a row holds the metrics' primary values over the region and the region's pixels; the columns that
+// have no region value stay empty).
 struct CsvColumn {
   std::string header;
-  std::function<std::string(const SequenceReport&, const FrameMetrics&)> cell;
+  std::function<std::string(const SequenceReport&, const FrameMetrics&, int)> cell;
 };
 
 std::vector<CsvColumn> csv_layout(const ComparisonReport& report) {
   const auto defs = definitions_of(report);
   const bool mask = !report.mask.empty();
   std::vector<CsvColumn> cols;
-  cols.push_back({"frame", [](const SequenceReport&, const FrameMetrics& f) { return std::to_string(f.frame); }});
-  cols.push_back({"sequence", [](const SequenceReport& s, const FrameMetrics&) { return csv_quote(s.name); }});
+  cols.push_back({"frame", [](const SequenceReport&, const FrameMetrics& f, int) { return std::to_string(f.frame); }});
+  cols.push_back({"sequence", [](const SequenceReport& s, const FrameMetrics&, int) { return csv_quote(s.name); }});
+  if (report.regions) {
+    cols.push_back({"region", [](const SequenceReport&, const FrameMetrics&, int r) {
+                      return std::string(region_name(r));
+                    }});
+    cols.push_back({"region_share", [](const SequenceReport&, const FrameMetrics& f, int r) {
+                      if (r == kAllRegions) return field(1.0);
+                      if (!f.valid_pixels) return field(kNaN);
+                      return field(double(f.region_pixels[std::size_t(r)]) / double(f.valid_pixels));
+                    }});
+  }
   auto value = [&](const MetricDefinition* d, std::size_t k) {
-    return CsvColumn{d->columns[k].csv, [name = d->name, k](const SequenceReport&, const FrameMetrics& f) {
-                       return field(f.value(name, k));
+    return CsvColumn{d->columns[k].csv, [name = d->name, k](const SequenceReport&, const FrameMetrics& f, int r) {
+                       if (r == kAllRegions) return field(f.value(name, k));
+                       const MetricSample* s = f.sample(name);
+                       return field(s && k == 0 ? s->regions[std::size_t(r)] : kNaN);
                      }};
   };
   auto inside_outside = [&](const MetricDefinition* d) {
     for (const bool in : {true, false})
-      cols.push_back({d->mask_columns[in ? 0 : 1], [name = d->name, in](const SequenceReport&, const FrameMetrics& f) {
-                        const MetricSample* s = f.sample(name);
+      cols.push_back({d->mask_columns[in ? 0 : 1],
+                      [name = d->name, in](const SequenceReport&, const FrameMetrics& f, int r) {
+                        const MetricSample* s = r == kAllRegions ? f.sample(name) : nullptr;  // the mask: whole rows
                         return field(s ? (in ? s->inside : s->outside) : kNaN);
                       }});
   };
@@ -111,15 +139,23 @@ std::vector<CsvColumn> csv_layout(const ComparisonReport& report) {
   for (const auto* d : defs)
     if (d->historical_csv)
       for (std::size_t k = 1; k < d->columns.size(); ++k) cols.push_back(value(d, k));
-  cols.push_back({"peak", [](const SequenceReport&, const FrameMetrics& f) { return field(f.peak); }});
-  cols.push_back({"valid_pixels", [](const SequenceReport&, const FrameMetrics& f) { return std::to_string(f.valid_pixels); }});
-  cols.push_back({"nonfinite_test", [](const SequenceReport&, const FrameMetrics& f) { return std::to_string(f.nonfinite_test); }});
-  cols.push_back({"nonfinite_reference",
-                  [](const SequenceReport&, const FrameMetrics& f) { return std::to_string(f.nonfinite_reference); }});
-  cols.push_back({"compute_ms", [](const SequenceReport&, const FrameMetrics& f) { return field(f.compute_ms, 8); }});
-  cols.push_back({"metrics_ms", [](const SequenceReport&, const FrameMetrics& f) { return field(f.metrics_ms, 5); }});
+  cols.push_back({"peak", [](const SequenceReport&, const FrameMetrics& f, int) { return field(f.peak); }});
+  cols.push_back({"valid_pixels", [](const SequenceReport&, const FrameMetrics& f, int r) {
+                    return std::to_string(r == kAllRegions ? f.valid_pixels : f.region_pixels[std::size_t(r)]);
+                  }});
+  // Facts of the whole frame: on its `all` row only.
+  auto whole = [](std::function<std::string(const FrameMetrics&)> get) {
+    return [get](const SequenceReport&, const FrameMetrics& f, int r) {
+      return r == kAllRegions ? get(f) : std::string();
+    };
+  };
+  cols.push_back({"nonfinite_test", whole([](const FrameMetrics& f) { return std::to_string(f.nonfinite_test); })});
+  cols.push_back(
+      {"nonfinite_reference", whole([](const FrameMetrics& f) { return std::to_string(f.nonfinite_reference); })});
+  cols.push_back({"compute_ms", whole([](const FrameMetrics& f) { return field(f.compute_ms, 8); })});
+  cols.push_back({"metrics_ms", whole([](const FrameMetrics& f) { return field(f.metrics_ms, 5); })});
   if (mask) {
-    cols.push_back({"mask_fraction", [](const SequenceReport&, const FrameMetrics& f) { return field(f.mask_fraction); }});
+    cols.push_back({"mask_fraction", whole([](const FrameMetrics& f) { return field(f.mask_fraction); })});
     for (const auto* d : defs)
       if (d->historical_csv) inside_outside(d);
   }
@@ -141,17 +177,21 @@ Status write_comparison_csv(const ComparisonReport& report, const std::string& p
     text += cols[c].header;
   }
   text += "\n";
-  // Frame-major: all sequences of frame N, then frame N+1 (the order compare computes them).
+  // Frame-major: all sequences of frame N, then frame N+1 (the order compare computes them); with regions each
+  // sequence's `all` row, then its static, moving and disoccluded rows.
   std::size_t frames = 0;
   for (const auto& s : report.sequences) frames = std::max(frames, s.frames.size());
+  const int last_region = report.regions ? kRegionCount - 1 : kAllRegions;
   for (std::size_t i = 0; i < frames; ++i)
     for (const auto& s : report.sequences) {
       if (i >= s.frames.size()) continue;
-      for (std::size_t c = 0; c < cols.size(); ++c) {
-        if (c) text += ',';
-        text += cols[c].cell(s, s.frames[i]);
+      for (int r = kAllRegions; r <= last_region; ++r) {
+        for (std::size_t c = 0; c < cols.size(); ++c) {
+          if (c) text += ',';
+          text += cols[c].cell(s, s.frames[i], r);
+        }
+        text += "\n";
       }
-      text += "\n";
     }
   return write_text_atomic(path, text);
 }
@@ -189,6 +229,36 @@ nlohmann::ordered_json metric_json(const ComparisonReport& report, const Sequenc
   return j;
 }
 
+// The pooled PSNR of `metric` in `region` (pooled_summary): the value over all pixels of all frames, its 95 %
+// block-bootstrap interval and the frames that entered it.
+nlohmann::ordered_json pooled_json(const SequenceReport& s, const std::string& metric, int region,
+                                   const BootstrapOptions& o) {
+  const MeanInterval m = pooled_summary(s, metric, region, o);
+  if (m.count == 0) return nullptr;
+  return {{"value", jnum(m.mean)}, {"ci95", jinterval(m.ci)}, {"frames", m.count}};
+}
+
+// Each region of --regions: its share of the valid pixels over all frames, and per metric the mean over frames of
+// the region's per-frame values with its interval (and the pooled PSNR of the pooled metrics).
+nlohmann::ordered_json regions_json(const ComparisonReport& report, const SequenceReport& s) {
+  using json = nlohmann::ordered_json;
+  json regions = json::object();
+  for (int r = 0; r < kRegionCount; ++r) {
+    json jr;
+    jr["share"] = jnum(region_share(s, r));
+    double pixels = 0.0;
+    for (const double w : region_weights(s, r)) pixels += w;
+    jr["pixels"] = std::size_t(pixels);
+    for (const auto* d : definitions_of(report)) {
+      const auto series = region_series(s, d->name, r);
+      jr[d->name] = jmean(series, report.bootstrap);
+      if (d->pooled) jr[d->name + "_pooled"] = pooled_json(s, d->name, r, report.bootstrap);
+    }
+    regions[region_name(r)] = jr;
+  }
+  return regions;
+}
+
 // `on_front`: the sequence is on the Pareto front of compute time against report.speed_metric (speed_points).
 nlohmann::ordered_json sequence_json(const ComparisonReport& report, const SequenceReport& s, bool on_front) {
   using json = nlohmann::ordered_json;
@@ -197,7 +267,10 @@ nlohmann::ordered_json sequence_json(const ComparisonReport& report, const Seque
   js["path"] = s.pattern;
   js["frames"] = s.frames.size();
   const auto defs = definitions_of(report);
-  for (const auto* d : defs) js[d->name] = metric_json(report, s, *d);
+  for (const auto* d : defs) {
+    js[d->name] = metric_json(report, s, *d);
+    if (d->pooled) js[d->name + "_pooled"] = pooled_json(s, d->name, kAllRegions, report.bootstrap);
+  }
   std::size_t nf_test = 0, nf_ref = 0;
   for (const auto& f : s.frames) {
     nf_test += f.nonfinite_test;
@@ -218,6 +291,7 @@ nlohmann::ordered_json sequence_json(const ComparisonReport& report, const Seque
   for (const auto& [name, sum] : sums) timings[name] = sum.first / double(sum.second);
   js["timings_ms"] = timings;
   js["metrics_ms"] = jnum(mean_of(s, [](const FrameMetrics& f) { return f.metrics_ms; }));
+  if (report.regions) js["regions"] = regions_json(report, s);
   if (!report.mask.empty()) {
     js["mask_source"] = s.mask_source;
     js["mask_fraction"] = jnum(mean_of(s, [](const FrameMetrics& f) { return f.mask_fraction; }));
@@ -236,16 +310,28 @@ nlohmann::ordered_json sequence_json(const ComparisonReport& report, const Seque
 
 // The paired difference a - b of every two test sequences for every metric, over the frames where both have a
 // value, with its interval (and the steady state apart with --warmup): the numbers behind an "A beats B".
+// Pooled metrics add a `<name>_pooled` entry (pooled(a) - pooled(b), pooled_difference); with --regions every
+// entry is repeated per region (`region`: "all" for the whole frame).
 nlohmann::ordered_json paired_json(const ComparisonReport& report) {
   using json = nlohmann::ordered_json;
   json pairs = json::array();
+  const int last_region = report.regions ? kRegionCount - 1 : kAllRegions;
   for (std::size_t a = 0; a < report.sequences.size(); ++a)
     for (std::size_t b = a + 1; b < report.sequences.size(); ++b)
+      for (int r = kAllRegions; r <= last_region; ++r)
       for (const auto* d : definitions_of(report)) {
-        const auto sa = metric_series(report.sequences[a], d->name), sb = metric_series(report.sequences[b], d->name);
+        const SequenceReport &A = report.sequences[a], &B = report.sequences[b];
+        const auto sa = region_series(A, d->name, r), sb = region_series(B, d->name, r);
         const MeanInterval m = bootstrap_paired_difference(sa, sb, report.bootstrap);
         if (m.count == 0) continue;
-        json p = {{"a", report.sequences[a].name}, {"b", report.sequences[b].name}, {"metric", d->name},
+        if (d->pooled) {
+          const MeanInterval pm = pooled_difference(A, B, d->name, r, report.bootstrap);
+          if (pm.count)
+            pairs.push_back({{"a", A.name}, {"b", B.name}, {"metric", d->name + "_pooled"}, {"region", region_name(r)},
+                             {"higher_is_better", true}, {"frames", pm.count}, {"difference", jnum(pm.mean)},
+                             {"ci95", jinterval(pm.ci)}});
+        }
+        json p = {{"a", A.name}, {"b", B.name}, {"metric", d->name}, {"region", region_name(r)},
                   {"higher_is_better", d->higher_is_better}, {"frames", m.count}, {"mean_difference", jnum(m.mean)},
                   {"ci95", jinterval(m.ci)}};
         const std::size_t warm = std::min(sa.size(), std::size_t(std::max(0, report.warmup_frames)));
@@ -289,7 +375,14 @@ Status write_comparison_json(const ComparisonReport& report, const Thresholds& t
   j["mask"] = report.mask.empty() ? json(nullptr) : json(report.mask);
   if (report.flip != FlipMode::Off)
     j["flip"] = {{"mode", flip_mode_name(report.flip)}, {"pixels_per_degree", report.pixels_per_degree}};
-  j["speed_metric"] = report.speed_metric;  // the metric of the sequences' `pareto` flags
+  j["speed_metric"] = report.speed_metric;
+  if (report.regions)
+    j["regions"] = {{"kind", "motion"},
+                    {"static_frames", report.region_options.static_frames},
+                    {"static_tolerance", report.region_options.static_tolerance},
+                    {"static_motion", kStaticMotion}};
+  else
+    j["regions"] = nullptr;  // the metric of the sequences' `pareto` flags
   json th = json::object();
   for (const auto* d : definitions_of(report)) {
     if (d->threshold_option.empty()) continue;
@@ -330,10 +423,15 @@ std::string summary_table(const ComparisonReport& report) {
     if (left) out.append(pad, ' ');
   };
   const auto defs = definitions_of(report);
+  std::vector<const MetricDefinition*> pooled;
+  for (const auto* d : defs)
+    if (d->pooled) pooled.push_back(d);
+  auto pooled_width = [](const MetricDefinition* d) { return int(d->name.size() + 7); };
   put("sequence", 20, true);
   put("frames", 7, false);
   for (const auto* d : defs) put(d->name, d->table_width, false);
-  put("compute_ms", 11, false);
+  put("compute_ms", 11, false);  // the columns before it as they always were (scripts read them by position)
+  for (const auto* d : pooled) put(d->name + "_pooled", pooled_width(d), false);
   out += '\n';
   for (const auto& s : report.sequences) {
     put(s.name, 20, true);
@@ -341,8 +439,32 @@ std::string summary_table(const ComparisonReport& report) {
     for (const auto* d : defs) put(cell(summarize(s, d->name).mean, d->table_format), d->table_width, false);
     const auto ms = mean_compute_ms(s);
     put(ms ? cell(*ms, "%.3f") : std::string("-"), 11, false);
+    for (const auto* d : pooled)
+      put(cell(pooled_psnr(metric_series(s, d->name), region_weights(s, kAllRegions)), d->table_format),
+          pooled_width(d), false);
     out += '\n';
   }
+  if (!report.regions) return out;
+  // Per region: the pixel share and the mean over frames of each metric's region values, then the pooled PSNRs.
+  out += '\n';
+  put("sequence", 20, true);
+  put("region", 11, true);
+  put("share", 7, false);
+  for (const auto* d : defs) put(d->name, d->table_width, false);
+  for (const auto* d : pooled) put(d->name + "_pooled", pooled_width(d), false);
+  out += '\n';
+  for (const auto& s : report.sequences)
+    for (int r = 0; r < kRegionCount; ++r) {
+      put(s.name, 20, true);
+      put(region_name(r), 11, true);
+      put(cell(100.0 * region_share(s, r), "%.1f%%"), 7, false);
+      for (const auto* d : defs)
+        put(cell(series_mean(region_series(s, d->name, r)), d->table_format), d->table_width, false);
+      for (const auto* d : pooled)
+        put(cell(pooled_psnr(region_series(s, d->name, r), region_weights(s, r)), d->table_format), pooled_width(d),
+            false);
+      out += '\n';
+    }
   return out;
 }
 

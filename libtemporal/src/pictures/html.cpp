@@ -24,6 +24,9 @@ td.name, th.name { text-align: left; }
 td.best { font-weight: bold; }
 span.ci { color: #666; font-size: 0.85em; }
 td.decided { color: #0072b2; font-weight: bold; } td.winner { font-weight: bold; } td.tie { color: #666; }
+div.share { display: flex; width: 30em; height: 1.2em; border: 1px solid #ccc; font-size: 0.8em; }
+div.share span { display: block; overflow: hidden; text-align: center; color: #fff; }
+span.static { background: #0072b2; } span.moving { background: #e69f00; } span.disoccluded { background: #cc79a7; }  /* Okabe-Ito */
 figure { display: inline-block; margin: 0.5em 1em 1em 0; vertical-align: top; max-width: 100%; }
 figcaption { font-size: 0.85em; color: #444; max-width: 60em; }
 img { border: 1px solid #ddd; max-width: 100%; height: auto; }
@@ -70,6 +73,8 @@ void metric_table(std::ostringstream& out, const ComparisonReport& r) {
   for (const auto* d : defs)
     out << "<th>" << html_escape(d->name) << (d->unit.empty() ? "" : " (" + html_escape(d->unit) + ")")
         << (d->higher_is_better ? " ↑" : " ↓") << "</th>";
+  for (const auto* d : defs)
+    if (d->pooled) out << "<th>" << html_escape(d->name) << "_pooled (" << html_escape(d->unit) << ") ↑</th>";
   out << "<th>compute ms</th></tr>\n";
   // The best mean of each metric in bold.
   std::vector<double> best(defs.size(), std::nan(""));
@@ -87,6 +92,8 @@ void metric_table(std::ostringstream& out, const ComparisonReport& r) {
       const bool is_best = m.count && r.sequences.size() > 1 && m.mean == best[k];
       out << "<td" << (is_best ? " class=\"best\"" : "") << ">" << cell_value(m, 4) << "</td>";
     }
+    for (const auto* d : defs)
+      if (d->pooled) out << "<td>" << cell_value(pooled_summary(s, d->name, kAllRegions, r.bootstrap), 4) << "</td>";
     const auto ms = mean_compute_ms(s);
     out << "<td>" << (ms ? format_number(*ms, 3) : std::string("–"))
         << (ms && s.compute_kind != ComputeKind::Method ? " (" + std::string(compute_kind_name(s.compute_kind)) + ")" : "")
@@ -95,37 +102,94 @@ void metric_table(std::ostringstream& out, const ComparisonReport& r) {
   out << "</table>\n";
 }
 
+// With --regions: a stacked bar of the region shares and a table of every metric per region (mean over frames
+// with its interval, pooled PSNR with its interval) for each sequence.
+void region_section(std::ostringstream& out, const ComparisonReport& r) {
+  if (!r.regions || r.sequences.empty()) return;
+  char tolerance[32];
+  std::snprintf(tolerance, sizeof tolerance, "%g", r.region_options.static_tolerance);
+  out << "<h2 id=\"regions\">Regions</h2>\n<p class=\"note\">From the G-buffer (docs/compare.md, Regions): "
+         "<b>static</b> = zero motion, history found and the reference's luminance unchanged (within "
+      << tolerance << ") for " << r.region_options.static_frames
+      << " frames; <b>disoccluded</b> = no history (the reprojection's off-screen or depth/id test fails, or no previous "
+         "frame); <b>moving</b> = the rest. Each value is the mean over the frames where the region has pixels, with its "
+         "95 % interval; <code>_pooled</code> is the PSNR of the region's squared error pooled over all its pixels of "
+         "all frames. Flicker has no value where disoccluded (no history).</p>\n";
+  std::vector<const MetricDefinition*> defs;
+  for (const auto& name : r.metrics)
+    if (const MetricDefinition* d = find_metric(name)) defs.push_back(d);
+  for (const auto& s : r.sequences) {
+    out << "<p class=\"note\">" << html_escape(s.name) << ": share of the valid pixels</p>\n<div class=\"share\">";
+    for (int g = 0; g < kRegionCount; ++g) {
+      const double share = region_share(s, g);
+      const double pct = std::isfinite(share) ? 100.0 * share : 0.0;
+      char width[32];
+      std::snprintf(width, sizeof width, "%.3f%%", pct);
+      out << "<span class=\"" << region_name(g) << "\" style=\"width:" << width << "\" title=\"" << region_name(g)
+          << " " << format_number(pct, 3) << " %\">" << (pct >= 12.0 ? region_name(g) : "") << "</span>";
+    }
+    out << "</div>\n";
+  }
+  out << "<table class=\"regions\">\n<tr><th class=\"name\">sequence</th><th class=\"name\">region</th><th>share</th>";
+  for (const auto* d : defs)
+    out << "<th>" << html_escape(d->name) << (d->higher_is_better ? " ↑" : " ↓") << "</th>";
+  for (const auto* d : defs)
+    if (d->pooled) out << "<th>" << html_escape(d->name) << "_pooled ↑</th>";
+  out << "</tr>\n";
+  for (const auto& s : r.sequences)
+    for (int g = 0; g < kRegionCount; ++g) {
+      out << "<tr><td class=\"name\">" << html_escape(s.name) << "</td><td class=\"name\">" << region_name(g)
+          << "</td><td>" << format_number(100.0 * region_share(s, g), 3) << " %</td>";
+      for (const auto* d : defs)
+        out << "<td>" << cell_value(bootstrap_mean(region_series(s, d->name, g), r.bootstrap), 4) << "</td>";
+      for (const auto* d : defs)
+        if (d->pooled) out << "<td>" << cell_value(pooled_summary(s, d->name, g, r.bootstrap), 4) << "</td>";
+      out << "</tr>\n";
+    }
+  out << "</table>\n";
+}
+
 void paired_table(std::ostringstream& out, const ComparisonReport& r) {
   if (r.sequences.size() < 2) return;
   out << "<h2 id=\"paired\">Paired differences</h2>\n<p class=\"note\">Mean over frames of a − b with its 95 % "
          "moving-block bootstrap interval (the JSON's <code>paired</code>). “a better” or “b better” when the "
-         "interval excludes 0; “no difference” otherwise.</p>\n";
+         "interval excludes 0; “no difference” otherwise. <code>_pooled</code> rows: pooled(a) − pooled(b), the "
+         "same frames resampled for both.</p>\n";
   out << "<table class=\"paired\">\n<tr><th class=\"name\">a</th><th class=\"name\">b</th><th class=\"name\">metric</th>"
-         "<th>a − b [95 %]</th><th class=\"name\">verdict</th></tr>\n";
+      << (r.regions ? "<th class=\"name\">region</th>" : "") << "<th>a − b [95 %]</th><th class=\"name\">verdict</th></tr>\n";
+  const int last_region = r.regions ? kRegionCount - 1 : kAllRegions;
+  // The verdict names the better method in bold blue (Okabe-Ito's blue: colour-blind safe) and bolds its name in
+  // the row; colouring "a better" green and "b better" red would colour by the row's order, not by which is
+  // better, and red/green is what colour-blind readers cannot tell apart (issue 25).
+  auto row = [&](std::size_t a, std::size_t b, const std::string& name, bool higher, int region, const MeanInterval& m) {
+    std::string verdict = "no difference", cls = "tie", a_cls, b_cls;
+    const bool above = m.ci.low > 0.0, below = m.ci.high < 0.0;
+    if (above || below) {
+      const bool a_better = higher ? above : below;
+      verdict = (a_better ? r.sequences[a].name : r.sequences[b].name) + " better";
+      cls = "decided";
+      (a_better ? a_cls : b_cls) = " winner";
+    }
+    out << "<tr><td class=\"name" << a_cls << "\">" << html_escape(r.sequences[a].name) << "</td><td class=\"name"
+        << b_cls << "\">" << html_escape(r.sequences[b].name) << "</td><td class=\"name\">" << html_escape(name) << "</td>"
+        << (r.regions ? "<td class=\"name\">" + std::string(region_name(region)) + "</td>" : std::string()) << "<td>"
+        << cell_value(m, 3) << "</td><td class=\"name " << cls << "\">" << html_escape(verdict) << "</td></tr>\n";
+  };
   for (std::size_t a = 0; a < r.sequences.size(); ++a)
     for (std::size_t b = a + 1; b < r.sequences.size(); ++b)
-      for (const auto& name : r.metrics) {
-        const MetricDefinition* d = find_metric(name);
-        if (!d) continue;
-        const auto sa = metric_series(r.sequences[a], name), sb = metric_series(r.sequences[b], name);
-        const MeanInterval m = bootstrap_paired_difference(sa, sb, r.bootstrap);
-        if (m.count == 0) continue;
-        // The verdict names the better method in bold blue (Okabe-Ito's blue: colour-blind safe) and bolds its
-        // name in the row; the old table coloured "a better" green and "b better" red, a colour by the row's
-        // order, not by which is better, and red/green is what colour-blind readers cannot tell apart (issue 25).
-        std::string verdict = "no difference", cls = "tie", a_cls, b_cls;
-        const bool above = m.ci.low > 0.0, below = m.ci.high < 0.0;
-        if (above || below) {
-          const bool a_better = d->higher_is_better ? above : below;
-          verdict = (a_better ? r.sequences[a].name : r.sequences[b].name) + " better";
-          cls = "decided";
-          (a_better ? a_cls : b_cls) = " winner";
+      for (int g = kAllRegions; g <= last_region; ++g)
+        for (const auto& name : r.metrics) {
+          const MetricDefinition* d = find_metric(name);
+          if (!d) continue;
+          const auto sa = region_series(r.sequences[a], name, g), sb = region_series(r.sequences[b], name, g);
+          const MeanInterval m = bootstrap_paired_difference(sa, sb, r.bootstrap);
+          if (m.count == 0) continue;
+          row(a, b, name, d->higher_is_better, g, m);
+          if (d->pooled) {
+            const MeanInterval p = pooled_difference(r.sequences[a], r.sequences[b], name, g, r.bootstrap);
+            if (p.count) row(a, b, name + "_pooled", true, g, p);
+          }
         }
-        out << "<tr><td class=\"name" << a_cls << "\">" << html_escape(r.sequences[a].name) << "</td><td class=\"name"
-            << b_cls << "\">" << html_escape(r.sequences[b].name) << "</td><td class=\"name\">" << html_escape(name)
-            << "</td><td>"
-            << cell_value(m, 3) << "</td><td class=\"name " << cls << "\">" << html_escape(verdict) << "</td></tr>\n";
-      }
   out << "</table>\n";
 }
 
@@ -219,6 +283,7 @@ std::string html_report(const HtmlReport& rep) {
            "Compute ms: mean <code>temporal:computeMs</code> of the test's headers (render or simulation time is "
            "marked: it is not the method's cost).</p>\n";
     metric_table(out, *r);
+    region_section(out, *r);
     if (!rep.failures.empty()) {
       out << "<p class=\"note\"><b>Thresholds failed:</b></p>\n<ul>\n";
       for (const auto& f : rep.failures) out << "<li>" << html_escape(f.message()) << "</li>\n";

@@ -66,6 +66,48 @@ std::vector<std::pair<std::string, Chart>> comparison_charts(const ComparisonRep
     charts.emplace_back(stem + d->chart.suffix + ext, std::move(c));
   }
 
+  // With --regions (docs/compare.md, "Regions"): each region's share of the valid pixels per frame (F-regions), and
+  // PSNR (RGB) per frame in each region (F-psnr-static, F-psnr-moving, F-psnr-disoccluded), one curve per sequence.
+  if (report.regions && !report.sequences.empty()) {
+    Chart shares;
+    shares.title = with_title(title, "Share of the pixels in each region per frame");
+    shares.x_label = x_label;
+    shares.y_label = "share of the valid pixels (%)";
+    shares.y_lowest = 0.0;
+    shares.y_highest = 100.0;
+    const SequenceReport& first = report.sequences.front();  // the regions are the frames', not a method's
+    for (int r = 0; r < kRegionCount; ++r) {
+      ChartSeries series;
+      series.name = region_name(r);
+      series.color = r;
+      for (const auto& f : first.frames) {
+        series.x.push_back(f.frame);
+        series.y.push_back(f.valid_pixels ? 100.0 * double(f.region_pixels[std::size_t(r)]) / double(f.valid_pixels)
+                                          : kNaN);
+      }
+      shares.series.push_back(std::move(series));
+    }
+    charts.emplace_back(stem + "-regions" + ext, std::move(shares));
+    for (int r = 0; r < kRegionCount; ++r) {
+      Chart c;
+      c.title = with_title(title, "PSNR (" + report.layer + ") per frame, " + region_name(r) + " pixels");
+      c.x_label = x_label;
+      c.y_label = "PSNR (dB)";
+      for (std::size_t i = 0; i < report.sequences.size(); ++i) {
+        ChartSeries series;
+        series.name = report.sequences[i].name;
+        series.color = int(i);
+        const auto values = region_series(report.sequences[i], "psnr_rgb", r);
+        for (std::size_t k = 0; k < values.size(); ++k) {
+          series.x.push_back(report.sequences[i].frames[k].frame);
+          series.y.push_back(std::isfinite(values[k]) ? values[k] : kNaN);  // an empty region leaves a gap
+        }
+        c.series.push_back(std::move(series));
+      }
+      charts.emplace_back(stem + "-psnr-" + region_name(r) + ext, std::move(c));
+    }
+  }
+
   // Speed: only times that measure the method itself (ComputeKind::Method). A render-gbuffer input's computeMs
   // is the render, a morph-120hz --perceive output's the perception simulation: neither is a method's cost.
   // The points and their Pareto front come from speed_points (the JSON's `pareto` flags are the same).

@@ -2,7 +2,9 @@
 """An experiment's summary table from compare's JSON files (one per scene): per variant the mean of each metric
 with its 95 % interval, the mean compute time from the output headers, whether the variant is on the Pareto front
 of compute time against PSNR (compare's `pareto` flag, the front of its speed chart), and its paired PSNR
-difference against the baseline with the interval. It only formats what compare computed (docs/pipelines.md)."""
+difference against the baseline with the interval; with compare --regions, a table per scene of the regions'
+shares and each variant's mean PSNR [95 % CI] / pooled PSNR per region. It only formats what compare computed
+(docs/pipelines.md)."""
 import argparse
 import json
 import os
@@ -30,7 +32,7 @@ def main():
                   "|---|---|---|---|---|---|---|"]
         paired = {}
         for p in report.get("paired", []):
-            if p["metric"] != "psnr_rgb":
+            if p["metric"] != "psnr_rgb" or p.get("region", "all") != "all":  # the whole frame (--regions adds more)
                 continue
             if p["b"] == a.baseline:
                 paired[p["a"]] = (num(p["mean_difference"]), p["ci95"])
@@ -43,6 +45,18 @@ def main():
             lines.append(f"| {s['name']} | {with_ci(s.get('psnr_rgb'))} | {with_ci(s.get('ssim'), 4)} | "
                          f"{with_ci(s.get('flicker'), 4)} | {fmt(s.get('compute_ms'), 3)} | "
                          f"{'yes' if s.get('pareto') else ''} | {diff} |")
+        # With compare --regions motion: per region its share and each variant's mean PSNR [95% CI] / pooled PSNR.
+        if any("regions" in q for q in seqs):
+            lines += ["", "| region | share | " + " | ".join(q["name"] for q in seqs) + " |",
+                      "|---|---|" + "---|" * len(seqs)]
+            for region in ("static", "moving", "disoccluded"):
+                rs = [(q.get("regions") or {}).get(region) or {} for q in seqs]
+                share = num(rs[0].get("share")) if rs and rs[0] else None
+                cells = [("-" if num((r.get("psnr_rgb") or {}).get("mean")) is None else
+                          f"{with_ci(r.get('psnr_rgb'))} / {fmt(num((r.get('psnr_rgb_pooled') or {}).get('value')))}")
+                         for r in rs]
+                lines.append(f"| {region} | {fmt(100.0 * share, 1) + ' %' if share is not None else '-'} | "
+                             + " | ".join(cells) + " |")
         plots = os.path.join(os.path.dirname(path), "plots")
         lines += ["", f"Charts: `{os.path.relpath(plots, os.path.dirname(a.out))}/` (metrics-speed.png: compute time "
                       "against PSNR)", ""]

@@ -1,8 +1,9 @@
 // Sequence comparison, the engine of the `compare` tool: streams a reference and any number of test
 // sequences frame by frame (only the current frame and the previous frame's luminance are in memory), measures
-// every metric of the registry per frame and per test, optionally inside and outside a mask layer, writes error
-// maps, and turns the results into CSV, JSON, a summary table, charts and threshold checks. docs/compare.md
-// defines every number.
+// every metric of the registry per frame and per test, optionally inside and outside a mask layer and per region
+// of the frame (static / moving / disoccluded from the G-buffer, --regions motion), writes error maps, and turns
+// the results into CSV, JSON, a summary table (with the pooled PSNR beside the mean of frames), charts and
+// threshold checks. docs/compare.md defines every number.
 //
 // The metric set is open: a metric is one entry of the registry (metric_registry()) - its name, label, unit,
 // the per-frame measure, the CSV columns it writes, whether higher is better, its threshold option
@@ -42,6 +43,49 @@ enum class FlipMode { Off, Ldr, Hdr };
 // "off", "ldr", "hdr" (the values of `compare --flip`).
 const char* flip_mode_name(FlipMode mode);
 
+// --- Regions (compare --regions motion; docs/compare.md, "Regions") ----------------------------------------
+
+// Every pixel of a compared frame is in exactly one region, decided from the G-buffer and the reference:
+//   static:      zero motion (below kStaticMotion pixels in x and y), history found by the reprojection rules
+//                (temporal/core/reproject.h), and the reference's luminance unchanged (within static_tolerance) from
+//                each frame to the next over the last static_frames frames - all three at each of those frames;
+//   disoccluded: no history by the reprojection rules - the fetch is off screen or fails the depth/id test of
+//                temporal/core/reproject.h (the one the methods use), or there is no previous frame (the first
+//                frame, a camera cut, a gap in --frames that no primed frame fills);
+//   moving:      everything else (moving surfaces, and still surfaces whose shading changed, e.g. under a moving
+//                shadow, or that were not still for static_frames frames yet).
+enum : int { kRegionStatic = 0, kRegionMoving = 1, kRegionDisoccluded = 2, kRegionCount = 3, kAllRegions = -1 };
+// "static", "moving", "disoccluded"; "all" for kAllRegions.
+const char* region_name(int region);
+// Motion below this (pixels, |x| and |y|) is zero: the float rounding of a static surface's reprojection.
+inline constexpr double kStaticMotion = 1e-3;
+
+struct RegionOptions {
+  int static_frames = 10;          // --static-frames: frames the reference must have been unchanged
+  double static_tolerance = 0.02;  // --static-tolerance: largest |Y_t - Y_{t-1}| of "unchanged" (pixel units)
+};
+
+// One frame's inputs of the classification (width * height planes).
+struct RegionInputs {
+  int width = 0, height = 0;
+  const float* motion_x = nullptr;  // the G-buffer's motion (required)
+  const float* motion_y = nullptr;
+  const float* depth = nullptr;     // depth.Z; null with prev_depth null: only the off-screen rule
+  const float* warped_depth = nullptr;       // prevDepth.Z when the G-buffer has it (reproject::expect_depth)
+  const std::uint32_t* id = nullptr;         // material ids; null: no id test
+  const float* previous_depth = nullptr;     // the previous frame's depth.Z
+  const std::uint32_t* previous_id = nullptr;
+  bool has_previous = false;                 // false: every pixel is disoccluded (no history at all)
+  const float* reference_y = nullptr;        // the reference's luminance now and at the previous frame (NaN where
+  const float* previous_reference_y = nullptr;  // not finite: never "unchanged")
+};
+// Classifies one frame: labels[i] = kRegionStatic, kRegionMoving or kRegionDisoccluded. `still` holds, per pixel,
+// the number of consecutive frames up to this one with zero motion, a history hit and an unchanged reference; the
+// caller keeps it between frames (zeros at the start) and this call updates it. A pixel is static when it
+// reaches options.static_frames.
+void classify_regions(const RegionInputs& in, const RegionOptions& options, std::span<std::uint16_t> still,
+                      std::span<std::uint8_t> labels);
+
 struct ComparisonSetup {
   std::string reference;               // reference sequence pattern (REF.####.exr)
   std::vector<std::string> tests;      // test sequence patterns
@@ -51,6 +95,9 @@ struct ComparisonSetup {
   std::string gbuffer;                 // G-buffer pattern with `motion`; empty: flicker without compensation
   std::string mask;                    // mask layer or channel; empty: none. Looked up in each test, then the
                                        // G-buffer, then the reference (first frame's header)
+  bool regions = false;                // --regions motion: every metric also per region (needs `gbuffer` with
+                                       // motion, depth.Z and id)
+  RegionOptions region_options;
   std::optional<FrameRange> frames;    // empty: every reference frame on disk
   double peak = 1.0;                   // PSNR / SSIM peak L (units of the pixel values)
   bool peak_from_data = false;         // idiff's rule per frame: max(1, largest finite value of both images)
@@ -81,6 +128,9 @@ struct MetricSample {
   double inside = kNoValue;          // primary value over the pixels (or windows) inside the mask
   double outside = kNoValue;         // ... and outside it
   std::size_t count = 0;             // pixels or windows that entered the primary value
+  // With --regions: the primary value over each region's pixels (kRegionStatic, ...); NaN where the metric has no
+  // region value (docs/compare.md, "Regions": psnr_latency) or the region is empty.
+  std::array<double, kRegionCount> regions{kNoValue, kNoValue, kNoValue};
 };
 
 // What a metric sees of one test frame. Planes are width * height floats, row-major.
@@ -94,6 +144,10 @@ struct FrameInputs {
   const float* reference_y = nullptr;
   const std::uint8_t* valid = nullptr;       // 1 where every compared channel of both images is finite
   const float* mask = nullptr;               // inside: > 0.5; null without a mask
+  // With --regions: each pixel's region (kRegionStatic, ...) and the same as one 0/1 plane per region (for the
+  // kernels that take a mask); null without regions.
+  const std::uint8_t* regions = nullptr;
+  std::array<const float*, kRegionCount> region_masks{};
   double peak = 1.0;                         // PSNR / SSIM peak of this frame
   // The motion-compensated change of luminance since the previous frame (temporal_delta of the warped previous
   // luminance, temporal/metrics/flicker.h); null when the frame has no usable previous frame (first frame,
@@ -154,6 +208,9 @@ struct MetricDefinition {
   MetricChart chart;
   int table_width = 10;                // summary table column
   std::string table_format = "%.3f";   // printf format of the mean
+  // A PSNR of the frame's mean squared error: also reported as `<name>_pooled`, the PSNR of the squared error
+  // pooled over all frames (pooled_psnr, docs/compare.md "Pooled PSNR").
+  bool pooled = false;
   bool on_sheet = true;                // printed under each test on the contact sheet (psnr_y is not: PSNR says it)
   // Null: always measured. Otherwise whether `setup` asks for the metric, and what to add when it does not.
   bool (*enabled)(const ComparisonSetup& setup) = nullptr;
@@ -186,6 +243,8 @@ struct FrameMetrics {
   std::size_t valid_pixels = 0;         // pixels that entered the metrics
   bool has_mask = false;
   double mask_fraction = 0.0;           // share of valid pixels inside the mask
+  bool has_regions = false;
+  std::array<std::size_t, kRegionCount> region_pixels{};  // valid pixels in each region (they sum to valid_pixels)
   // From the test file's header: `temporal:computeMs` and `temporal:ms:<pass>` (milliseconds).
   std::optional<double> compute_ms;
   std::map<std::string, double> timings_ms;
@@ -242,6 +301,8 @@ struct ComparisonReport {
   int warmup_frames = 0;                        // ComparisonSetup::warmup_frames
   BootstrapOptions bootstrap;                   // ComparisonSetup::bootstrap
   std::string speed_metric = "psnr_rgb";        // ComparisonSetup::speed_metric
+  bool regions = false;                         // ComparisonSetup::regions: frames carry region values
+  RegionOptions region_options;                 // ComparisonSetup::region_options (a merged CSV: the defaults)
   std::vector<SequenceReport> sequences;
 };
 
@@ -312,6 +373,19 @@ MetricSummary summarize(const SequenceReport& sequence, std::string_view metric,
 // frame has none.
 std::vector<double> metric_series(const SequenceReport& sequence, std::string_view metric, std::size_t column = 0);
 
+// The per-frame primary values of `metric` in `region` (kAllRegions: metric_series), NaN where a frame has none.
+std::vector<double> region_series(const SequenceReport& sequence, std::string_view metric, int region);
+// The pixels behind each frame's value of `region`: valid_pixels (kAllRegions) or region_pixels (0 without regions).
+std::vector<double> region_weights(const SequenceReport& sequence, int region);
+// The region's share of the sequence's valid pixels over all frames (1 for kAllRegions; NaN without pixels).
+double region_share(const SequenceReport& sequence, int region);
+// The pooled PSNR of a `pooled` metric (psnr_rgb, psnr_y) in `region`, with its block-bootstrap interval over frames
+// (bootstrap_pooled_psnr), and the paired difference pooled(a) - pooled(b) with its interval.
+MeanInterval pooled_summary(const SequenceReport& sequence, std::string_view metric, int region,
+                            const BootstrapOptions& options);
+MeanInterval pooled_difference(const SequenceReport& a, const SequenceReport& b, std::string_view metric, int region,
+                               const BootstrapOptions& options);
+
 // Mean of `temporal:computeMs` over frames that have it (else the mean sum of the `temporal:ms:*` timings).
 std::optional<double> mean_compute_ms(const SequenceReport& sequence);
 
@@ -333,8 +407,9 @@ std::vector<SpeedPoint> speed_points(const ComparisonReport& report);
 // Usage error unless `setup.speed_metric` is a registry metric that `setup` measures (with how to turn it on).
 Status check_speed_metric(const ComparisonSetup& setup);
 
-// The table compare prints: one line per sequence with its frame count, the mean of each measured metric and
-// the mean compute time from the headers.
+// The table compare prints: one line per sequence with its frame count, the mean of each measured metric, the
+// pooled PSNRs (`psnr_rgb_pooled`, ...) and the mean compute time from the headers; with regions a second table, one
+// line per sequence and region with its pixel share and the same columns.
 std::string summary_table(const ComparisonReport& report);
 
 // --- Thresholds (compare --fail-*) -------------------------------------------------------------------------

@@ -46,4 +46,25 @@ MeanInterval bootstrap_mean(std::span<const double> series, const BootstrapOptio
 MeanInterval bootstrap_paired_difference(std::span<const double> a, std::span<const double> b,
                                          const BootstrapOptions& options = {});
 
+// Pooled PSNR (docs/compare.md, "Pooled PSNR"): the PSNR of the squared error pooled over every pixel of every
+// frame, from per-frame PSNRs p_t (dB) and pixel counts w_t:
+//     pooled = -10 log10( sum_t w_t 10^(-p_t / 10) / sum_t w_t ),
+// since 10^(-p_t/10) = MSE_t / L_t^2 is frame t's normalised mean squared error (= 10 log10(L^2 / pooled MSE) for a
+// fixed peak L). Unlike the mean of p_t it is not dominated by the best frames: one frame with 100x the error of
+// the others moves it by up to 20 dB, the mean of p_t by 20 dB / n. Frames with a NaN PSNR or a weight <= 0 are
+// left out; +inf frames (identical images) add no error; one -inf frame (an overflowing error) makes it -inf.
+// No frame: NaN.
+double pooled_psnr(std::span<const double> psnr, std::span<const double> weight);
+// The pooled PSNR with a bootstrap interval: the same moving blocks of frames as bootstrap_mean, the statistic
+// recomputed on each resample (the pooled value is a ratio of sums over frames, not a mean, so the interval is
+// the percentile interval of the resampled pooled values). `count` is the number of frames used, `mean` the pooled
+// PSNR of all of them.
+MeanInterval bootstrap_pooled_psnr(std::span<const double> psnr, std::span<const double> weight,
+                                   const BootstrapOptions& options = {});
+// pooled(a) - pooled(b) over the frames where both have a value, with its interval from resampling the same blocks
+// of frames for both (paired). Two +inf pooled values are a tie (0), as in bootstrap_paired_difference.
+MeanInterval bootstrap_pooled_psnr_difference(std::span<const double> psnr_a, std::span<const double> weight_a,
+                                              std::span<const double> psnr_b, std::span<const double> weight_b,
+                                              const BootstrapOptions& options = {});
+
 }  // namespace temporal

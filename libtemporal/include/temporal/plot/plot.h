@@ -107,6 +107,8 @@ class VirtualDisplay {
 // Titles are the metric's, after `title` ("walkers: PSNR (rgb) per frame") when given; series are the sequences'
 // names (--names). The speed chart also draws the Pareto front of its points as a line named "Pareto front" when
 // it has two points or more.
+// With regions (compare --regions motion): F-regions.EXT, each region's share of the valid pixels per frame, and
+// F-psnr-static.EXT, F-psnr-moving.EXT, F-psnr-disoccluded.EXT, PSNR (RGB) per frame in the region.
 std::vector<std::pair<std::string, Chart>> comparison_charts(const ComparisonReport& report,
                                                              const std::string& plot_path,
                                                              const std::string& title = {});
