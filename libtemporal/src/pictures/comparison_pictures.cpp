@@ -123,6 +123,10 @@ struct ComparisonPictures::Impl {
   Status video_frame(const ComparedFrame& cf, const Picture& ref, const std::vector<Picture>& tests);
   Expected<PictureProducts> finish(const ComparisonReport& report);
   Status finish_sheet(const ComparisonReport& report);
+  Expected<std::vector<Rect>> sheet_crops(bool flip) const;
+  float sheet_error_high() const;
+  static std::vector<std::string> sheet_caption(const ComparisonReport& report, const CapturedTest& t);
+  Expected<std::vector<std::string>> write_sheet_maps();
   // The report's sections of single maps (FLIP, error) and of the G-buffer pictures, after the sheet.
   Status report_map_sections(const ComparisonReport& report, bool flip, float error_high,
                              const std::vector<std::string>& map_links);
@@ -381,11 +385,10 @@ Expected<PictureProducts> ComparisonPictures::Impl::finish(const ComparisonRepor
   return std::move(products);
 }
 
-Status ComparisonPictures::Impl::finish_sheet(const ComparisonReport& report) {
+// The crops of the contact sheet: given (--crop, checked against the image), or where the methods differ most
+// (the sum over the tests of FLIP, else of the error).
+Expected<std::vector<Rect>> ComparisonPictures::Impl::sheet_crops(bool flip) const {
   const Captured& c = *captured;
-  const bool flip = !c.tests.empty() && c.tests.front().maps && c.tests.front().maps->plane("error.flip");
-
-  // The crops: given, or where the methods differ most (the sum over the tests of FLIP, else of the error).
   std::vector<Rect> crops;
   for (const Rect& r : o.crops) {
     if (r.x + r.width > width || r.y + r.height > height)
@@ -394,28 +397,84 @@ Status ComparisonPictures::Impl::finish_sheet(const ComparisonReport& report) {
                           std::to_string(height) + " image");
     crops.push_back(r);
   }
-  std::vector<float> error_all;  // error.Y of every test's valid pixels, for the error maps' range
-  if (crops.empty()) {
-    std::vector<float> score(std::size_t(width) * std::size_t(height), 0.0f);
-    for (const auto& t : c.tests) {
-      if (!t.maps) continue;
-      const float* v = t.maps->plane(flip ? "error.flip" : "error.Y");
-      const float* inv = t.maps->plane("error.invalid");
-      if (!v) continue;
-      for (std::size_t i = 0; i < score.size(); ++i)
-        if (!(inv && inv[i] > 0.5f) && std::isfinite(v[i])) score[i] += v[i];
-    }
-    const int side = default_crop_side(width, height);
-    crops = pick_crops(score.data(), width, height, o.picked_crops, side, side);
-  }
+  if (!crops.empty()) return crops;
+  std::vector<float> score(std::size_t(width) * std::size_t(height), 0.0f);
   for (const auto& t : c.tests) {
+    if (!t.maps) continue;
+    const float* v = t.maps->plane(flip ? "error.flip" : "error.Y");
+    const float* inv = t.maps->plane("error.invalid");
+    if (!v) continue;
+    for (std::size_t i = 0; i < score.size(); ++i)
+      if (!(inv && inv[i] > 0.5f) && std::isfinite(v[i])) score[i] += v[i];
+  }
+  const int side = default_crop_side(width, height);
+  return pick_crops(score.data(), width, height, o.picked_crops, side, side);
+}
+
+// The top of the error maps' range: a round number above the 99th percentile of error.Y over every test's valid
+// pixels.
+float ComparisonPictures::Impl::sheet_error_high() const {
+  std::vector<float> error_all;
+  for (const auto& t : captured->tests) {
     const float* e = t.maps ? t.maps->plane("error.Y") : nullptr;
     const float* inv = t.maps ? t.maps->plane("error.invalid") : nullptr;
     if (e)
       for (std::size_t i = 0; i < t.maps->pixel_count(); ++i)
         if (!(inv && inv[i] > 0.5f)) error_all.push_back(e[i]);
   }
-  const float error_high = nice_ceiling(plane_quantile(error_all.data(), error_all.size(), 0.99));
+  return nice_ceiling(plane_quantile(error_all.data(), error_all.size(), 0.99));
+}
+
+// A test's caption on the sheet: its name, then its metrics two per line (those the registry puts on sheets).
+std::vector<std::string> ComparisonPictures::Impl::sheet_caption(const ComparisonReport& report,
+                                                                 const CapturedTest& t) {
+  std::vector<std::string> lines = {t.name};
+  std::string line;
+  int on_line = 0;
+  for (const auto& m : report.metrics) {
+    if (const MetricDefinition* d = find_metric(m); d && !d->on_sheet) continue;
+    const double v = t.metrics.value(m);
+    if (std::isnan(v)) continue;
+    line += (on_line ? "  " : "") + metric_text(m, v);
+    if (++on_line == 2) {
+      lines.push_back(line);
+      line.clear();
+      on_line = 0;
+    }
+  }
+  if (!line.empty()) lines.push_back(line);
+  return lines;
+}
+
+// Writes each test's error maps of the sheet's frame as maps/NAME.####.exr in the report (with --report) and
+// returns their links (empty without).
+Expected<std::vector<std::string>> ComparisonPictures::Impl::write_sheet_maps() {
+  const Captured& c = *captured;
+  std::vector<std::string> map_links;
+  for (const auto& t : c.tests) {
+    std::string link;
+    if (report_on && t.maps) {
+      Image exr = *t.maps;
+      exr.metadata().frame = c.frame;
+      exr.metadata().extra["reference"] = c.reference_path;
+      exr.metadata().extra["test"] = t.path;
+      const std::string rel_path = "maps/" + safe_name(t.name) + "." + frame_digits(c.frame) + ".exr";
+      if (auto st = write_exr_file(exr, in_report(rel_path), "--report"); !st) return st.error();
+      link = rel_path;
+    }
+    map_links.push_back(link);
+  }
+  return map_links;
+}
+
+Status ComparisonPictures::Impl::finish_sheet(const ComparisonReport& report) {
+  const Captured& c = *captured;
+  const bool flip = !c.tests.empty() && c.tests.front().maps && c.tests.front().maps->plane("error.flip");
+
+  auto picked = sheet_crops(flip);
+  if (!picked) return picked.error();
+  const std::vector<Rect> crops = std::move(*picked);
+  const float error_high = sheet_error_high();
 
   // Tiles: shrunk to max_tile_width, the crops outlined.
   const double scale = std::min(1.0, double(o.max_tile_width) / double(width));
@@ -437,42 +496,16 @@ Status ComparisonPictures::Impl::finish_sheet(const ComparisonReport& report) {
   rows[0].cells.push_back(SheetCell{tile(c.reference, true), {"reference", sheet_frame, "layer " + report.reference_layer},
                                     links ? rel(c.reference_path) : std::string(), "reference, " + c.reference_path, {}});
   for (const auto& t : c.tests) {
-    std::vector<std::string> lines = {t.name};
-    std::string line;
-    int on_line = 0;
-    for (const auto& m : report.metrics) {
-      if (const MetricDefinition* d = find_metric(m); d && !d->on_sheet) continue;
-      const double v = t.metrics.value(m);
-      if (std::isnan(v)) continue;
-      line += (on_line ? "  " : "") + metric_text(m, v);
-      if (++on_line == 2) {
-        lines.push_back(line);
-        line.clear();
-        on_line = 0;
-      }
-    }
-    if (!line.empty()) lines.push_back(line);
+    const std::vector<std::string> lines = sheet_caption(report, t);
     rows[0].cells.push_back(SheetCell{tile(t.picture, true), lines, links ? rel(t.path) : std::string(), t.name + ", " + t.path, {}});
   }
   // The heat maps of the frame: FLIP (magma, 0..1, the FLIP paper's) or the error of luminance (inferno).
   SheetRow maps_row;
   maps_row.heading = flip ? "FLIP per pixel (magma, 0 = identical ... 1)"
                           : "|error| of luminance per pixel (inferno, 0 ... " + format_number(error_high, 3) + ")";
-  const std::string maps_dir = "maps";
-  std::vector<std::string> map_links;
-  for (const auto& t : c.tests) {
-    std::string link;
-    if (report_on && t.maps) {
-      Image exr = *t.maps;
-      exr.metadata().frame = c.frame;
-      exr.metadata().extra["reference"] = c.reference_path;
-      exr.metadata().extra["test"] = t.path;
-      const std::string rel_path = maps_dir + "/" + safe_name(t.name) + "." + frame_digits(c.frame) + ".exr";
-      if (auto st = write_exr_file(exr, in_report(rel_path), "--report"); !st) return st;
-      link = rel_path;
-    }
-    map_links.push_back(link);
-  }
+  auto written_maps = write_sheet_maps();
+  if (!written_maps) return written_maps.error();
+  const std::vector<std::string>& map_links = *written_maps;
   {
     auto bar = colour_bar(flip ? Colormap::Magma : Colormap::Inferno, 0.0f, flip ? 1.0f : error_high,
                           flip ? "FLIP" : "|error| of luminance", tile_w, *font);

@@ -134,6 +134,110 @@ AxisRange chart_y_range(const Chart& chart) {
   return {lo, hi};
 }
 
+namespace {
+
+// The x extent of the finite points of a chart (any = false when it has none).
+struct XExtent {
+  double xmin = std::numeric_limits<double>::infinity(), xmax = -std::numeric_limits<double>::infinity();
+  bool any = false;
+};
+
+// Adds each series of `chart` to `xy` as a plot in its palette colour: curves, markers, the Pareto front (grey, thin)
+// and error bars (no legend entry); returns the x extent of the finite points.
+XExtent add_series(const Chart& chart, vtkChartXY& xy) {
+  XExtent e;
+  double& xmin = e.xmin;
+  double& xmax = e.xmax;
+  bool& any = e.any;
+  for (std::size_t s = 0; s < chart.series.size(); ++s) {
+    const auto& series = chart.series[s];
+    vtkNew<vtkTable> table;
+    vtkNew<vtkDoubleArray> xs;
+    xs->SetName("x");
+    vtkNew<vtkDoubleArray> ys;
+    ys->SetName(series.name.empty() ? ("series " + std::to_string(s + 1)).c_str() : series.name.c_str());
+    const std::size_t n = std::min(series.x.size(), series.y.size());
+    xs->SetNumberOfValues(vtkIdType(n));
+    ys->SetNumberOfValues(vtkIdType(n));
+    for (std::size_t i = 0; i < n; ++i) {
+      const double y = std::isfinite(series.y[i]) ? series.y[i] : std::numeric_limits<double>::quiet_NaN();
+      xs->SetValue(vtkIdType(i), series.x[i]);
+      ys->SetValue(vtkIdType(i), y);
+      if (std::isfinite(y)) {
+        any = true;
+        xmin = std::min(xmin, series.x[i]);
+        xmax = std::max(xmax, series.x[i]);
+      }
+    }
+    table->AddColumn(xs);
+    table->AddColumn(ys);
+    const bool as_line = chart.style == ChartStyle::Lines || series.line || series.error_bar;
+    vtkPlot* plot = xy.AddPlot(as_line ? vtkChart::LINE : vtkChart::POINTS);
+    plot->SetInputData(table, 0, 1);
+    plot->SetLabel(ys->GetName());
+    const std::size_t entry = series.color >= 0 ? std::size_t(series.color) : s;
+    const auto* c = kPalette[entry % (sizeof kPalette / sizeof kPalette[0])];
+    if (series.line && chart.style == ChartStyle::Points) {
+      plot->SetColor(110, 110, 110, 255);  // the front: grey, thin, behind the markers' colours
+      plot->SetWidth(1.5f);
+      if (auto* points = vtkPlotPoints::SafeDownCast(plot)) points->SetMarkerStyle(vtkPlotPoints::NONE);
+      continue;
+    }
+    if (series.error_bar && chart.style == ChartStyle::Points) {
+      plot->SetColor(c[0], c[1], c[2], 255);
+      plot->SetWidth(1.5f);
+      plot->SetLegendVisibility(false);
+      if (auto* points = vtkPlotPoints::SafeDownCast(plot)) points->SetMarkerStyle(vtkPlotPoints::NONE);
+      continue;
+    }
+    plot->SetColor(c[0], c[1], c[2], 255);
+    plot->SetWidth(chart.style == ChartStyle::Lines ? 2.0f : 1.0f);
+    if (auto* points = vtkPlotPoints::SafeDownCast(plot)) {
+      const bool few = n <= 60;
+      points->SetMarkerStyle(chart.style == ChartStyle::Points ? vtkPlotPoints::CIRCLE
+                                                               : (few ? vtkPlotPoints::CIRCLE : vtkPlotPoints::NONE));
+      points->SetMarkerSize(chart.style == ChartStyle::Points ? 14.0f : 6.0f);
+    }
+  }
+
+  return e;
+}
+
+// Ranges with a margin, so single points and flat curves (identical frames) stay visible.
+void set_axis_ranges(const Chart& chart, vtkChartXY& xy, const XExtent& e) {
+  const double xmin = e.xmin, xmax = e.xmax;
+  auto* left = xy.GetAxis(vtkAxis::LEFT);
+  auto* bottom = xy.GetAxis(vtkAxis::BOTTOM);
+  if (e.any) {
+    const AxisRange y = chart_y_range(chart);
+    left->SetBehavior(vtkAxis::FIXED);
+    left->SetRange(y.low, y.high);
+    const double xfrac = chart.style == ChartStyle::Points ? 0.1 : 0.02;  // markers need room at the edges
+    const double xpad = xmax > xmin ? xfrac * (xmax - xmin) : std::max(0.5, 0.1 * std::fabs(xmax));
+    bottom->SetBehavior(vtkAxis::FIXED);
+    bottom->SetRange(xmin - xpad, xmax + xpad);
+    // Whole-number x (frame numbers): ticks on whole numbers only, at a 1-2-5 step giving at most ~12 ticks.
+    bool whole = true;
+    for (const auto& series : chart.series)
+      for (double x : series.x) whole = whole && std::floor(x) == x;
+    if (whole && chart.style == ChartStyle::Lines) {
+      const double xspan = std::max(1.0, xmax - xmin);
+      double step = 1.0;
+      for (double base = 1.0; xspan / step > 12.0; base *= 10.0)
+        for (double m : {1.0, 2.0, 5.0})
+          if (xspan / step > 12.0) step = m * base;
+      vtkNew<vtkDoubleArray> ticks;
+      for (double t = std::ceil(xmin / step) * step; t <= xmax; t += step) ticks->InsertNextValue(t);
+      bottom->SetCustomTickPositions(ticks);
+      bottom->SetNotation(vtkAxis::FIXED_NOTATION);
+      bottom->SetPrecision(0);
+    }
+  }
+
+}
+
+}  // namespace
+
 Status write_chart(const Chart& chart, const std::string& path) {
   auto format = chart_format(path);
   if (!format) return format.error();
@@ -165,87 +269,8 @@ Status write_chart(const Chart& chart, const std::string& path) {
     xy->GetAxis(a)->GetLabelProperties()->SetFontSize(12);
   }
 
-  double xmin = std::numeric_limits<double>::infinity(), xmax = -xmin;
-  bool any = false;
-  for (std::size_t s = 0; s < chart.series.size(); ++s) {
-    const auto& series = chart.series[s];
-    vtkNew<vtkTable> table;
-    vtkNew<vtkDoubleArray> xs;
-    xs->SetName("x");
-    vtkNew<vtkDoubleArray> ys;
-    ys->SetName(series.name.empty() ? ("series " + std::to_string(s + 1)).c_str() : series.name.c_str());
-    const std::size_t n = std::min(series.x.size(), series.y.size());
-    xs->SetNumberOfValues(vtkIdType(n));
-    ys->SetNumberOfValues(vtkIdType(n));
-    for (std::size_t i = 0; i < n; ++i) {
-      const double y = std::isfinite(series.y[i]) ? series.y[i] : std::numeric_limits<double>::quiet_NaN();
-      xs->SetValue(vtkIdType(i), series.x[i]);
-      ys->SetValue(vtkIdType(i), y);
-      if (std::isfinite(y)) {
-        any = true;
-        xmin = std::min(xmin, series.x[i]);
-        xmax = std::max(xmax, series.x[i]);
-      }
-    }
-    table->AddColumn(xs);
-    table->AddColumn(ys);
-    const bool as_line = chart.style == ChartStyle::Lines || series.line || series.error_bar;
-    vtkPlot* plot = xy->AddPlot(as_line ? vtkChart::LINE : vtkChart::POINTS);
-    plot->SetInputData(table, 0, 1);
-    plot->SetLabel(ys->GetName());
-    const std::size_t entry = series.color >= 0 ? std::size_t(series.color) : s;
-    const auto* c = kPalette[entry % (sizeof kPalette / sizeof kPalette[0])];
-    if (series.line && chart.style == ChartStyle::Points) {
-      plot->SetColor(110, 110, 110, 255);  // the front: grey, thin, behind the markers' colours
-      plot->SetWidth(1.5f);
-      if (auto* points = vtkPlotPoints::SafeDownCast(plot)) points->SetMarkerStyle(vtkPlotPoints::NONE);
-      continue;
-    }
-    if (series.error_bar && chart.style == ChartStyle::Points) {
-      plot->SetColor(c[0], c[1], c[2], 255);
-      plot->SetWidth(1.5f);
-      plot->SetLegendVisibility(false);
-      if (auto* points = vtkPlotPoints::SafeDownCast(plot)) points->SetMarkerStyle(vtkPlotPoints::NONE);
-      continue;
-    }
-    plot->SetColor(c[0], c[1], c[2], 255);
-    plot->SetWidth(chart.style == ChartStyle::Lines ? 2.0f : 1.0f);
-    if (auto* points = vtkPlotPoints::SafeDownCast(plot)) {
-      const bool few = n <= 60;
-      points->SetMarkerStyle(chart.style == ChartStyle::Points ? vtkPlotPoints::CIRCLE
-                                                               : (few ? vtkPlotPoints::CIRCLE : vtkPlotPoints::NONE));
-      points->SetMarkerSize(chart.style == ChartStyle::Points ? 14.0f : 6.0f);
-    }
-  }
-
-  // Ranges with a margin, so single points and flat curves (identical frames) stay visible.
-  auto* left = xy->GetAxis(vtkAxis::LEFT);
-  auto* bottom = xy->GetAxis(vtkAxis::BOTTOM);
-  if (any) {
-    const AxisRange y = chart_y_range(chart);
-    left->SetBehavior(vtkAxis::FIXED);
-    left->SetRange(y.low, y.high);
-    const double xfrac = chart.style == ChartStyle::Points ? 0.1 : 0.02;  // markers need room at the edges
-    const double xpad = xmax > xmin ? xfrac * (xmax - xmin) : std::max(0.5, 0.1 * std::fabs(xmax));
-    bottom->SetBehavior(vtkAxis::FIXED);
-    bottom->SetRange(xmin - xpad, xmax + xpad);
-    // Whole-number x (frame numbers): ticks on whole numbers only, at a 1-2-5 step giving at most ~12 ticks.
-    bool whole = true;
-    for (const auto& series : chart.series)
-      for (double x : series.x) whole = whole && std::floor(x) == x;
-    if (whole && chart.style == ChartStyle::Lines) {
-      const double xspan = std::max(1.0, xmax - xmin);
-      double step = 1.0;
-      for (double base = 1.0; xspan / step > 12.0; base *= 10.0)
-        for (double m : {1.0, 2.0, 5.0})
-          if (xspan / step > 12.0) step = m * base;
-      vtkNew<vtkDoubleArray> ticks;
-      for (double t = std::ceil(xmin / step) * step; t <= xmax; t += step) ticks->InsertNextValue(t);
-      bottom->SetCustomTickPositions(ticks);
-      bottom->SetNotation(vtkAxis::FIXED_NOTATION);
-      bottom->SetPrecision(0);
-    }
-  }
+  const XExtent extent = add_series(chart, *xy);
+  set_axis_ranges(chart, *xy, extent);
 
   view->GetRenderWindow()->Render();
   TemporaryFile tmp(path);  // removed on failure and on SIGINT; the extension is kept

@@ -19,20 +19,13 @@ std::string with_title(const std::string& title, const std::string& what) {
 }
 }  // namespace
 
-std::vector<std::pair<std::string, Chart>> comparison_charts(const ComparisonReport& report,
-                                                             const std::string& plot_path, const std::string& title) {
-  const fs::path p(plot_path);
-  const std::string ext = p.has_extension() ? p.extension().string() : std::string(".png");
-  const std::string stem = (p.parent_path() / p.stem()).string();
-  std::string x_label = "frame number";
-  if (report.fps && *report.fps > 0) {
-    char text[64];
-    std::snprintf(text, sizeof text, "frame number (at %g frames/s)", *report.fps);
-    x_label = text;
-  }
-  std::vector<std::pair<std::string, Chart>> charts;
+namespace {
 
-  // One chart per measured metric, from its registry entry (temporal/compare/comparison.h).
+using NamedCharts = std::vector<std::pair<std::string, Chart>>;
+
+// One chart per measured metric, from its registry entry (temporal/compare/comparison.h): STEM + suffix + EXT.
+void metric_charts(const ComparisonReport& report, const std::string& stem, const std::string& ext,
+                   const std::string& title, const std::string& x_label, NamedCharts& charts) {
   for (const auto& name : report.metrics) {
     const MetricDefinition* d = find_metric(name);
     if (!d) continue;
@@ -66,8 +59,12 @@ std::vector<std::pair<std::string, Chart>> comparison_charts(const ComparisonRep
     charts.emplace_back(stem + d->chart.suffix + ext, std::move(c));
   }
 
-  // With --regions (docs/compare.md, "Regions"): each region's share of the valid pixels per frame (F-regions), and
-  // PSNR (RGB) per frame in each region (F-psnr-static, F-psnr-moving, F-psnr-disoccluded), one curve per sequence.
+}
+
+// With --regions (docs/compare.md, "Regions"): each region's share of the valid pixels per frame (F-regions), and
+// PSNR (RGB) per frame in each region (F-psnr-static, F-psnr-moving, F-psnr-disoccluded), one curve per sequence.
+void region_charts(const ComparisonReport& report, const std::string& stem, const std::string& ext,
+                   const std::string& title, const std::string& x_label, NamedCharts& charts) {
   if (report.regions && !report.sequences.empty()) {
     Chart shares;
     shares.title = with_title(title, "Share of the pixels in each region per frame");
@@ -108,9 +105,12 @@ std::vector<std::pair<std::string, Chart>> comparison_charts(const ComparisonRep
     }
   }
 
-  // Speed: only times that measure the method itself (ComputeKind::Method). A render-gbuffer input's computeMs
-  // is the render, a morph-120hz --perceive output's the perception simulation: neither is a method's cost.
-  // The points and their Pareto front come from speed_points (the JSON's `pareto` flags are the same).
+}
+
+// Speed: only times that measure the method itself (ComputeKind::Method). A render-gbuffer input's computeMs is the
+// render, a morph-120hz --perceive output's the perception simulation: neither is a method's cost. The points and
+// their Pareto front come from speed_points (the JSON's `pareto` flags are the same).
+Chart speed_chart(const ComparisonReport& report, const std::string& title) {
   Chart speed;
   speed.title = with_title(title, "Speed against error (mean over frames)");
   speed.x_label = "compute time per frame (ms; the method's own, file I/O excluded)";
@@ -158,6 +158,27 @@ std::vector<std::pair<std::string, Chart>> comparison_charts(const ComparisonRep
     if (!ms.empty() && std::isfinite(x.ci.low) && std::isfinite(x.ci.high) && x.ci.high > x.ci.low)
       speed.series.push_back({"", {x.ci.low, x.ci.high}, {point.value, point.value}, colour, false, true});
   }
+  return speed;
+}
+
+}  // namespace
+
+std::vector<std::pair<std::string, Chart>> comparison_charts(const ComparisonReport& report,
+                                                             const std::string& plot_path, const std::string& title) {
+  const fs::path p(plot_path);
+  const std::string ext = p.has_extension() ? p.extension().string() : std::string(".png");
+  const std::string stem = (p.parent_path() / p.stem()).string();
+  std::string x_label = "frame number";
+  if (report.fps && *report.fps > 0) {
+    char text[64];
+    std::snprintf(text, sizeof text, "frame number (at %g frames/s)", *report.fps);
+    x_label = text;
+  }
+  std::vector<std::pair<std::string, Chart>> charts;
+
+  metric_charts(report, stem, ext, title, x_label, charts);
+  region_charts(report, stem, ext, title, x_label, charts);
+  Chart speed = speed_chart(report, title);
   if (!speed.series.empty()) charts.emplace_back(stem + "-speed" + ext, std::move(speed));
   return charts;
 }

@@ -575,6 +575,13 @@ class HerzogStateGpu final : public MethodState, public gpu::TimedKernel {
     timing_.clock = timer_.clock();
     timing_.bytes_moved = bytes_moved(f);
 
+    return read_back(f, history, stats);
+  }
+
+  // Downloads the output (and debug planes), keeps this frame's depth and ids as the previous frame's, and counts
+  // the history pixels.
+  Status read_back(const FrameContext& f, bool history, FrameStats& stats) {
+    const int C = f.C;
     if (result_.width() != f.W || result_.height() != f.H) result_ = Image(f.W, f.H);
     for (int c = 0; c < C; ++c)
       if (Status s = out_[cur_].download(c, result_, g_.channels[std::size_t(c)]); !s) return s;
