@@ -202,4 +202,28 @@ std::string_view reproject() {
   return text;
 }
 
+std::string_view ycgco_box() {
+  return R"(
+void to_box(float v[BOX_C], out float b[BOX_C]) {
+#if BOX_C == 3
+  b[0] = 0.25 * v[0] + 0.5 * v[1] + 0.25 * v[2];
+  b[1] = -0.25 * v[0] + 0.5 * v[1] - 0.25 * v[2];
+  b[2] = 0.5 * v[0] - 0.5 * v[2];
+#else
+  b[0] = v[0];
+#endif
+}
+void from_box(float b[BOX_C], out float v[BOX_C]) {
+#if BOX_C == 3
+  const float t = b[0] - b[1];
+  v[0] = t + b[2];
+  v[1] = b[0] + b[1];
+  v[2] = t - b[2];
+#else
+  v[0] = b[0];
+#endif
+}
+)";
+}
+
 }  // namespace temporal::gpu::glsl

@@ -41,25 +41,6 @@ float luma(float v[C]) {
   return v[0];
 #endif
 }
-void to_box(float v[C], out float b[C]) {
-#if PHLM_C == 3
-  b[0] = 0.25 * v[0] + 0.5 * v[1] + 0.25 * v[2];
-  b[1] = -0.25 * v[0] + 0.5 * v[1] - 0.25 * v[2];
-  b[2] = 0.5 * v[0] - 0.5 * v[2];
-#else
-  b[0] = v[0];
-#endif
-}
-void from_box(float b[C], out float v[C]) {
-#if PHLM_C == 3
-  const float t = b[0] - b[1];
-  v[0] = t + b[2];
-  v[1] = b[0] + b[1];
-  v[2] = t - b[2];
-#else
-  v[0] = b[0];
-#endif
-}
 float model_scale(float c[C]) { return max_(1.0, abs(luma(c))); }
 
 // rls.h
@@ -502,11 +483,12 @@ Expected<std::unique_ptr<FrameFilter>> make_phlm_filter_gpu(std::shared_ptr<gpu:
   }
   gpu::Program programs[2];
   for (int k = 0; k < 2; ++k) {
-    const std::string define = std::string("#define PHLM_C ") + (k == 0 ? "1" : "3") + "\n";
+    const std::string define = std::string("#define PHLM_C ") + (k == 0 ? "1" : "3") + "\n#define BOX_C PHLM_C\n";
     auto program = gpu::Program::compile(
         context, k == 0 ? "phlm (1 channel)" : "phlm (3 channels)",
         {gpu::glsl::prelude(), define, gpu::glsl::storage(0, "src"), gpu::glsl::storage(1, "prev"),
-         gpu::glsl::storage(2, "nxt"), gpu::glsl::storage(3, "outb"), kPhlmDecl, gpu::glsl::reproject(), kPhlmMain});
+         gpu::glsl::storage(2, "nxt"), gpu::glsl::storage(3, "outb"), gpu::glsl::ycgco_box(), kPhlmDecl,
+         gpu::glsl::reproject(), kPhlmMain});
     if (!program) return program.error();
     programs[k] = std::move(*program);
   }

@@ -26,26 +26,6 @@ uniform float u_alpha, u_gamma;
 uniform float u_weight[9];
 #define PLANE(p) (uint(p) * u_n)
 
-// temporal/core/color.h
-void to_box(float v[TAA_C], out float b[TAA_C]) {
-#if TAA_C == 3
-  b[0] = 0.25 * v[0] + 0.5 * v[1] + 0.25 * v[2];
-  b[1] = -0.25 * v[0] + 0.5 * v[1] - 0.25 * v[2];
-  b[2] = 0.5 * v[0] - 0.5 * v[2];
-#else
-  b[0] = v[0];
-#endif
-}
-void from_box(float b[TAA_C], out float v[TAA_C]) {
-#if TAA_C == 3
-  const float t = b[0] - b[1];
-  v[0] = t + b[2];
-  v[1] = b[0] + b[1];
-  v[2] = t - b[2];
-#else
-  v[0] = b[0];
-#endif
-}
 // taa.cpp's min_ / max_ (plain comparisons).
 float min_(float a, float b) { return b < a ? b : a; }
 float max_(float a, float b) { return a < b ? b : a; }
@@ -336,11 +316,11 @@ Expected<std::unique_ptr<FrameFilter>> make_taa_filter_gpu(std::shared_ptr<gpu::
   }
   gpu::Program programs[2];
   for (int k = 0; k < 2; ++k) {
-    const std::string define = std::string("#define TAA_C ") + (k == 0 ? "1" : "3") + "\n";
+    const std::string define = std::string("#define TAA_C ") + (k == 0 ? "1" : "3") + "\n#define BOX_C TAA_C\n";
     auto program = gpu::Program::compile(
         context, k == 0 ? "taa (1 channel)" : "taa (3 channels)",
         {gpu::glsl::prelude(), define, gpu::glsl::storage(0, "src"), gpu::glsl::storage(1, "hist"),
-         gpu::glsl::storage(2, "nxt"), kTaaKernel, gpu::glsl::reproject(), kTaaMain});
+         gpu::glsl::storage(2, "nxt"), gpu::glsl::ycgco_box(), kTaaKernel, gpu::glsl::reproject(), kTaaMain});
     if (!program) return program.error();
     programs[k] = std::move(*program);
   }

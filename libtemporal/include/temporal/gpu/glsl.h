@@ -35,4 +35,9 @@ std::string storage(int binding, const char* name);
 // offset q) before this snippet when it tests depth or ids.
 std::string_view reproject();
 
+// temporal/core/color.h's to_ycgco_box / from_ycgco_box for BOX_C channels (1 or 3; the kernel defines BOX_C before
+// this snippet): void to_box(float v[BOX_C], out float b[BOX_C]) and from_box(b, v), YCgCo for three channels, the
+// value itself for one. The box space of phlm's box test and taa's clipping.
+std::string_view ycgco_box();
+
 }  // namespace temporal::gpu::glsl
