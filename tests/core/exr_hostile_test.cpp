@@ -119,10 +119,12 @@ TEST(ExrMemory, ReadsWhatTheFileReaderReadsAndRefusesWhatItRefuses) {
   ASSERT_TRUE(from_file && from_memory) << (from_memory ? "" : from_memory.error().message);
   EXPECT_EQ(from_memory->channel_names(), from_file->channel_names());
   for (const auto& c : from_file->channel_names()) {
-    if (const float* a = from_file->plane(c))
+    if (const float* a = from_file->plane(c)) {
       for (std::size_t i = 0; i < img.pixel_count(); ++i) ASSERT_EQ(a[i], from_memory->plane(c)[i]) << c;
-    if (const std::uint32_t* a = from_file->uint_plane(c))
+    }
+    if (const std::uint32_t* a = from_file->uint_plane(c)) {
       for (std::size_t i = 0; i < img.pixel_count(); ++i) ASSERT_EQ(a[i], from_memory->uint_plane(c)[i]) << c;
+    }
   }
   EXPECT_EQ(from_memory->metadata().frame.value_or(-1), 12);
   auto info = read_exr_info(bytes, "buffer.exr");

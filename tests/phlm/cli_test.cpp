@@ -254,8 +254,9 @@ TEST(FilterPhlmCli, AHugeFiniteColourIsNoSample) {
       auto state = read_exr((dir / name).string());
       ASSERT_TRUE(state) << state.error().message;
       for (const auto& c : state->channel_names())
-        if (const float* p = state->plane(c))
+        if (const float* p = state->plane(c)) {
           for (std::size_t i = 0; i < state->pixel_count(); ++i) ASSERT_TRUE(std::isfinite(p[i])) << name << " " << c;
+        }
     }
   }
 }

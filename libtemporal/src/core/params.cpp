@@ -102,7 +102,11 @@ Status check_param(const Param& p) {
   const double v = *value;
   if (!std::isfinite(v)) return Error::usage(p.flag + " must be a finite number (got " + number(v) + ")");
   if (p.or_zero && v == 0.0) return Status::ok();
-  if (v < p.min || v > p.max || (p.above_min && v == p.min))
+  // A float field holds the bound rounded to float (0.01 is stored as 0.0099999998): compare in that precision, so
+  // that the bound itself, given on the command line, is inside the range.
+  const bool as_float = std::holds_alternative<float*>(p.value);
+  const double lo = as_float ? double(float(p.min)) : p.min, hi = as_float ? double(float(p.max)) : p.max;
+  if (v < lo || v > hi || (p.above_min && v == lo))
     return Error::usage(p.flag + " " + number(v) + " is out of range: it must be " + param_range_text(p));
   return Status::ok();
 }

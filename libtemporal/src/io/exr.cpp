@@ -364,6 +364,19 @@ Status check_exr_structure(ExrSource& src) {
       return Error::input(path, "part " + std::to_string(p) + " declares " + std::to_string(w) + "x" +
                                     std::to_string(h) + " pixels: the tools read at most 16384x16384 per image "
                                     "(a corrupt header, or an image to crop or scale down first)");
+    // The chunkCount attribute (required in multi-part files) must be the number of chunks the part has: a negative
+    // one was read past (the readers count chunks from the data window) and the file accepted with exit 0 (issue
+    // 26); a file that disagrees with itself is corrupt. Scanline parts: ceil(height / scanlines per chunk).
+    if (std::int32_t declared = 0; exr_attr_get_int(ctx, p, "chunkCount", &declared) == EXR_ERR_SUCCESS) {
+      std::int32_t lines = 0;
+      std::int64_t expected = -1;
+      if (storage == EXR_STORAGE_SCANLINE && exr_get_scanlines_per_chunk(ctx, p, &lines) == EXR_ERR_SUCCESS && lines > 0)
+        expected = (h + lines - 1) / lines;
+      if (declared < 1 || (expected > 0 && declared != expected))
+        return Error::input(path, "part " + std::to_string(p) + " declares " + std::to_string(declared) + " chunks" +
+                                      (expected > 0 ? " but its data window holds " + std::to_string(expected) : "") +
+                                      " (chunkCount): the file is corrupt; write it again");
+    }
     exr_chunk_info_t last{};
     exr_result_t r = EXR_ERR_SUCCESS;
     if (storage == EXR_STORAGE_SCANLINE) {
