@@ -7,8 +7,10 @@
 
 #include <OpenImageIO/imageio.h>
 
+#include <cstring>
 #include <fstream>
 #include <iterator>
+#include <limits>
 #include <tuple>
 #include <vector>
 
@@ -146,6 +148,37 @@ TEST(ExrMemory, ReadsWhatTheFileReaderReadsAndRefusesWhatItRefuses) {
   auto r3 = read_exr(png, "p.exr");
   ASSERT_FALSE(r3);
   EXPECT_NE(r3.error().message.find("PNG"), std::string::npos) << r3.error().message;
+}
+
+
+// Issue 26, "Exit codes that say fine": a multi-part file whose chunkCount attribute is negative (or disagrees with
+// its data window) was read with exit 0; it is an input error naming the file and the attribute.
+TEST(ExrHostile, AChunkCountThatDisagreesWithTheFileIsRefused) {
+  const fs::path dir = test::scratch_dir("exr_hostile_chunks");
+  Image img(8, 40);
+  img.add_channel("R", 0.5f);
+  img.add_channel("G", 0.5f);
+  img.add_channel("B", 0.5f);
+  img.add_channel("depth.Z", 2.0f);
+  ASSERT_TRUE(write_exr((dir / "ok.exr").string(), img));
+  std::ifstream in(dir / "ok.exr", std::ios::binary);
+  const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::string key = std::string("chunkCount\0int\0", 15) + std::string("\x04\0\0\0", 4);
+  const std::size_t at = bytes.find(key);
+  ASSERT_NE(at, std::string::npos) << "a multi-part file has chunkCount";
+  ASSERT_TRUE(read_exr((dir / "ok.exr").string()));
+  for (std::int32_t bad : {-5, std::numeric_limits<std::int32_t>::min(), 0, 1000}) {
+    std::string patched = bytes;
+    std::memcpy(&patched[at + key.size()], &bad, 4);  // little-endian, as the file
+    const fs::path path = dir / ("bad" + std::to_string(bad) + ".exr");
+    std::ofstream(path, std::ios::binary) << patched;
+    auto r = read_exr(path.string());
+    ASSERT_FALSE(r) << bad;
+    EXPECT_EQ(r.error().kind, ErrorKind::Input);
+    EXPECT_EQ(r.error().file, path.string());
+    EXPECT_NE(r.error().message.find("chunkCount"), std::string::npos) << r.error().message;
+    EXPECT_FALSE(read_exr_info(path.string())) << bad;
+  }
 }
 
 }  // namespace

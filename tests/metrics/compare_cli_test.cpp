@@ -403,6 +403,7 @@ TEST_F(CompareCli, OutputsThatAliasOrAreNotRegularFilesAreRefused) {
   EXPECT_NE(out.find("--json"), std::string::npos) << out;
   EXPECT_NE(out.find("--csv"), std::string::npos) << out;
   EXPECT_FALSE(fs::exists(dir_ / "m.txt"));
+  fs::create_directories(dir_ / "sub");
   EXPECT_EQ(run("--reference ref.####.exr a.####.exr --csv m.txt --json ./sub/../m.txt", &out), 1) << out;
   const fs::path fifo = dir_ / "pipe.csv";
   ASSERT_EQ(mkfifo(fifo.c_str(), 0600), 0);
