@@ -7,6 +7,7 @@
 
 #include <sys/stat.h>
 
+#include <OpenImageIO/imageio.h>
 #include <nlohmann/json.hpp>
 
 #include <gtest/gtest.h>
@@ -415,6 +416,35 @@ TEST_F(CompareCli, OutputsThatAliasOrAreNotRegularFilesAreRefused) {
   EXPECT_TRUE(S_ISFIFO(st.st_mode)) << "the pipe was replaced";
   EXPECT_EQ(run("--reference ref.####.exr a.####.exr --csv /dev/null", &out), 1) << out;  // a character device
   EXPECT_NE(out.find("/dev/null"), std::string::npos) << out;
+}
+
+// Issue 26 items 6 and 8 at the command line: a test frame whose data window is shifted against its display window
+// (it scored inf dB) and one whose R, G, B are stored as uint32 (SIGSEGV) are input errors (exit 2) naming the file.
+TEST_F(CompareCli, ShiftedDataWindowsAndIntegerColourAreInputErrorsNamingTheFile) {
+  auto write_raw = [&](const std::string& name, int x, int y, OIIO::TypeDesc type) {
+    OIIO::ImageSpec spec(64 - x, 40 - y, 3, type);
+    spec.x = x;
+    spec.y = y;
+    spec.full_width = 64;
+    spec.full_height = 40;
+    spec.channelnames = {"R", "G", "B"};
+    auto out = OIIO::ImageOutput::create(name);
+    ASSERT_TRUE(out && out->open((dir_ / name).string(), spec));
+    std::vector<float> pixels(std::size_t(spec.width) * spec.height * 3, 0.25f);
+    std::vector<std::uint32_t> ints(pixels.size(), 7u);
+    ASSERT_TRUE(type == OIIO::TypeFloat ? out->write_image(OIIO::TypeFloat, pixels.data())
+                                        : out->write_image(OIIO::TypeUInt, ints.data()));
+    ASSERT_TRUE(out->close());
+  };
+  write_raw("shift.0001.exr", 10, 7, OIIO::TypeFloat);
+  write_raw("uint.0001.exr", 0, 0, OIIO::TypeUInt);
+  std::string out;
+  EXPECT_EQ(run("--reference ref.####.exr shift.####.exr --frames 1-1", &out), 2) << out;
+  EXPECT_NE(out.find("shift.0001.exr"), std::string::npos) << out;
+  EXPECT_NE(out.find("data window"), std::string::npos) << out;
+  EXPECT_EQ(run("--reference ref.####.exr uint.####.exr --frames 1-1", &out), 2) << out;
+  EXPECT_NE(out.find("uint.0001.exr"), std::string::npos) << out;
+  EXPECT_NE(out.find("uint"), std::string::npos) << out;
 }
 
 // Inputs that cannot be examined (a symbolic link loop) are input errors naming the file wherever compare looks
