@@ -127,6 +127,13 @@ RunHooks Tool::hooks() {
 }
 
 int Tool::run(int argc, char** argv, const std::function<Status()>& body) {
+  // Every floating-point option has a finite range (core/params.h, issue 26): a Param table without one is the
+  // tool's own bug, caught by any run of the tool (its tests included) before the options are read.
+  for (const auto& p : params_)
+    if (!has_finite_range(p)) {
+      print_error(Error::internal(p.flag + " has no finite range in its Param table (please report this)"));
+      return kExitInternal;
+    }
   for (int i = 1; i < argc; ++i) {
     if (i > 1) command_line_ += ' ';
     command_line_ += argv[i];

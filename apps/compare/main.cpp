@@ -74,10 +74,10 @@ int main(int argc, char** argv) {
                         "to [0,1]); hdr = HDR-FLIP of the scene-linear values (ACES, automatic exposures). Off by "
                         "default: it costs about as much as PSNR and SSIM together (LDR) or more (HDR)",
                         &flip, {"off", "ldr", "hdr"}),
-          Param::positive("--ppd",
-                          "FLIP's viewing condition in pixels per degree of visual angle (default: 0.7 m from a 0.7 m "
-                          "wide 3840-pixel screen)",
-                          &setup.flip_options.pixels_per_degree),
+          Param::real("--ppd",
+                      "FLIP's viewing condition in pixels per degree of visual angle (default: 0.7 m from a 0.7 m "
+                      "wide 3840-pixel screen; FLIP's filters grow with it)",
+                      &setup.flip_options.pixels_per_degree, kFlipMinPixelsPerDegree, kFlipMaxPixelsPerDegree),
           Param::choice("--regions",
                         "Every metric also per region: motion = static (zero motion, history, reference unchanged for "
                         "--static-frames frames), moving, disoccluded (the reprojection's depth/id test fails), from "
@@ -91,7 +91,8 @@ int main(int argc, char** argv) {
                 .help = "Largest frame-to-frame change of the reference's luminance (pixel units) that counts as "
                         "unchanged for the static region (noise of a Monte-Carlo reference)",
                 .value = &setup.region_options.static_tolerance,
-                .min = 0.0},
+                .min = 0.0,
+                .max = 1e6},
           Param::text("--speed-metric",
                       "Metric judged against compute time: the speed chart's y axis and the JSON's `pareto` flags "
                       "(compare --list-metrics)",
@@ -137,7 +138,9 @@ int main(int argc, char** argv) {
                       &profile),
           Param{.flag = "--exposure",
                 .help = "Exposure of the pictures in stops (values x 2^E before encoding)",
-                .value = &pic.display.exposure},
+                .value = &pic.display.exposure,
+                .min = -64.0,  // 2^E stays a normal float
+                .max = 64.0},
           Param::text("--display",
                       "Display colour space of the pictures (OCIO config: srgb_display, gamma22_display, ...)",
                       &pic.display.display),
@@ -153,7 +156,7 @@ int main(int argc, char** argv) {
   ParamList thresholds_params;
   for (const auto& d : metric_registry()) {
     if (d.threshold_option.empty()) continue;
-    thresholds_params.push_back(Param::optional("--fail-" + d.threshold_option, d.threshold_help, &fail[d.name]));
+    thresholds_params.push_back(Param::optional("--fail-" + d.threshold_option, d.threshold_help, &fail[d.name], -1e6, 1e6));
     fail_list += (fail_list.empty() ? "--fail-" : ", --fail-") + d.threshold_option;
   }
   bool fail_nonfinite = false;

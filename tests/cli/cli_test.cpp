@@ -12,6 +12,8 @@
 #include <fstream>
 #include <regex>
 #include <set>
+#include <utility>
+#include <vector>
 
 namespace temporal {
 namespace {
@@ -80,6 +82,45 @@ INSTANTIATE_TEST_SUITE_P(AllTools, ToolCli, ::testing::ValuesIn(kTools), [](cons
     if (c == '-') c = '_';
   return name;
 });
+
+// Issue 26, "Exit codes that say fine": empty option values (`--flag=`) and infinite or overflowing ones are usage
+// errors (exit 1) naming the option, before any file is read (the inputs named here do not exist: an input error,
+// exit 2, would mean the options were accepted).
+TEST(OptionValues, EmptyInfiniteAndOverflowingValuesAreUsageErrorsNamingTheOption) {
+  const std::string seq = " --input in.####.exr --gbuffer g.####.exr --out o.####.exr";
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"morph-120hz" + seq, "--distortion-low="},
+      {"morph-120hz" + seq, "--distortion-low inf"},
+      {"morph-120hz" + seq, "--snap-threshold 1e300"},
+      {"morph-120hz" + seq, "--ppd 1e-40"},
+      {"morph-120hz" + seq, "--fps 1e-40"},
+      {"compare --reference r.####.exr t.####.exr", "--sheet-frame="},
+      {"compare --reference r.####.exr t.####.exr", "--ppd 1e30"},
+      {"compare --reference r.####.exr t.####.exr", "--exposure 1e10"},
+      {"compare --reference r.####.exr t.####.exr", "--fail-psnr inf"},
+      {"upsample-st" + seq, "--lock-luma-change="},
+      {"upsample-st" + seq, "--sigma-depth 1e-40"},
+      {"upsample-st" + seq, "--max-history-weight 1e30"},
+      {"render-gbuffer scene.glb --out o", "--ssao-radius inf"},
+      {"render-gbuffer scene.glb --out o", "--shadow-bias -inf"},
+      {"render-gbuffer scene.glb --out o", "--ssao-radius="},
+      {"render-gbuffer scene.glb --out o", "--fps 1e-45"},
+      {"filter-phlm" + seq, "--p-init 1e38"},
+      {"filter-phlm" + seq, "--trace-factor 1e-40"},
+      {"filter-phlm" + seq, "--ema-depth-tolerance inf"},
+  };
+  const std::string dir = test::scratch_dir("option_values").string();
+  for (const auto& [command, option] : cases) {
+    const std::string tool = command.substr(0, command.find(' '));
+    const std::string args = command.substr(command.find(' '));
+    std::string out;
+    EXPECT_EQ(test::run_command("cd " + dir + " && " + test::tool_path(tool).string() + args + " " + option, &out), 1)
+        << tool << " " << option << "\n" << out;
+    const std::string flag = option.substr(0, option.find_first_of(" ="));
+    EXPECT_NE(out.find(flag), std::string::npos) << tool << " " << option << "\n" << out;
+    EXPECT_EQ(out.rfind(tool + ": ", 0), 0u) << out;
+  }
+}
 
 // Issue 21: `--layer` is one rule (select_layers, docs/conventions.md "Layers") in every tool. One multi-layer
 // sequence (render-gbuffer's shade: R,G,B, direct.R,G,B, ssao.Y, ...) goes through all four tools with the same

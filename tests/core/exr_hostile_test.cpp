@@ -7,6 +7,10 @@
 
 #include <OpenImageIO/imageio.h>
 
+#include <cstring>
+#include <fstream>
+#include <iterator>
+#include <limits>
 #include <tuple>
 #include <vector>
 
@@ -89,6 +93,91 @@ TEST(ExrStandardAttributes, FramesPerSecondAndChromaticities) {
     const float* xy = static_cast<const float*>(c->data());
     EXPECT_FLOAT_EQ(xy[0], 0.64f);
     EXPECT_FLOAT_EQ(xy[7], 0.3290f);
+  }
+}
+
+
+// The readers over a buffer in memory (tests/fuzz/exr_fuzz reads its inputs this way) read what the file readers
+// read, bit for bit, and refuse what they refuse, naming the buffer by the name given.
+TEST(ExrMemory, ReadsWhatTheFileReaderReadsAndRefusesWhatItRefuses) {
+  const fs::path dir = test::scratch_dir("exr_memory");
+  Image img(9, 5);
+  float* r = img.add_channel("R");
+  img.add_channel("G", 0.5f);
+  img.add_channel("B", 0.25f);
+  img.add_channel("depth.Z", 3.0f);
+  std::uint32_t* id = img.add_uint_channel("id");
+  for (std::size_t i = 0; i < img.pixel_count(); ++i) {
+    r[i] = float(i) * 0.125f;
+    id[i] = std::uint32_t(i * 7);
+  }
+  img.metadata().frame = 12;
+  ASSERT_TRUE(write_exr((dir / "m.exr").string(), img));
+  std::ifstream in(dir / "m.exr", std::ios::binary);
+  const std::vector<std::uint8_t> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  ASSERT_GT(bytes.size(), 100u);
+  auto from_file = read_exr((dir / "m.exr").string());
+  auto from_memory = read_exr(bytes, "buffer.exr");
+  ASSERT_TRUE(from_file && from_memory) << (from_memory ? "" : from_memory.error().message);
+  EXPECT_EQ(from_memory->channel_names(), from_file->channel_names());
+  for (const auto& c : from_file->channel_names()) {
+    if (const float* a = from_file->plane(c)) {
+      for (std::size_t i = 0; i < img.pixel_count(); ++i) ASSERT_EQ(a[i], from_memory->plane(c)[i]) << c;
+    }
+    if (const std::uint32_t* a = from_file->uint_plane(c)) {
+      for (std::size_t i = 0; i < img.pixel_count(); ++i) ASSERT_EQ(a[i], from_memory->uint_plane(c)[i]) << c;
+    }
+  }
+  EXPECT_EQ(from_memory->metadata().frame.value_or(-1), 12);
+  auto info = read_exr_info(bytes, "buffer.exr");
+  ASSERT_TRUE(info);
+  EXPECT_EQ(info->width, 9);
+  auto depth = read_exr(bytes, "buffer.exr", ExrSelection{{"depth"}});
+  ASSERT_TRUE(depth);
+  EXPECT_TRUE(depth->plane("depth.Z") && !depth->plane("R"));
+  // Truncated in its last chunk, cut inside the header, empty, and another format: refused, naming the buffer.
+  for (std::size_t keep : {bytes.size() - 20, std::size_t(40), std::size_t(0)}) {
+    const std::vector<std::uint8_t> cut(bytes.begin(), bytes.begin() + std::ptrdiff_t(keep));
+    auto r2 = read_exr(cut, "cut.exr");
+    ASSERT_FALSE(r2) << keep;
+    EXPECT_EQ(r2.error().kind, ErrorKind::Input);
+    EXPECT_EQ(r2.error().file, "cut.exr");
+    EXPECT_FALSE(read_exr_info(cut, "cut.exr")) << keep;
+  }
+  const std::vector<std::uint8_t> png = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n', 0, 0, 0, 13};
+  auto r3 = read_exr(png, "p.exr");
+  ASSERT_FALSE(r3);
+  EXPECT_NE(r3.error().message.find("PNG"), std::string::npos) << r3.error().message;
+}
+
+
+// Issue 26, "Exit codes that say fine": a multi-part file whose chunkCount attribute is negative (or disagrees with
+// its data window) was read with exit 0; it is an input error naming the file and the attribute.
+TEST(ExrHostile, AChunkCountThatDisagreesWithTheFileIsRefused) {
+  const fs::path dir = test::scratch_dir("exr_hostile_chunks");
+  Image img(8, 40);
+  img.add_channel("R", 0.5f);
+  img.add_channel("G", 0.5f);
+  img.add_channel("B", 0.5f);
+  img.add_channel("depth.Z", 2.0f);
+  ASSERT_TRUE(write_exr((dir / "ok.exr").string(), img));
+  std::ifstream in(dir / "ok.exr", std::ios::binary);
+  const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::string key = std::string("chunkCount\0int\0", 15) + std::string("\x04\0\0\0", 4);
+  const std::size_t at = bytes.find(key);
+  ASSERT_NE(at, std::string::npos) << "a multi-part file has chunkCount";
+  ASSERT_TRUE(read_exr((dir / "ok.exr").string()));
+  for (std::int32_t bad : {-5, std::numeric_limits<std::int32_t>::min(), 0, 1000}) {
+    std::string patched = bytes;
+    std::memcpy(&patched[at + key.size()], &bad, 4);  // little-endian, as the file
+    const fs::path path = dir / ("bad" + std::to_string(bad) + ".exr");
+    std::ofstream(path, std::ios::binary) << patched;
+    auto r = read_exr(path.string());
+    ASSERT_FALSE(r) << bad;
+    EXPECT_EQ(r.error().kind, ErrorKind::Input);
+    EXPECT_EQ(r.error().file, path.string());
+    EXPECT_NE(r.error().message.find("chunkCount"), std::string::npos) << r.error().message;
+    EXPECT_FALSE(read_exr_info(path.string())) << bad;
   }
 }
 

@@ -17,6 +17,8 @@
 #include <cmath>
 #include <csignal>
 #include <fstream>
+#include <limits>
+#include <optional>
 
 namespace {
 
@@ -148,6 +150,35 @@ TEST(Robustness, NonFiniteAndOutOfRangeParametersAreUsageErrors) {
   Param q = Param::positive("--scale", "scale", &g);
   EXPECT_FALSE(check_param(q));  // > 0
   EXPECT_EQ(param_range_text(q), "> 0");
+}
+
+// Issue 26 item 13: every floating-point option has a finite range; an "off / derived" 0 outside it is allowed by
+// or_zero (morph-120hz --ppd: 0 or [0.01, 10000], so 1e-40 no longer makes fps / ppd infinite). The tools refuse to
+// start with a floating-point Param whose range is not finite (has_finite_range).
+TEST(Robustness, FloatParametersHaveFiniteRangesAndZeroCanBeTheOffValue) {
+  float ppd = 0.0f;
+  const Param p = Param::real_or_zero("--ppd", "pixels per degree", &ppd, 0.01, 1e4);
+  EXPECT_TRUE(check_param(p));
+  EXPECT_EQ(param_range_text(p), "0 or [0.01, 10000]");
+  for (float bad : {1e-40f, 0.001f, -1.0f, 2e4f}) {
+    ppd = bad;
+    const Status s = check_param(p);
+    ASSERT_FALSE(s) << bad;
+    EXPECT_NE(s.error().message.find("it must be 0 or [0.01, 10000]"), std::string::npos) << s.error().message;
+  }
+  ppd = 0.01f;
+  EXPECT_TRUE(check_param(p));
+  EXPECT_TRUE(has_finite_range(p));
+  float x = 0.0f;
+  double d = 1.0;
+  std::optional<double> o;
+  int i = 0;
+  EXPECT_FALSE(has_finite_range(Param::positive("--scale", "scale", &x)));
+  EXPECT_FALSE(has_finite_range(Param::real("--a", "a", &x, 0.0, INFINITY)));
+  EXPECT_FALSE(has_finite_range(Param::optional("--t", "threshold", &o)));
+  EXPECT_TRUE(has_finite_range(Param::optional("--t", "threshold", &o, -1e6, 1e6)));
+  EXPECT_TRUE(has_finite_range(Param::real("--d", "d", &d, 1.0, 1000.0)));
+  EXPECT_TRUE(has_finite_range(Param::integer("--n", "n", &i, 0, std::numeric_limits<int>::max())));
 }
 
 // Issue 26: an empty value is a usage error naming the parameter, for text parameters too (it used to be kept as

@@ -1,6 +1,8 @@
 #!/usr/bin/env bash
 # Runs one libFuzzer target for a bounded time (the fuzz_<target> CTests; by hand too):
 #   run_fuzzer.sh FUZZER WORK_DIR SECONDS MAX_LEN SEED_SPEC...
+# SECONDS may instead be runs=N: the fuzzer stops after N executions, however long they take (the fuzz-long
+# CTests: 10^6 executions per parser).
 # SEED_SPEC is DIR:EXT[,EXT...]: every file under DIR (recursively) with one of the extensions is copied into
 # WORK_DIR/seeds (never into the repository); a DIR that does not exist is skipped with a message (the shared
 # assets are optional). A DIR starting with SHARED means the shared assets: $TEMPORAL_SHARED_ASSETS, else
@@ -34,5 +36,10 @@ regressions="$here/regressions/$name"
 if compgen -G "$regressions/*" >/dev/null; then
   "$fuzzer" -runs=1 "$regressions"/* 2>&1 | tail -3
 fi
-exec "$fuzzer" -max_total_time="$seconds" -timeout=20 -rss_limit_mb=2048 -max_len="$max_len" \
+if [[ "$seconds" == runs=* ]]; then
+  limit=(-runs="${seconds#runs=}")
+else
+  limit=(-max_total_time="$seconds")
+fi
+exec "$fuzzer" "${limit[@]}" -timeout=20 -rss_limit_mb=2048 -max_len="$max_len" \
   -print_final_stats=1 -artifact_prefix="$work/crash-" "$work/corpus" "$work/seeds"

@@ -5,11 +5,15 @@
 
 #include "test_support.h"
 
+#include <sys/stat.h>
+
+#include <OpenImageIO/imageio.h>
 #include <nlohmann/json.hpp>
 
 #include <gtest/gtest.h>
 
 #include <array>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <functional>
@@ -438,6 +442,105 @@ TEST_F(CompareCli, ListsMetricsAndFlagsTheParetoFront) {
   EXPECT_NE(out.find("--flip ldr"), std::string::npos) << out;
   EXPECT_EQ(run(tests + " --speed-metric psnr", &out), 1) << out;
   EXPECT_NE(out.find("--speed-metric 'psnr' is not a metric"), std::string::npos) << out;
+}
+
+// Issue 26 item 8: a --crop whose x + w overflows an int, and a --ppd that asks FLIP for filters of 1e29 taps, once
+// crashed compare (SIGSEGV); both are usage errors naming the option. The FLIP range's ends run.
+TEST_F(CompareCli, OverflowingCropsAndPixelsPerDegreeAreUsageErrors) {
+  std::string out;
+  EXPECT_EQ(run("--reference ref.####.exr a.####.exr --png pics --crop 60,60,2147483647,2147483647", &out), 1) << out;
+  EXPECT_NE(out.find("--crop 60,60,2147483647,2147483647 does not fit in the 64x40 image"), std::string::npos) << out;
+  EXPECT_EQ(run("--reference ref.####.exr a.####.exr --png pics --crop 2147483647,0,1,1", &out), 1) << out;
+  EXPECT_NE(out.find("--crop"), std::string::npos) << out;
+  for (const char* ppd : {"1e30", "1001", "0.5", "1e-40", "inf"}) {
+    EXPECT_EQ(run(std::string("--reference ref.####.exr a.####.exr --flip ldr --ppd ") + ppd, &out), 1) << ppd << out;
+    EXPECT_NE(out.find("--ppd"), std::string::npos) << out;
+  }
+  EXPECT_NE(out.find("must be a finite number"), std::string::npos) << out;
+  ASSERT_EQ(run("--help", &out), 0);
+  EXPECT_NE(out.find("[1, 1000]"), std::string::npos) << "--help names --ppd's range";
+  for (const char* ppd : {"1", "1000"}) {
+    for (const char* mode : {"ldr", "hdr"}) {
+      EXPECT_EQ(run(std::string("--reference ref.####.exr a.####.exr --frames 1-2 --json f.json --flip ") + mode +
+                        " --ppd " + ppd,
+                    &out),
+                0)
+          << mode << " " << ppd << out;
+      const auto j = nlohmann::json::parse(read_text(dir_ / "f.json"));
+      const auto& flip = j["sequences"][0]["flip"];
+      ASSERT_TRUE(flip.is_object()) << j.dump().substr(0, 600);
+      ASSERT_TRUE(flip["mean"].is_number()) << "a NaN FLIP is written as null: " << flip.dump();
+      EXPECT_TRUE(std::isfinite(flip["mean"].get<double>())) << flip.dump();
+    }
+  }
+}
+
+// Issue 26 items 2 and 5: --csv and --json naming one file lost the CSV, and an output that was a device node was
+// replaced by a regular file (exit 0). Both are refused (exit 1) before anything is written; the pipe stays a pipe.
+TEST_F(CompareCli, OutputsThatAliasOrAreNotRegularFilesAreRefused) {
+  std::string out;
+  EXPECT_EQ(run("--reference ref.####.exr a.####.exr --csv m.txt --json m.txt", &out), 1) << out;
+  EXPECT_NE(out.find("--json"), std::string::npos) << out;
+  EXPECT_NE(out.find("--csv"), std::string::npos) << out;
+  EXPECT_FALSE(fs::exists(dir_ / "m.txt"));
+  fs::create_directories(dir_ / "sub");
+  EXPECT_EQ(run("--reference ref.####.exr a.####.exr --csv m.txt --json ./sub/../m.txt", &out), 1) << out;
+  const fs::path fifo = dir_ / "pipe.csv";
+  ASSERT_EQ(mkfifo(fifo.c_str(), 0600), 0);
+  EXPECT_EQ(run("--reference ref.####.exr a.####.exr --csv pipe.csv", &out), 1) << out;
+  EXPECT_NE(out.find("pipe.csv"), std::string::npos) << out;
+  EXPECT_NE(out.find("not a regular file"), std::string::npos) << out;
+  struct stat st {};
+  ASSERT_EQ(::stat(fifo.c_str(), &st), 0);
+  EXPECT_TRUE(S_ISFIFO(st.st_mode)) << "the pipe was replaced";
+  EXPECT_EQ(run("--reference ref.####.exr a.####.exr --csv /dev/null", &out), 1) << out;  // a character device
+  EXPECT_NE(out.find("/dev/null"), std::string::npos) << out;
+}
+
+// Issue 26 items 6 and 8 at the command line: a test frame whose data window is shifted against its display window
+// (it scored inf dB) and one whose R, G, B are stored as uint32 (SIGSEGV) are input errors (exit 2) naming the file.
+TEST_F(CompareCli, ShiftedDataWindowsAndIntegerColourAreInputErrorsNamingTheFile) {
+  auto write_raw = [&](const std::string& name, int x, int y, OIIO::TypeDesc type) {
+    OIIO::ImageSpec spec(64 - x, 40 - y, 3, type);
+    spec.x = x;
+    spec.y = y;
+    spec.full_width = 64;
+    spec.full_height = 40;
+    spec.channelnames = {"R", "G", "B"};
+    auto out = OIIO::ImageOutput::create(name);
+    ASSERT_TRUE(out && out->open((dir_ / name).string(), spec));
+    std::vector<float> pixels(std::size_t(spec.width) * spec.height * 3, 0.25f);
+    std::vector<std::uint32_t> ints(pixels.size(), 7u);
+    ASSERT_TRUE(type == OIIO::TypeFloat ? out->write_image(OIIO::TypeFloat, pixels.data())
+                                        : out->write_image(OIIO::TypeUInt, ints.data()));
+    ASSERT_TRUE(out->close());
+  };
+  write_raw("shift.0001.exr", 10, 7, OIIO::TypeFloat);
+  write_raw("uint.0001.exr", 0, 0, OIIO::TypeUInt);
+  std::string out;
+  EXPECT_EQ(run("--reference ref.####.exr shift.####.exr --frames 1-1", &out), 2) << out;
+  EXPECT_NE(out.find("shift.0001.exr"), std::string::npos) << out;
+  EXPECT_NE(out.find("data window"), std::string::npos) << out;
+  EXPECT_EQ(run("--reference ref.####.exr uint.####.exr --frames 1-1", &out), 2) << out;
+  EXPECT_NE(out.find("uint.0001.exr"), std::string::npos) << out;
+  EXPECT_NE(out.find("uint"), std::string::npos) << out;
+}
+
+// Inputs that cannot be examined (a symbolic link loop) are input errors naming the file wherever compare looks
+// at them, also where it checks whether the frame before a --frames range exists (it used the throwing
+// std::filesystem::exists there: exit 5, "please report this").
+TEST_F(CompareCli, AnInputThatCannotBeExaminedIsAnInputErrorNamingIt) {
+  for (int f = 2; f <= 3; ++f)
+    fs::copy_file(dir_ / ("a.000" + std::to_string(f) + ".exr"), dir_ / ("loop.000" + std::to_string(f) + ".exr"));
+  fs::create_symlink("loop.0001.exr", dir_ / "loop.0001.exr");  // a link to itself
+  std::string out;
+  EXPECT_EQ(run("--reference ref.####.exr loop.####.exr --frames 2-3", &out), 2) << out;
+  EXPECT_NE(out.find("loop.0001.exr"), std::string::npos) << out;
+  EXPECT_NE(out.find("cannot be examined"), std::string::npos) << out;
+  EXPECT_EQ(out.find("please report"), std::string::npos) << out;
+  // The control: without the loop the frame before the range is simply absent.
+  fs::remove(dir_ / "loop.0001.exr");
+  EXPECT_EQ(run("--reference ref.####.exr loop.####.exr --frames 2-3", &out), 0) << out;
 }
 
 }  // namespace

@@ -292,6 +292,17 @@ TEST(Flip, BadOptionsAndInputsAreErrors) {
   FlipOptions o;
   o.pixels_per_degree = 0.0;
   EXPECT_EQ(FlipEvaluator(o).ldr(img.image(), img.image(), 4, 4, nullptr, map.data()).error().kind, ErrorKind::Usage);
+  // Issue 26 item 8: 1e30 asked for filters of 1e29 taps (a crash); the library accepts [1, 1000] only.
+  for (double ppd : {1e30, 1000.5, 0.5}) {
+    o.pixels_per_degree = ppd;
+    EXPECT_EQ(FlipEvaluator(o).ldr(img.image(), img.image(), 4, 4, nullptr, map.data()).error().kind, ErrorKind::Usage)
+        << ppd;
+  }
+  for (double ppd : {kFlipMinPixelsPerDegree, kFlipMaxPixelsPerDegree}) {
+    o.pixels_per_degree = ppd;
+    ASSERT_TRUE(FlipEvaluator(o).ldr(img.image(), img.image(), 4, 4, nullptr, map.data())) << ppd;
+    for (float v : map) EXPECT_TRUE(std::isfinite(v)) << ppd;
+  }
   o = {};
   o.start_exposure = 2.0f;
   o.stop_exposure = 1.0f;

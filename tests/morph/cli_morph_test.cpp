@@ -7,7 +7,11 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <functional>
 #include <limits>
 
 namespace temporal::morph {
@@ -163,6 +167,61 @@ TEST_F(MorphCli, OverflowingFrameNumbersAndInfiniteHeaderRatesAreRefused) {
             2)
       << out;
   EXPECT_NE(out.find("temporal:fps"), std::string::npos) << out;
+}
+
+// Issue 26 item 2: --out naming the --lag-reference sequence overwrote it; the lag reference is an input of the
+// run, so that is refused (exit 1) and the files are unchanged.
+TEST_F(MorphCli, TheLagReferenceIsProtectedAsAnInput) {
+  for (const char* n : {"000", "001"})
+    std::filesystem::copy_file(dir_ / ("color." + std::string(n) + ".exr"), dir_ / ("lag." + std::string(n) + ".exr"));
+  const auto checksum = [&] {
+    std::string all;
+    for (const char* f : {"lag.000.exr", "lag.001.exr"}) {
+      std::ifstream in(dir_ / f, std::ios::binary);
+      all += std::string(std::istreambuf_iterator<char>(in), {});
+    }
+    return std::hash<std::string>{}(all);
+  };
+  const auto before = checksum();
+  std::string out;
+  EXPECT_EQ(test::run_command(tool() + " --perceive --input " + in("color") + " --gbuffer " + in("gbuffer") +
+                                  " --lag-reference " + in("lag") + " --out " + (dir_ / "lag.%03d.exr").string(),
+                              &out),
+            1)
+      << out;
+  EXPECT_NE(out.find("lag"), std::string::npos) << out;
+  EXPECT_EQ(checksum(), before);
+}
+
+// Issue 26 item 13: --ppd 1e-40 lay inside the accepted [0, 10000] and made the eye-tracking limit's fps / ppd
+// infinite (NaN outputs). --ppd and --fps are 0 (derived / read from the header) or in a range whose arithmetic stays
+// finite; --help says which. The smallest accepted --ppd gives finite outputs.
+TEST_F(MorphCli, ViewingOptionsHaveFiniteRangesAndTheirEndsGiveFiniteOutputs) {
+  const std::string base = tool() + " --input " + in("color") + " --gbuffer " + in("gbuffer") + " --method didyk";
+  std::string out;
+  for (const char* bad : {"--ppd 1e-40", "--ppd 0.001", "--ppd 1e5", "--fps 1e-40", "--fps 1e-4", "--ppd inf"}) {
+    EXPECT_EQ(test::run_command(base + " --out " + (dir_ / "x" / "o.####.exr").string() + " " + bad, &out), 1) << bad;
+    EXPECT_NE(out.find(std::string(bad).substr(0, 5)), std::string::npos) << out;
+  }
+  EXPECT_NE(out.find("must be a finite number"), std::string::npos) << out;
+  ASSERT_EQ(test::run_command(base + " --out " + (dir_ / "x" / "o.####.exr").string() + " --ppd 1e-40", &out), 1);
+  // (The float field holds 1e-40 as the denormal 9.99995e-41, which the message prints.)
+  EXPECT_NE(out.find("is out of range: it must be 0 or [0.01, 10000]"), std::string::npos) << out;
+  EXPECT_FALSE(std::filesystem::exists(dir_ / "x")) << "nothing is written on a usage error";
+  ASSERT_EQ(test::run_command(tool() + " --help", &out), 0);
+  EXPECT_NE(out.find("0 or [0.01, 10000]"), std::string::npos) << "--help names the range";
+  for (const char* edge : {"--ppd 0.01", "--ppd 10000", "--ppd 0.01 --fps 10000", "--fps 0.001"}) {
+    const std::string name = std::string("edge") + std::to_string(std::hash<std::string>{}(edge) % 1000);
+    ASSERT_EQ(test::run_command(base + " --out " + (dir_ / name / "o.####.exr").string() + " " + edge, &out), 0)
+        << edge << "\n" << out;
+    for (int f = 0; f < 6; ++f) {
+      auto img = read_exr((dir_ / name / ("o.000" + std::to_string(f) + ".exr")).string());
+      ASSERT_TRUE(img) << edge << " " << f;
+      for (const auto& c : img->channel_names())
+        for (std::size_t i = 0; i < img->pixel_count(); ++i)
+          ASSERT_TRUE(std::isfinite(img->plane(c)[i])) << edge << " frame " << f << " " << c;
+    }
+  }
 }
 
 }  // namespace

@@ -118,7 +118,7 @@ TEST(FilterPhlmCli, ResetFramesAndNonFiniteInput) {
                           (dir / "gbuffer.####.exr").string() + " --out " + (dir / "p.####.exr").string() +
                           " --reset-frames 3 --state-out " + (dir / "s.exr").string();
   ASSERT_EQ(test::run_command(cmd, &out), 0) << out;
-  EXPECT_NE(out.find("color.0001.exr: warning: 2 pixels hold NaN or Inf"), std::string::npos) << out;
+  EXPECT_NE(out.find("color.0001.exr: warning: 2 pixels hold NaN, Inf or a magnitude above 1e10"), std::string::npos) << out;
   auto p1 = read_exr((dir / "p.0001.exr").string());
   ASSERT_TRUE(p1);
   for (const char* c : {"R", "G", "B"})
@@ -217,6 +217,48 @@ TEST(FilterPhlmCli, ListMethodsPrintsTheRegistry) {
   EXPECT_NE(out.find("{\"name\": \"fxaa\""), std::string::npos) << out;
   EXPECT_NE(out.find("\"stateful\": false, \"implementations\": [\"cpu\"]}"), std::string::npos)
       << "fxaa is spatial: " << out;
+}
+
+// Issue 26 item 12: a finite colour of FLT_MAX (3.4e38) in one frame is no sample, as NaN is (temporal/core/image.h
+// kMaxSampleMagnitude): it is warned about, and no method writes a non-finite value in that frame or later ones
+// (phlm's RLS update once overflowed and wrote 864 of them in three frames). The state too stays finite.
+TEST(FilterPhlmCli, AHugeFiniteColourIsNoSample) {
+  const auto dir = test::scratch_dir("filter-phlm-cli-flt-max");
+  write_sequence(dir, 5);
+  auto f1 = read_exr((dir / "color.0001.exr").string());
+  ASSERT_TRUE(f1);
+  for (const char* c : {"R", "G", "B"})
+    for (std::size_t i : {std::size_t(5), std::size_t(40), std::size_t(41)}) f1->plane(c)[i] = 3.4e38f;
+  f1->plane("G")[77] = -3.4e38f;
+  ASSERT_TRUE(write_exr((dir / "color.0001.exr").string(), *f1));
+  for (const std::string m : {"phlm", "taa", "ema", "fxaa"}) {
+    std::string out;
+    const bool stateful = m != "fxaa";
+    const std::string cmd = tool() + " --input " + (dir / "color.####.exr").string() + " --gbuffer " +
+                            (dir / "gbuffer.####.exr").string() + " --out " + (dir / (m + ".####.exr")).string() +
+                            " --method " + m + " --debug-layers" +
+                            (stateful ? " --state-out " + (dir / (m + "-state.####.exr")).string() : std::string());
+    ASSERT_EQ(test::run_command(cmd, &out), 0) << cmd << "\n" << out;
+    EXPECT_NE(out.find("color.0001.exr: warning: 4 pixels hold NaN, Inf or a magnitude above 1e10"), std::string::npos)
+        << out;
+    for (int t = 0; t < 5; ++t) {
+      char name[64];
+      std::snprintf(name, sizeof name, "%s.%04d.exr", m.c_str(), t);
+      auto img = read_exr((dir / name).string());
+      ASSERT_TRUE(img) << img.error().message;
+      for (const auto& c : img->channel_names())
+        for (std::size_t i = 0; i < img->pixel_count(); ++i)
+          ASSERT_TRUE(std::isfinite(img->plane(c)[i])) << name << " " << c << " pixel " << i;
+      if (!stateful) continue;
+      std::snprintf(name, sizeof name, "%s-state.%04d.exr", m.c_str(), t);
+      auto state = read_exr((dir / name).string());
+      ASSERT_TRUE(state) << state.error().message;
+      for (const auto& c : state->channel_names())
+        if (const float* p = state->plane(c)) {
+          for (std::size_t i = 0; i < state->pixel_count(); ++i) ASSERT_TRUE(std::isfinite(p[i])) << name << " " << c;
+        }
+    }
+  }
 }
 
 }  // namespace

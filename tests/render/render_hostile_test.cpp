@@ -344,6 +344,9 @@ TEST(RenderHostile, DegenerateCamerasRotationsNormalsAndTexcoordsAreInputErrors)
   refused(write_quad(dir, "rotation.gltf", with_camera(R"("translation": [0, 0, 5], "rotation": [0, 0, 0, 0])", ok_camera)),
           {"node #1", "rotation"});
   refused(write_quad(dir, "huge.gltf", with_camera(R"("translation": [0, 0, 1e300])", ok_camera)), {"node #1", "not finite"});
+  // A camera node whose matrix has an all-zero rotation part (the camera's transform is singular).
+  refused(write_quad(dir, "matrix.gltf", with_camera(R"("matrix": [0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 5, 1])", ok_camera)),
+          {"camera '0'", "not finite"});
   {
     // A rotation channel whose keys are zero quaternions.
     QuadScene q = with_camera(R"("translation": [0, 0, 5])", ok_camera);
@@ -382,6 +385,20 @@ TEST(RenderHostile, DegenerateCamerasRotationsNormalsAndTexcoordsAreInputErrors)
 }
 )";
   refused(dir / "orient.usda", {"/Cam", "length 0"});
+  // The same as time samples (a key of length 0), and as an all-zero xformOp:transform rotation.
+  std::ofstream(dir / "orient_keys.usda") << "#usda 1.0\n" + quad + R"(def Camera "Cam" {
+ double3 xformOp:translate = (0, 0, 5)
+ quatf xformOp:orient.timeSamples = { 0: (1, 0, 0, 0), 1: (0, 0, 0, 0) }
+ uniform token[] xformOpOrder = ["xformOp:translate", "xformOp:orient"]
+}
+)";
+  refused(dir / "orient_keys.usda", {"/Cam", "length 0"});
+  std::ofstream(dir / "matrix.usda") << "#usda 1.0\n" + quad + R"(def Camera "Cam" {
+ matrix4d xformOp:transform = ( (0, 0, 0, 0), (0, 0, 0, 0), (0, 0, 0, 0), (0, 0, 5, 1) )
+ uniform token[] xformOpOrder = ["xformOp:transform"]
+}
+)";
+  refused(dir / "matrix.usda", {"camera 'Cam'", "not finite"});
   std::ofstream(dir / "narrow.usda") << "#usda 1.0\n" + quad + R"(def Camera "Cam" {
  float focalLength = 1e30
  double3 xformOp:translate = (0, 0, 5)

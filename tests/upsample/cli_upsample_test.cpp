@@ -9,6 +9,7 @@
 #include <gtest/gtest.h>
 #include <test_support.h>
 
+#include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
@@ -217,4 +218,54 @@ TEST(UpsampleCli, UnknownMethodSuggestsTheClosest) {
                         "'herzog'?)"),
             std::string::npos)
       << output;
+}
+
+namespace {
+// Non-finite values in every float plane of an output frame (outputs and debug layers alike).
+std::size_t non_finite_values(const temporal::Image& img) {
+  std::size_t n = 0;
+  for (const auto& c : img.channel_names())
+    if (const float* p = img.plane(c))
+      for (std::size_t i = 0; i < img.pixel_count(); ++i) n += std::isfinite(p[i]) ? 0 : 1;
+  return n;
+}
+}  // namespace
+
+// Issue 26 items 11 and 12: a G-buffer frame with NaN depth (64 pixels) and a shade frame with a finite FLT_MAX
+// sample are warned about and treated as missing by every method: no non-finite value in any output, debug
+// layers included, in that frame or the ones after it. drobot once wrote thousands (its Listing 7.2 confidence of a
+// NaN cached depth was NaN and entered the frame count of the cache).
+TEST(UpsampleCli, NonFiniteDepthAndHugeSamplesNeverReachTheOutputs) {
+  const fs::path dir = write_sequence("upsample_cli_hostile_values", 5);
+  {
+    auto g = temporal::read_exr((dir / "gbuffer.0001.exr").string());
+    ASSERT_TRUE(g.has_value());
+    float* z = g->plane("depth.Z");
+    for (int y = 12; y < 20; ++y)  // an 8x8 square: block centres of the cache and the taps beside them
+      for (int x = 20; x < 28; ++x) z[std::size_t(y) * std::size_t(g->width()) + std::size_t(x)] = NAN;
+    ASSERT_TRUE(temporal::write_exr((dir / "gbuffer.0001.exr").string(), *g));
+    auto s = temporal::read_exr((dir / "shade.0002.exr").string());
+    ASSERT_TRUE(s.has_value());
+    for (const char* c : {"R", "G", "B"}) s->plane(c)[5] = 3.4e38f;
+    ASSERT_TRUE(temporal::write_exr((dir / "shade.0002.exr").string(), *s));
+  }
+  for (const std::string method : {"spatial", "temporal", "herzog", "drobot", "drobot --mode refresh", "taau"}) {
+    std::string output;
+    const std::string name = method == "drobot --mode refresh" ? "refresh" : method;
+    const std::string cmd = tool() + " --gbuffer " + (dir / "gbuffer.####.exr").string() + " --input " +
+                            (dir / "shade.####.exr").string() + " --out " + (dir / name).string() +
+                            ".####.exr --debug-layers --method " + method;
+    ASSERT_EQ(temporal::test::run_command(cmd, &output), 0) << output;
+    EXPECT_NE(output.find("gbuffer.0001.exr: warning: 64 pixels hold NaN or Inf"), std::string::npos) << output;
+    EXPECT_NE(output.find("shade.0002.exr: warning: 1 pixels hold NaN, Inf or a magnitude above 1e10"),
+              std::string::npos)
+        << output;
+    for (int t = 0; t < 5; ++t) {
+      char num[16];
+      std::snprintf(num, sizeof num, "%04d", t);
+      auto img = temporal::read_exr((dir / (name + "." + num + ".exr")).string());
+      ASSERT_TRUE(img.has_value()) << img.error().message;
+      EXPECT_EQ(non_finite_values(*img), 0u) << method << " frame " << t;
+    }
+  }
 }

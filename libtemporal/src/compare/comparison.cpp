@@ -111,7 +111,12 @@ class Run {
       if (gap_before) {
         const int floor = i == 0 ? std::numeric_limits<int>::min() : report_.frames[i - 1] + 1;
         int first = f;  // the earliest frame of an unbroken run of frames on disk just before f
-        while (f - first < prime_depth && first - 1 >= floor && previous_frame_exists(first - 1)) --first;
+        while (f - first < prime_depth && first - 1 >= floor) {
+          auto exists = previous_frame_exists(first - 1);
+          if (!exists) return exists.error();
+          if (!*exists) break;
+          --first;
+        }
         for (int p = first; p < f; ++p) {
           order.push_back(p);
           primes.push_back(true);
@@ -187,12 +192,19 @@ class Run {
   bool gbuf_mask_ = false, ref_mask_ = false;
   ProtectedInputs inputs_;  // every file this comparison reads: no error map may replace one
   bool priming_ = false;     // this frame only primes the history (the frame before a --frames range)
-  // True when frame `f` of the reference, of every test and of the G-buffer exists on disk.
-  bool previous_frame_exists(int f) const {
-    if (f < 0 || !std::filesystem::exists(ref_pattern_->path(f))) return false;
-    for (const auto& t : tests_)
-      if (!std::filesystem::exists(t.pattern.path(f))) return false;
-    return !gbuf_pattern_ || std::filesystem::exists(gbuf_pattern_->path(f));
+  // True when frame `f` of the reference, of every test and of the G-buffer exists on disk; an input error naming
+  // the file when one of them cannot be examined (a symbolic link loop, a folder without search permission: the
+  // throwing std::filesystem::exists would end the run with exit 5).
+  Expected<bool> previous_frame_exists(int f) const {
+    if (f < 0) return false;
+    std::vector<std::string> paths{ref_pattern_->path(f)};
+    for (const auto& t : tests_) paths.push_back(t.pattern.path(f));
+    if (gbuf_pattern_) paths.push_back(gbuf_pattern_->path(f));
+    for (const auto& path : paths) {
+      auto found = input_exists(path);
+      if (!found || !*found) return found;
+    }
+    return true;
   }
   bool gbuf_geometry_ = false, have_prev_geometry_ = false;  // G-buffer depth and ids for the disocclusion test
   bool gbuf_warped_ = false;  // and prevDepth.Z, the expected previous depth (temporal/core/reproject.h)
@@ -224,8 +236,10 @@ Status Run::open() {
                         std::to_string(setup_.tests.size()) + " test sequences: give one name per test, comma-separated");
   if (!(setup_.peak > 0.0) || !std::isfinite(setup_.peak)) return Error::usage("--peak must be a positive number or 'max'");
   if (setup_.flip != FlipMode::Off &&
-      (!(setup_.flip_options.pixels_per_degree > 0.0) || !std::isfinite(setup_.flip_options.pixels_per_degree)))
-    return Error::usage("--ppd must be a positive number of pixels per degree (FLIP's default: 67.0206)");
+      !(setup_.flip_options.pixels_per_degree >= kFlipMinPixelsPerDegree &&
+        setup_.flip_options.pixels_per_degree <= kFlipMaxPixelsPerDegree))
+    return Error::usage("--ppd must be in [1, 1000] pixels per degree (FLIP's default: 67.0206; larger values ask for "
+                        "filters wider than any image)");
 
   report_.reference = setup_.reference;
   report_.gbuffer = setup_.gbuffer;
@@ -508,7 +522,9 @@ Expected<const ShownReference*> Run::shown_reference(int frame) {
   if (auto it = shown_.find(frame); it != shown_.end()) return &it->second;
   ShownReference& s = shown_[frame];
   const std::string path = ref_pattern_->path(frame);
-  if (!fs::exists(path)) return &s;
+  auto found = input_exists(path);  // not the throwing fs::exists: a link loop is an input error naming the file
+  if (!found) return found.error();
+  if (!*found) return &s;
   auto img = read_exr(path, ref_sel_);
   if (!img) return img.error();
   if (img->width() != width_ || img->height() != height_)

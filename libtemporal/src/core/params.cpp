@@ -59,6 +59,7 @@ std::string param_range_text(const Param& p) {
   const bool lo = std::isfinite(p.min), hi = std::isfinite(p.max);
   // Appended piece by piece: `"[" + std::string` trips a false -Wrestrict in GCC 12.
   std::string text;
+  if (p.or_zero) text.append("0 or ");
   if (lo && hi) {
     text.append(p.above_min ? "(" : "[").append(number(p.min)).append(", ").append(number(p.max)).append("]");
   } else if (lo) {
@@ -98,7 +99,12 @@ Status check_param(const Param& p) {
   if (!value) return Status::ok();  // an optional number not given
   const double v = *value;
   if (!std::isfinite(v)) return Error::usage(p.flag + " must be a finite number (got " + number(v) + ")");
-  if (v < p.min || v > p.max || (p.above_min && v == p.min))
+  if (p.or_zero && v == 0.0) return Status::ok();
+  // A float field holds the bound rounded to float (0.01 is stored as 0.0099999998): compare in that precision, so
+  // that the bound itself, given on the command line, is inside the range.
+  const bool as_float = std::holds_alternative<float*>(p.value);
+  const double lo = as_float ? double(float(p.min)) : p.min, hi = as_float ? double(float(p.max)) : p.max;
+  if (v < lo || v > hi || (p.above_min && v == lo))
     return Error::usage(p.flag + " " + number(v) + " is out of range: it must be " + param_range_text(p));
   return Status::ok();
 }
@@ -107,6 +113,12 @@ Status check_params(const ParamList& params) {
   for (const auto& p : params)
     if (Status s = check_param(p); !s) return s;
   return Status::ok();
+}
+
+bool has_finite_range(const Param& p) {
+  const bool floating = std::holds_alternative<float*>(p.value) || std::holds_alternative<double*>(p.value) ||
+                        std::holds_alternative<std::optional<double>*>(p.value);
+  return !floating || !p.choices.empty() || (std::isfinite(p.min) && std::isfinite(p.max));
 }
 
 Status apply_args(const ParamList& params, const std::vector<std::string>& args) {

@@ -46,7 +46,7 @@ Status check_gbuffer_layers(const Image& g, const std::vector<LayerNeed>& needs,
   return Status::ok();
 }
 
-std::size_t count_non_finite_layers(const Image& image, const std::vector<std::string>& layers) {
+std::size_t count_non_finite_layers(const Image& image, const std::vector<std::string>& layers, float max_magnitude) {
   std::vector<const float*> planes;
   for (const auto& name : image.channel_names()) {
     bool selected = layers.empty();
@@ -60,7 +60,7 @@ std::size_t count_non_finite_layers(const Image& image, const std::vector<std::s
   std::size_t n = 0;
   for (std::size_t i = 0; i < image.pixel_count(); ++i) {
     bool finite = true;
-    for (const float* p : planes) finite = finite && std::isfinite(p[i]);
+    for (const float* p : planes) finite = finite && std::isfinite(p[i]) && std::abs(p[i]) <= max_magnitude;
     n += finite ? 0 : 1;
   }
   return n;

@@ -4,11 +4,14 @@
 // does), the kernels' tests bound the difference (docs/gpu.md, "Tolerances").
 #include "temporal/gpu/glsl.h"
 
+#include "temporal/core/image.h"
 #include "temporal/core/reproject.h"
 
 #include <cstdio>
 
 namespace temporal::gpu::glsl {
+
+static_assert(kMaxSampleMagnitude == 1e10f, "is_sample in the prelude spells kMaxSampleMagnitude");
 
 std::string_view prelude() {
   static const std::string text = R"(#version 450
@@ -16,6 +19,8 @@ layout(local_size_x = 16, local_size_y = 16) in;
 uniform ivec2 u_size;
 
 bool is_finite_bits(float v) { return (floatBitsToUint(v) & 0x7f800000u) != 0x7f800000u; }
+// usable_sample of temporal/core/image.h: finite and at most kMaxSampleMagnitude (1e10) in magnitude.
+bool is_sample(float v) { return is_finite_bits(v) && abs(v) <= 1e10; }
 
 // The invocation's pixel; false outside the image (the last groups overhang it).
 bool pixel_index(out ivec2 p, out uint i) {

@@ -4,6 +4,7 @@
 #include "temporal/io/atomic_file.h"
 
 #include <OpenEXR/openexr.h>
+#include <OpenImageIO/filesystem.h>
 #include <OpenImageIO/imageio.h>
 
 #include <glm/gtc/type_ptr.hpp>
@@ -19,6 +20,7 @@
 #include <filesystem>
 #include <map>
 #include <set>
+#include <span>
 
 namespace temporal {
 namespace {
@@ -213,20 +215,52 @@ constexpr int kMaxSide = 65536;
 // refuses an attribute whose declared size is negative or runs past the end of the file. OpenEXR's C++ reader
 // (which OpenImageIO uses) allocates a string attribute's declared size before it reads it: a 12 kB file that
 // declares a 1.8 GB `temporal:tool` made it allocate 1.8 GB (found by tests/fuzz/exr_fuzz). Reads only the headers.
-Status check_exr_attributes(const std::string& path, std::FILE* f, std::uint64_t size, bool multipart) {
+// The bytes of an EXR being read: a file (`path`), or a buffer in memory (`memory`, named `path` in messages: the
+// fuzz target reads its inputs this way, without a file per execution). Sequential reads for the header walk, and
+// OpenEXR's positioned reads (exr_read_func_ptr_t) for its core.
+struct ExrSource {
+  std::string path;
+  std::span<const std::uint8_t> memory;
+  bool in_memory = false;
+  std::FILE* file = nullptr;  // the header walk's stream (files)
+  std::uint64_t position = 0;  // the header walk's position (memory)
+
+  int get() {
+    if (!in_memory) return std::fgetc(file);
+    return position < memory.size() ? int(memory[position++]) : EOF;
+  }
+  bool read(unsigned char* out, std::size_t n) {
+    if (!in_memory) return std::fread(out, 1, n, file) == n;
+    if (position + n > memory.size()) return false;
+    std::memcpy(out, memory.data() + position, n);
+    position += n;
+    return true;
+  }
+  long tell() const { return in_memory ? long(position) : std::ftell(file); }
+  bool seek(long offset, int whence) {
+    if (!in_memory) return std::fseek(file, offset, whence) == 0;
+    const long base = whence == SEEK_SET ? 0 : long(position);
+    if (offset < 0 || base + offset < 0) return false;
+    position = std::uint64_t(base + offset);  // past the end is allowed, as fseek does; reads then fail
+    return true;
+  }
+};
+
+Status check_exr_attributes(ExrSource& src, std::uint64_t size, bool multipart) {
+  const std::string& path = src.path;
   auto corrupt = [&](const std::string& what) {
     return Error::input(path, "has a corrupt header (" + what + "): the file is damaged; write it again");
   };
   auto read_name = [&](std::string& out) -> bool {  // a NUL-terminated name of at most 255 characters
     out.clear();
-    for (int c; (c = std::fgetc(f)) != EOF;) {
+    for (int c; (c = src.get()) != EOF;) {
       if (c == 0) return true;
       if (out.size() >= 255) return false;
       out.push_back(char(c));
     }
     return false;
   };
-  if (std::fseek(f, 8, SEEK_SET) != 0) return corrupt("no header");
+  if (!src.seek(8, SEEK_SET)) return corrupt("no header");
   std::string name, type;
   for (int part = 0;; ++part) {
     int attributes = 0;
@@ -235,13 +269,13 @@ Status check_exr_attributes(const std::string& path, std::FILE* f, std::uint64_t
       if (name.empty()) break;  // end of this header
       if (!read_name(type)) return corrupt("the type of attribute '" + name + "' is not terminated");
       unsigned char b[4];
-      if (std::fread(b, 1, 4, f) != 4) return corrupt("attribute '" + name + "' has no size");
+      if (!src.read(b, 4)) return corrupt("attribute '" + name + "' has no size");
       const std::int32_t declared = std::int32_t(std::uint32_t(b[0]) | std::uint32_t(b[1]) << 8 |
                                                  std::uint32_t(b[2]) << 16 | std::uint32_t(b[3]) << 24);
-      const long at = std::ftell(f);
+      const long at = src.tell();
       if (declared < 0 || at < 0 || std::uint64_t(at) + std::uint64_t(declared) > size)
         return corrupt("attribute '" + name + "' declares " + std::to_string(declared) + " bytes, more than the file holds");
-      if (std::fseek(f, declared, SEEK_CUR) != 0) return corrupt("attribute '" + name + "'");
+      if (!src.seek(declared, SEEK_CUR)) return corrupt("attribute '" + name + "'");
     }
     if (!multipart) return Status::ok();
     if (attributes == 0) return Status::ok();  // the empty header that ends a multi-part file's headers
@@ -253,18 +287,25 @@ Status check_exr_attributes(const std::string& path, std::FILE* f, std::uint64_t
 // sane part sizes, and for every part the last chunk (scanline block or tile) lies inside the file. A multi-part
 // file truncated in a part that the caller does not read is caught here (reading only the needed parts would
 // otherwise accept it). Cost: the headers, the chunk tables and one chunk leader per part.
-Status check_exr_structure(const std::string& path) {
-  std::error_code ec;
-  if (fs::is_directory(path, ec)) return Error::input(path, "is a folder, not an OpenEXR file");
-  if (!fs::exists(path, ec)) return Error::input(path, ec ? "cannot be examined: " + ec.message() : "no such file");
-  const auto size = fs::file_size(path, ec);
+Status check_exr_structure(ExrSource& src) {
+  const std::string& path = src.path;
+  std::uint64_t size = src.memory.size();
   unsigned char magic[8] = {};
   std::size_t got = 0;
-  if (FILE* f = std::fopen(path.c_str(), "rb")) {
-    got = std::fread(magic, 1, sizeof magic, f);
-    std::fclose(f);
+  if (src.in_memory) {
+    got = std::min(sizeof magic, src.memory.size());
+    if (got) std::memcpy(magic, src.memory.data(), got);
   } else {
-    return Error::input(path, "cannot open for reading (permissions?)");
+    std::error_code ec;
+    if (fs::is_directory(path, ec)) return Error::input(path, "is a folder, not an OpenEXR file");
+    if (!fs::exists(path, ec)) return Error::input(path, ec ? "cannot be examined: " + ec.message() : "no such file");
+    size = fs::file_size(path, ec);
+    if (FILE* f = std::fopen(path.c_str(), "rb")) {
+      got = std::fread(magic, 1, sizeof magic, f);
+      std::fclose(f);
+    } else {
+      return Error::input(path, "cannot open for reading (permissions?)");
+    }
   }
   if (got < 4 || !(magic[0] == 0x76 && magic[1] == 0x2f && magic[2] == 0x31 && magic[3] == 0x01)) {
     const std::string what = foreign_format(magic, got);
@@ -274,15 +315,34 @@ Status check_exr_structure(const std::string& path) {
     return Error::input(path, std::string("is not an OpenEXR file") + (what.empty() ? "" : " (it looks like " + what + ")") +
                                   (got < 4 ? ": it is empty or truncated" : ""));
   }
-  if (std::FILE* f = std::fopen(path.c_str(), "rb")) {
-    const bool multipart = (magic[5] & 0x10) != 0;  // version field bit 12: multi-part
-    const Status st = check_exr_attributes(path, f, size, multipart);
+  const bool multipart = (magic[5] & 0x10) != 0;  // version field bit 12: multi-part
+  if (src.in_memory) {
+    src.position = 0;
+    if (const Status st = check_exr_attributes(src, size, multipart); !st) return st;
+  } else if (std::FILE* f = std::fopen(path.c_str(), "rb")) {
+    src.file = f;
+    const Status st = check_exr_attributes(src, size, multipart);
+    src.file = nullptr;
     std::fclose(f);
     if (!st) return st;
   }
   exr_context_t ctx = nullptr;
   exr_context_initializer_t init = EXR_DEFAULT_CONTEXT_INITIALIZER;
   init.error_handler_fn = [](exr_const_context_t, exr_result_t, const char*) {};  // we word the errors ourselves
+  if (src.in_memory) {  // OpenEXR's positioned reads and size query over the buffer
+    init.user_data = &src.memory;
+    init.read_fn = [](exr_const_context_t, void* user, void* buffer, uint64_t n, uint64_t offset,
+                      exr_stream_error_func_ptr_t) -> int64_t {
+      const auto& m = *static_cast<const std::span<const std::uint8_t>*>(user);
+      if (offset >= m.size()) return 0;
+      const uint64_t count = std::min<uint64_t>(n, m.size() - offset);
+      std::memcpy(buffer, m.data() + offset, count);
+      return int64_t(count);
+    };
+    init.size_fn = [](exr_const_context_t, void* user) -> int64_t {
+      return int64_t(static_cast<const std::span<const std::uint8_t>*>(user)->size());
+    };
+  }
   if (exr_start_read(&ctx, path.c_str(), &init) != EXR_ERR_SUCCESS) {
     exr_finish(&ctx);
     return Error::input(path, "cannot read the OpenEXR header: the file is truncated or corrupt");
@@ -304,6 +364,19 @@ Status check_exr_structure(const std::string& path) {
       return Error::input(path, "part " + std::to_string(p) + " declares " + std::to_string(w) + "x" +
                                     std::to_string(h) + " pixels: the tools read at most 16384x16384 per image "
                                     "(a corrupt header, or an image to crop or scale down first)");
+    // The chunkCount attribute (required in multi-part files) must be the number of chunks the part has: a negative
+    // one was read past (the readers count chunks from the data window) and the file accepted with exit 0 (issue
+    // 26); a file that disagrees with itself is corrupt. Scanline parts: ceil(height / scanlines per chunk).
+    if (std::int32_t declared = 0; exr_attr_get_int(ctx, p, "chunkCount", &declared) == EXR_ERR_SUCCESS) {
+      std::int32_t lines = 0;
+      std::int64_t expected = -1;
+      if (storage == EXR_STORAGE_SCANLINE && exr_get_scanlines_per_chunk(ctx, p, &lines) == EXR_ERR_SUCCESS && lines > 0)
+        expected = (h + lines - 1) / lines;
+      if (declared < 1 || (expected > 0 && declared != expected))
+        return Error::input(path, "part " + std::to_string(p) + " declares " + std::to_string(declared) + " chunks" +
+                                      (expected > 0 ? " but its data window holds " + std::to_string(expected) : "") +
+                                      " (chunkCount): the file is corrupt; write it again");
+    }
     exr_chunk_info_t last{};
     exr_result_t r = EXR_ERR_SUCCESS;
     if (storage == EXR_STORAGE_SCANLINE) {
@@ -343,9 +416,29 @@ Expected<ExrCompression> parse_compression(const std::string& name) {
   return Error::usage("unknown compression '" + name + "': use none, zip, piz or dwaa (dwaa applies to colour only)");
 }
 
-Expected<ExrInfo> read_exr_info(const std::string& path) {
-  if (Status st = check_exr_structure(path); !st) return st.error();
-  auto in = ImageInput::open(path);
+namespace {
+
+// OpenImageIO's reader of the source: the file, or the buffer through an IOMemReader (`proxy`, which must outlive
+// the reader). The name must end in .exr either way (OpenImageIO picks the format by it).
+std::unique_ptr<ImageInput> open_input(const ExrSource& src, std::unique_ptr<OIIO::Filesystem::IOMemReader>& proxy) {
+  if (!src.in_memory) return ImageInput::open(src.path);
+  proxy = std::make_unique<OIIO::Filesystem::IOMemReader>(src.memory.data(), src.memory.size());
+  return ImageInput::open(src.path, nullptr, proxy.get());
+}
+
+ExrSource memory_source(std::span<const std::uint8_t> bytes, const std::string& name) {
+  ExrSource src;
+  src.path = name;
+  src.memory = bytes;
+  src.in_memory = true;
+  return src;
+}
+
+Expected<ExrInfo> read_info(ExrSource& src) {
+  const std::string& path = src.path;
+  if (Status st = check_exr_structure(src); !st) return st.error();
+  std::unique_ptr<OIIO::Filesystem::IOMemReader> proxy;
+  auto in = open_input(src, proxy);
   if (!in) return Error::input(path, "cannot read as OpenEXR: " + oiio_error("unknown error") + " (is it truncated or corrupt?)");
   ExrInfo info;
   const ImageSpec& first = in->spec();
@@ -357,9 +450,11 @@ Expected<ExrInfo> read_exr_info(const std::string& path) {
   return info;
 }
 
-Expected<Image> read_exr(const std::string& path, const ExrSelection& selection) {
-  if (Status st = check_exr_structure(path); !st) return st.error();
-  auto in = ImageInput::open(path);
+Expected<Image> read_image(ExrSource& src, const ExrSelection& selection) {
+  const std::string& path = src.path;
+  if (Status st = check_exr_structure(src); !st) return st.error();
+  std::unique_ptr<OIIO::Filesystem::IOMemReader> proxy;
+  auto in = open_input(src, proxy);
   if (!in) return Error::input(path, "cannot read as OpenEXR: " + oiio_error("unknown error") + " (is it truncated or corrupt?)");
 
   const ImageSpec first = in->spec();
@@ -450,6 +545,28 @@ Expected<Image> read_exr(const std::string& path, const ExrSelection& selection)
                                   "); produce it upstream (e.g. render-gbuffer --outputs) or pick another --layer");
   }
   return image;
+}
+
+}  // namespace
+
+Expected<ExrInfo> read_exr_info(const std::string& path) {
+  ExrSource src{.path = path};
+  return read_info(src);
+}
+
+Expected<ExrInfo> read_exr_info(std::span<const std::uint8_t> bytes, const std::string& name) {
+  ExrSource src = memory_source(bytes, name);
+  return read_info(src);
+}
+
+Expected<Image> read_exr(const std::string& path, const ExrSelection& selection) {
+  ExrSource src{.path = path};
+  return read_image(src, selection);
+}
+
+Expected<Image> read_exr(std::span<const std::uint8_t> bytes, const std::string& name, const ExrSelection& selection) {
+  ExrSource src = memory_source(bytes, name);
+  return read_image(src, selection);
 }
 
 Status write_exr(const std::string& path, const Image& image, const ExrWriteOptions& options) {
@@ -557,7 +674,8 @@ Status write_exr(const std::string& path, const Image& image, const ExrWriteOpti
   // OpenEXR's stream does not report every failed write (a full disk gave a truncated file and no error), so the
   // finished temporary file is checked the way inputs are - every part's last chunk inside the file - before it
   // may take the final name. Cost: one header read of a file that is in the page cache.
-  if (Status s = check_exr_structure(tmp); !s)
+  ExrSource written{.path = tmp};
+  if (Status s = check_exr_structure(written); !s)
     return Error::output(path, "the file written is incomplete (is the disk full or a file-size limit reached?): " +
                                    s.error().message);
   return file.commit();

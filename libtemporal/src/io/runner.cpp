@@ -411,9 +411,10 @@ Expected<RunSummary> run_sequence(const SequenceOptions& options, FrameStage& st
                                              std::to_string(plan->frames.front()) + " is " + dims(width, height) +
                                              ": every frame of a sequence must have one size");
     }
-    if (const std::size_t bad = count_non_finite_layers(*sf.input, needs.input_layers); bad > 0) {
+    if (const std::size_t bad = count_non_finite_layers(*sf.input, needs.input_layers, kMaxSampleMagnitude); bad > 0) {
       warn(sf.input_path, std::to_string(bad) +
-                              " pixels hold NaN or Inf: treated as missing samples and kept out of every history");
+                              " pixels hold NaN, Inf or a magnitude above 1e10: treated as missing samples and kept out "
+                              "of every history");
       summary.non_finite_input += bad;
     }
     Image gbuffer;

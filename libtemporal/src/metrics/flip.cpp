@@ -641,9 +641,9 @@ void combine_pass(const Plane (&ref)[kProducts], const Plane (&test)[kProducts],
 
 Status check_inputs(const FlipImage& test, const FlipImage& ref, int width, int height, const float* map,
                     const FlipOptions& o) {
-  if (!(o.pixels_per_degree > 0.0) || !std::isfinite(o.pixels_per_degree))
-    return Error::usage("FLIP needs a positive, finite number of pixels per degree (got " +
-                        std::to_string(o.pixels_per_degree) + "); the default is 67.0206");
+  if (!(o.pixels_per_degree >= kFlipMinPixelsPerDegree && o.pixels_per_degree <= kFlipMaxPixelsPerDegree))
+    return Error::usage("FLIP needs pixels per degree in [1, 1000] (got " + std::to_string(o.pixels_per_degree) +
+                        "); the default is 67.0206");
   if (width <= 0 || height <= 0) return Error::input({}, "FLIP of an empty image: give images of at least 1x1 pixels");
   for (const FlipImage* im : {&test, &ref})
     if (!im->r || !im->g || !im->b) return Error::input({}, "FLIP needs three planes (R, G, B) per image; pass one plane three times for grey");

@@ -35,18 +35,17 @@ struct DidykOptions {
   bool compensate = true;  // high-frequency compensation of the rendered frame (section 5.1)
 
   ParamList params() {
-    const double inf = std::numeric_limits<double>::infinity();
     return {
         Param::integer("--grid", "Grid cell size in pixels, a power of two (seed 004: 8)", &grid.cell, 2, 32),
         Param::real("--snap-threshold", "Smallest motion difference (px per input frame) a vertex snaps to",
-                    &grid.snap_threshold, 0, inf),
+                    &grid.snap_threshold, 0, 1e6),
         Param::flag_off("--no-snap", "Keep the grid regular (no snapping to motion discontinuities)", &grid.snap),
         Param::real("--blur-level", "Blur pyramid level read for the low-pass layer (fractional allowed)", &blur_level,
                     0, 8),
         Param::real("--distortion-low", "Cell distortion (fraction of a cell) where the in-between blur starts",
-                    &distortion_low, 0, inf),
+                    &distortion_low, 0, 1e6),
         Param::real("--distortion-high", "Cell distortion where the in-between frame is fully blurred",
-                    &distortion_high, 0, inf),
+                    &distortion_high, 0, 1e6),
         Param::real("--min-blur", "Blur strength floor of the in-between frames (1: blur everywhere, [CKL*05])",
                     &min_blur, 0, 1),
         Param::flag_off("--no-compensation", "Do not add compensating high frequencies to the rendered frame",

@@ -314,15 +314,19 @@ ParamList morph_stage_params(MorphStageOptions& o) {
   const ParamList stage = {
       Param::text("--layer", "Colour layer morphed: rgb (the bare R,G,B) or a layer with NAME.R,G,B (docs/conventions.md, "
                              "Layers); the outputs keep its channel names", &o.layer),
+      // The range a header's temporal:fps must have too (MorphStage::run): frame / (fps n) stays finite.
       {.flag = "--fps", .help = "Input frame rate; 0 reads temporal:fps from the input header", .value = &o.fps,
-       .min = 0.0, .max = 1e4},
+       .min = 1e-3, .max = 1e4, .or_zero = true},
       {.flag = "--display",
        .help = "Display colour space whose gamma to use (e.g. gamma22_display, srgb_display); excludes --gamma",
        .value = &o.display},
       {.flag = "--ocio",
        .help = "OpenColorIO config for --display (default: $OCIO, else the built-in config)",
        .value = &o.ocio},
-      Param::real("--ppd", "Pixels per degree of visual angle; 0 derives it from the screen geometry", &v.ppd, 0, 1e4),
+      // At least 0.01: the eye-tracking limit divides by it (speed = |motion| fps / ppd, grid_warp.cpp), and 1e-40
+      // made that quotient infinite and the outputs NaN (issue 26 item 13).
+      Param::real_or_zero("--ppd", "Pixels per degree of visual angle; 0 derives it from the screen geometry", &v.ppd,
+                          0.01, 1e4),
       Param::real("--screen-width-m", "Screen width in metres (default: the paper's 22\" Samsung 2233RZ)",
                   &v.screen_width_m, 0.01, 100),
       Param::real("--distance-m", "Viewing distance in metres", &v.distance_m, 0.01, 100),

@@ -130,10 +130,10 @@ struct EmaOptions : EmaParams {
         Param::real("--ema-alpha", "history weight alpha of seed 003 eq. 1", &alpha, 0.0, 1.0),
         Param::positive("--ema-depth-tolerance",
                         "relative depth difference of the disocclusion test (temporal/core/reproject.h)",
-                        &depth_tolerance),
+                        &depth_tolerance, 0.0, 10.0),
         Param::positive("--ema-warped-depth-tolerance",
                         "the same when the G-buffer has prevDepth.Z (the warped depth, temporal/core/reproject.h)",
-                        &warped_depth_tolerance),
+                        &warped_depth_tolerance, 0.0, 10.0),
     };
   }
 };

@@ -39,7 +39,7 @@ void main() {
     float y[3];
     for (int c = 0; c < C; ++c) {
       y[c] = src[SRC(c) + i];
-      valid = valid && is_finite_bits(y[c]);
+      valid = valid && is_sample(y[c]);
     }
     // ema.cpp: reject = reset || no history of this size || the shared reprojection misses.
     bool reject = u_reject_all;

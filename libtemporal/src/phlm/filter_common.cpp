@@ -47,7 +47,8 @@ std::size_t prepare_frame(const FilterInput& in, bool want_ycgco, std::vector<fl
     std::size_t local = 0;
     for (std::size_t i = std::size_t(y0) * std::size_t(w); i < std::size_t(y1) * std::size_t(w); ++i) {
       bool ok = true;
-      for (int c = 0; c < channels; ++c) ok = ok && std::isfinite(p[c][i]);
+      // NaN, Inf and magnitudes past kMaxSampleMagnitude are no sample (temporal/core/image.h, issue 26 item 12).
+      for (int c = 0; c < channels; ++c) ok = ok && usable_sample(p[c][i]);
       valid[i] = ok ? 1 : 0;
       local += ok ? 0 : 1;
       if (want_ycgco) rgb_to_ycgco(p[0][i], p[1][i], p[2][i], ycgco[0][i], ycgco[1][i], ycgco[2][i]);

@@ -30,7 +30,7 @@ void main() {
   count_begin();
   if (inside) {
     bool ok = true;
-    for (int c = 0; c < u_channels; ++c) ok = ok && is_finite_bits(src[uint(c) * u_n + i]);
+    for (int c = 0; c < u_channels; ++c) ok = ok && is_sample(src[uint(c) * u_n + i]);
     // temporal/core/color.h luminance; sqrt of the value clamped to [0, 1]; 0 for a non-finite pixel.
     const float l = u_channels == 3 ? 0.2126 * src[i] + 0.7152 * src[u_n + i] + 0.0722 * src[2u * u_n + i] : src[i];
     work[i] = ok ? sqrt(clamp(l, 0.0, 1.0)) : 0.0;

@@ -656,10 +656,12 @@ struct PhlmOptions : PhlmParams {
   ParamList params() {
     return {
         Param::real("--lambda", "RLS forgetting factor (seed 003 eq. 6-7)", &lambda, 0.5, 1.0),
-        Param::positive("--p-init", "P = p_init * I at reset (seed 003 section 6)", &p_init),
+        // Finite ranges (issue 26): trace_max = trace_factor * N * p_init and the gain P x / (lambda + x^T P x) of
+        // eq. 6 stay finite and nonzero in float.
+        Param::real("--p-init", "P = p_init * I at reset (seed 003 section 6)", &p_init, 1e-6, 1e6),
         Param::real("--feature-a", "a of phi(v,l) = a l^2 + b v l^3 (section 5.1)", &feature_a, -1e6, 1e6),
         Param::real("--feature-b", "b of phi(v,l)", &feature_b, -1e6, 1e6),
-        Param::positive("--trace-factor", "trace(P) <= factor * N * p_init (wind-up guard)", &trace_factor),
+        Param::real("--trace-factor", "trace(P) <= factor * N * p_init (wind-up guard)", &trace_factor, 1e-3, 1e3),
         Param::flag_on("--no-feature",
                        "ablation: predictor x = [1], an intercept-only RLS (a per-pixel running mean with the same "
                        "resets)",

@@ -119,7 +119,7 @@ float rls_update(inout Model m, float x[N], float y[C], float lambda, float d_ma
 
 bool valid_at(uint q) {
   bool ok = true;
-  for (int c = 0; c < C; ++c) ok = ok && is_finite_bits(src[PL(c) + q]);
+  for (int c = 0; c < C; ++c) ok = ok && is_sample(src[PL(c) + q]);
   return ok;
 }
 )";

@@ -61,7 +61,7 @@ void main() {
         bool valid = true;
         for (int c = 0; c < TAA_C; ++c) {
           v[c] = src[PLANE(c) + n];
-          valid = valid && is_finite_bits(v[c]);
+          valid = valid && is_sample(v[c]);
         }
         if (j == 1 && k == 1) centre_valid = valid;
         if (!valid) continue;

@@ -16,6 +16,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <filesystem>
 
@@ -391,7 +392,8 @@ Expected<std::vector<Rect>> ComparisonPictures::Impl::sheet_crops(bool flip) con
   const Captured& c = *captured;
   std::vector<Rect> crops;
   for (const Rect& r : o.crops) {
-    if (r.x + r.width > width || r.y + r.height > height)
+    // In 64 bits: x + w of --crop 60,60,2147483647,2147483647 overflows an int (and then passed, issue 26 item 8).
+    if (std::int64_t(r.x) + r.width > width || std::int64_t(r.y) + r.height > height)
       return Error::usage("--crop " + std::to_string(r.x) + "," + std::to_string(r.y) + "," + std::to_string(r.width) +
                           "," + std::to_string(r.height) + " does not fit in the " + std::to_string(width) + "x" +
                           std::to_string(height) + " image");

@@ -293,7 +293,8 @@ Status write_chart(const Chart& chart, const std::string& path) {
     if (Status s = svg_to_pdf(svg.path(), tmp.path(), chart.title, chart.width, chart.height); !s) return s;
   }
   std::error_code ec;
-  if (!std::filesystem::exists(tmp.path()) || std::filesystem::file_size(tmp.path(), ec) == 0)
+  // The non-throwing forms: a file that cannot be examined is this output's error (exit 4), not an exception.
+  if (!std::filesystem::exists(tmp.path(), ec) || ec || std::filesystem::file_size(tmp.path(), ec) == 0 || ec)
     return Error::output(path, "the chart could not be written: check that the folder exists and is writable");
   return tmp.commit();
 }

@@ -144,6 +144,15 @@ Expected<CompareRun> run_compare(const ComparisonSetup& setup, const Thresholds&
   for (const auto& path : {page, report_csv, report_json})
     if (!path.empty())
       if (auto st = inputs->check(path, "--report"); !st) return st.error();
+  // No two outputs may name one file (--csv m.txt --json m.txt lost the CSV), and an existing output must be a
+  // regular file (a device node given as --csv was replaced by one): refused before anything runs (issue 26 items 2
+  // and 5), with the rule every tool's outputs follow (OutputPaths, temporal/io/runner.h).
+  OutputPaths outputs;
+  for (const auto& [path, option] : {std::pair{o.csv, "--csv"}, std::pair{o.json, "--json"}, std::pair{o.plot, "--plot"},
+                                     std::pair{page, "--report"}, std::pair{report_csv, "--report"},
+                                     std::pair{report_json, "--report"}})
+    if (!path.empty())
+      if (auto st = outputs.add(path, option); !st) return st.error();
 
   if (report_on)
     if (auto st = clear_earlier_report(o.pictures.report_dir, *inputs, base_hooks); !st) return st.error();

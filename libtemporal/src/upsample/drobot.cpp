@@ -217,7 +217,10 @@ void build_cache_grid(DrobotState& s, const FrameContext& f) {
     for (int x = 0; x < lw; ++x) {
       const std::size_t j = std::size_t(y) * lw + x;
       const std::size_t i = std::size_t(std::min(f.H - 1, k * y + k / 2)) * f.W + std::min(f.W - 1, k * x + k / 2);
-      s.cz[j] = f.z[i];
+      // A non-finite depth is no depth (as in the reprojection module, whose same-surface test it fails): 0, which
+      // fails every `z > 0` test below, so the block takes no sample, and no NaN reaches the cache's depth, Listing
+      // 7.3's depth weights or Listing 7.2's cached depth of the next frame (issue 26 item 11).
+      s.cz[j] = std::isfinite(f.z[i]) ? f.z[i] : 0.0f;
       if (f.prev_z) s.czw[j] = f.prev_z[i];
       s.cnx[j] = f.nx[i];
       s.cny[j] = f.ny[i];
@@ -252,9 +255,12 @@ void listing72_depth_row(const HistoryRow& h, const float* __restrict prev_z, co
 }
 
 // Then the confidence: 0 where the module's fetch misses (off screen, or no tap of the same surface), else
-// 1 - saturate((|z - zc| / z - threshold) * convergenceTime) (drobot.h).
+// 1 - saturate((|z - zc| / z - threshold) * convergenceTime) (drobot.h). A non-finite depth, current or the
+// listing's bilinear cached one (a tap with NaN depth beside surviving taps), is a miss: saturate(NaN) is NaN,
+// and a NaN confidence would make the frame count, the history weight and then the outputs NaN (issue 26 item 11).
 inline float cache_confidence(float hit, float z, float zc, float threshold, float convergence_time) {
-  return hit > 0 ? drobot_cache_confidence(z > 0 ? (z - zc) / z : 1.0f, threshold, convergence_time, true) : 0.0f;
+  if (!(hit > 0) || !std::isfinite(z) || !std::isfinite(zc)) return 0.0f;
+  return drobot_cache_confidence(z > 0 ? (z - zc) / z : 1.0f, threshold, convergence_time, true);
 }
 
 // Steps 3-5 of the framework for cache row y: this frame's samples accumulated into the reprojected cache HB

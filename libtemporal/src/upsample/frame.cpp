@@ -57,9 +57,10 @@ void gather_low_geometry(FrameContext& f) {
         f.lnx[i] = f.nx[g];
         f.lny[i] = f.ny[g];
         f.lnz[i] = f.nz[g];
-        // A sample with a non-finite payload or geometry is no sample (its weight becomes 0).
+        // A sample with a non-finite payload or geometry is no sample (its weight becomes 0); so is a payload past
+        // kMaxSampleMagnitude (temporal/core/image.h: squared and accumulated, it would overflow).
         bool ok = std::isfinite(f.z[g]) && std::isfinite(f.nx[g]) && std::isfinite(f.ny[g]) && std::isfinite(f.nz[g]);
-        for (int c = 0; c < f.C; ++c) ok = ok && std::isfinite(f.low[c][i]);
+        for (int c = 0; c < f.C; ++c) ok = ok && usable_sample(f.low[c][i]);
         f.lvalid[i] = ok ? 1.0f : 0.0f;
       }
     }

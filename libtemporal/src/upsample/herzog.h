@@ -52,7 +52,7 @@ struct HerzogOptions {
                     "spatial low-pass of the gradient: trilinear mip level, counted at full resolution",
                     &gradient_mip_level, 0.0, 8.0),
         Param::real("--max-history-weight", "bound of the history weight h_w; 0 = 2 k^2", &max_history_weight, 0.0,
-                    std::numeric_limits<double>::infinity()),
+                    1e6),
         Param::flag_on("--lagged-wf",
                        "eq. 7 with the previous frame's w_f (motion-compensated): one pass instead of three, w_f "
                        "reacts one frame later",

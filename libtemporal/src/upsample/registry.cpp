@@ -7,7 +7,6 @@
 
 namespace temporal::upsample {
 namespace {
-constexpr double kUnbounded = std::numeric_limits<double>::infinity();
 }  // namespace
 
 // Every method, in the order of --help, --list-methods and the docs. Adding a method: its source file defines
@@ -58,8 +57,8 @@ ParamList params(Options& o) {
       Param::real("--sigma-normal", "sigma_n of the normal weight (seed 000 eq. 2)", &o.sigma_normal, 1e-3, 1e3),
       Param::real("--sigma-depth-fraction", "sigma_d as a fraction of clipFar - clipNear (seed 000 section 3.1: 3%)",
                   &o.sigma_depth_fraction, 1e-6, 1.0),
-      Param::real("--sigma-depth", "Absolute sigma_d in world units; 0 uses --sigma-depth-fraction", &o.sigma_depth,
-                  0.0, kUnbounded),
+      Param::real_or_zero("--sigma-depth", "Absolute sigma_d in world units; 0 uses --sigma-depth-fraction", &o.sigma_depth,
+                  1e-6, 1e6),
       Param::real("--depth-tolerance",
                   "Relative depth difference above which a history tap is disoccluded (temporal/core/reproject.h)",
                   &o.depth_tolerance, 0.0, 10.0),

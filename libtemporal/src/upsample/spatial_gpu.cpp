@@ -41,7 +41,7 @@ bool low_valid(uint q) {
   const uint g = (uint(u_k) * ly + uint(u_sy)) * uint(u_size.x) + uint(u_sx) + uint(u_k) * lx;
   bool ok = is_finite_bits(gb[g]) && is_finite_bits(gb[u_n + g]) && is_finite_bits(gb[2u * u_n + g]) &&
             is_finite_bits(gb[3u * u_n + g]);
-  for (int c = 0; c < u_C; ++c) ok = ok && is_finite_bits(lowb[uint(c) * u_ln + q]);
+  for (int c = 0; c < u_C; ++c) ok = ok && is_sample(lowb[uint(c) * u_ln + q]);
   return ok;
 }
 // A low-resolution sample: its full-resolution pixel's geometry, valid when that geometry and every payload

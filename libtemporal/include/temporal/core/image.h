@@ -130,4 +130,15 @@ std::vector<std::string> layer_names(const std::vector<std::string>& channels); 
 // Counts the non-finite values (NaN, +-Inf) of a float plane.
 std::size_t count_non_finite(std::span<const float> plane);
 
+// The largest colour magnitude a method takes as a sample (docs/conventions.md, "Non-finite values"). A larger one
+// is treated as NaN is: no sample at that pixel this frame. Finite is not enough (issue 26 item 12: FLT_MAX in one
+// frame made phlm's later frames NaN). Seed 003's method squares and cubes its inputs in float: the a-priori error
+// of eq. 5 is squared (||e||^2) and the neighbourhood box's variance sums squares (both overflow past ~1.8e19), and
+// the feature's phi(v, l) = a l^2 + b v l^3 (section 5.1) overflows past l ~ 1.1e11 at the largest motion the
+// reprojection accepts (1e6 px, temporal/core/reproject.h) and b = 0.25. 1e10 keeps every one of them finite, and is
+// far above any scene-linear radiance a renderer writes (the sun's disc is ~1.6e9 cd/m^2).
+inline constexpr float kMaxSampleMagnitude = 1e10f;
+// True for a value a method takes as a sample: finite and at most kMaxSampleMagnitude in magnitude (false for NaN).
+inline bool usable_sample(float v) { return v >= -kMaxSampleMagnitude && v <= kMaxSampleMagnitude; }
+
 }  // namespace temporal

@@ -16,7 +16,9 @@ namespace temporal {
 
 // One parameter: the command-line flag, a help line (what it is, the paper's name and equation), the field it
 // sets, and its valid range. Floating-point values must be finite and inside [min, max]; integers inside
-// [min, max]; strings one of `choices` (when given). Optional numbers (a threshold that is off until given) are
+// [min, max]; strings one of `choices` (when given). Every floating-point option of the tools has a finite
+// range that keeps its arithmetic from overflowing or underflowing (issue 26: `--ppd 1e-40` inside [0, 10000]
+// made fps / ppd infinite); a value that means "off / derive it" (0) outside that range sets `or_zero`. Optional numbers (a threshold that is off until given) are
 // checked the same way once set; a list takes the option again for each value (or `separator`-separated
 // values) and checks each against `choices`.
 using ParamValue = std::variant<float*, double*, int*, bool*, std::string*, std::optional<double>*,
@@ -37,10 +39,22 @@ struct Param {
   std::string group = {};
   char separator = 0;                  // a list: each value is split at this character ("a,b" for --names)
   std::vector<std::string> excludes = {};  // flags that cannot be given together with this one
+  // 0 is also valid (an "off" or "derive it" value) although it lies outside [min, max]: `--ppd` is 0 (derived
+  // from the screen) or in [0.01, 10000], not 1e-40.
+  bool or_zero = false;
 
   // Shorthands for the common ranges.
   static Param real(std::string flag, std::string help, float* v, double lo, double hi) {
     return {std::move(flag), std::move(help), v, lo, hi, {}};
+  }
+  static Param real(std::string flag, std::string help, double* v, double lo, double hi) {
+    return {std::move(flag), std::move(help), v, lo, hi, {}};
+  }
+  // A value in [lo, hi], or 0 (off / derived): see `or_zero`.
+  static Param real_or_zero(std::string flag, std::string help, float* v, double lo, double hi) {
+    Param p{std::move(flag), std::move(help), v, lo, hi, {}};
+    p.or_zero = true;
+    return p;
   }
   // A value strictly above `lo` (e.g. a positive scale: > 0).
   static Param positive(std::string flag, std::string help, float* v, double lo = 0.0,
@@ -95,13 +109,17 @@ using ParamList = std::vector<Param>;
 // in effect (an inverted flag: when its field is false); an unset optional number ""; a list its values joined with
 // ", ".
 std::string param_value_text(const Param& param);
-// The valid range as text: "[0, 1]", "> 0", "one of: cache, refresh"; empty when unbounded.
+// The valid range as text: "[0, 1]", "> 0", "0 or [0.01, 10000]", "one of: cache, refresh"; empty when unbounded.
 std::string param_range_text(const Param& param);
 // Usage error unless the current value is valid: finite, inside the range, one of the choices
 // ("--flip: 'yes' is not one of off, ldr, hdr").
 Status check_param(const Param& param);
 // check_param for every entry (the first failure).
 Status check_params(const ParamList& params);
+// True for a number parameter that holds a floating-point value (float, double, optional<double>) and has a finite
+// range on both sides: what every floating-point option of the tools must have (the tools refuse to start
+// otherwise, so a forgotten range fails every test of the tool).
+bool has_finite_range(const Param& param);
 
 // Sets parameters from command-line style arguments, e.g. {"--mode", "refresh", "--lagged-wf"}: a flag (bool)
 // takes no value, every other parameter the next argument; each value is range-checked. For the named variants

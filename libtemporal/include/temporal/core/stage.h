@@ -8,6 +8,7 @@
 #include "temporal/core/image.h"
 
 #include <cstddef>
+#include <limits>
 #include <map>
 #include <string>
 #include <vector>
@@ -88,7 +89,9 @@ std::vector<std::string> layer_channel_names(const std::string& layer);
 Status check_gbuffer_layers(const Image& gbuffer, const std::vector<LayerNeed>& needs, const std::string& path);
 
 // Pixels of `image` with a NaN or Inf in any float plane of the named layers (every float plane when empty; "rgb"
-// stands for R, G, B).
-std::size_t count_non_finite_layers(const Image& image, const std::vector<std::string>& layers);
+// stands for R, G, B), or a value of magnitude above `max_magnitude` (the colour inputs: kMaxSampleMagnitude, the
+// samples the methods refuse, temporal/core/image.h).
+std::size_t count_non_finite_layers(const Image& image, const std::vector<std::string>& layers,
+                                    float max_magnitude = std::numeric_limits<float>::infinity());
 
 }  // namespace temporal

@@ -31,5 +31,10 @@ constexpr double pixels_per_degree_at_centre(double screen_width_m, double dista
 // FLIP's default viewing condition: 0.7 m from a 0.7 m wide screen 3840 pixels across, 67.0206 pixels per
 // degree (NVIDIA's tool prints it rounded, "67").
 inline constexpr double kFlipDefaultPixelsPerDegree = pixels_per_degree_at_centre(0.7, 0.7, 3840);
+// The pixels per degree FLIP accepts. Its filters are sized in degrees (radius ~ 0.14 ppd pixels for the CSF,
+// ~ 0.12 ppd for the features): 1e30 asked for a filter of 1e29 taps and crashed (issue 26 item 8); below 1 a
+// pixel spans more than a degree and the kernels shrink to their centre tap. 1000 is far past any display.
+inline constexpr double kFlipMinPixelsPerDegree = 1.0;
+inline constexpr double kFlipMaxPixelsPerDegree = 1000.0;
 
 }  // namespace temporal

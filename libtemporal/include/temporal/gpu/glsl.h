@@ -9,6 +9,7 @@ namespace temporal::gpu::glsl {
 
 // "#version 450", the 16 x 16 work-group size, and helpers every kernel uses:
 //   is_finite_bits(v)  v is neither NaN nor +-Inf, decided on the bits (immune to a compiler that assumes no NaN)
+//   is_sample(v)       is_finite_bits(v) and |v| <= kMaxSampleMagnitude (temporal/core/image.h usable_sample)
 //   pixel_index()      the invocation's pixel (gl_GlobalInvocationID.xy) and whether it lies inside u_size
 //   count_add(k, b)    adds b (0 or 1) to counter k (0..3) of the `counters` buffer (binding 15), reduced per
 //                      work group in shared memory so that each group issues one atomic per counter

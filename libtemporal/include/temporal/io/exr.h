@@ -45,6 +45,12 @@ Expected<ExrInfo> read_exr_info(const std::string& path);
 // file has. A channel stored as uint (`id`) is read exactly as uint; half and float become float32.
 Expected<Image> read_exr(const std::string& path, const ExrSelection& selection = {});
 
+// The same two readers over the bytes of an EXR file held in memory; `name` names it in messages and must end in
+// .exr. Every check of the file readers applies (tests/fuzz/exr_fuzz reads its inputs this way: no file per run).
+Expected<ExrInfo> read_exr_info(std::span<const std::uint8_t> bytes, const std::string& name);
+Expected<Image> read_exr(std::span<const std::uint8_t> bytes, const std::string& name,
+                         const ExrSelection& selection = {});
+
 // Writes atomically: a temporary file beside `path` is written and then renamed over it, so an
 // interrupted run never leaves a truncated EXR. Creates missing parent folders.
 // The R, G, B channels of `path` (read_exr with the selection {"rgb"}): the reader handed to stages that read
