@@ -220,7 +220,7 @@ constexpr int kMaxSide = 65536;
 // OpenEXR's positioned reads (exr_read_func_ptr_t) for its core.
 struct ExrSource {
   std::string path;
-  std::span<const std::uint8_t> memory;
+  std::span<const std::uint8_t> memory = {};
   bool in_memory = false;
   std::FILE* file = nullptr;  // the header walk's stream (files)
   std::uint64_t position = 0;  // the header walk's position (memory)
