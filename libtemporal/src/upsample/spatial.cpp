@@ -4,6 +4,7 @@
 // gathering version (spatial_row, in frame.cpp) serves `temporal`'s sparse hole runs; both compute the
 // same weights in the same order, so their results are bit-identical.
 #include "method.h"
+#include "gpu_methods.h"
 
 #include "temporal/core/parallel.h"
 
@@ -112,7 +113,8 @@ const MethodEntry& spatial_method() {
       .implementations = {{kCpuDevice,
                            [](const Options&, const Geometry& g) -> std::unique_ptr<MethodState> {
                              return std::make_unique<SpatialState>(g);
-                           }}},
+                           }},
+                          {kGpuDevice, make_spatial_state_gpu}},
       .streamed_bytes = streamed_bytes};
   return entry;
 }

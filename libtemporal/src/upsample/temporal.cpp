@@ -4,6 +4,7 @@
 // leave the screen have no history: the paper re-renders them in a second pass; we count them
 // (FrameStats::hole_pixels, `temporal:holePixels`) and fill them with the joint-bilateral result (eq. 1-3).
 #include "method.h"
+#include "gpu_methods.h"
 
 #include "temporal/core/parallel.h"
 
@@ -159,7 +160,8 @@ const MethodEntry& temporal_method() {
       .implementations = {{kCpuDevice,
                            [](const Options&, const Geometry& g) -> std::unique_ptr<MethodState> {
                              return std::make_unique<TemporalState>(g);
-                           }}},
+                           }},
+                          {kGpuDevice, make_temporal_state_gpu}},
       .streamed_bytes = streamed_bytes};
   return entry;
 }
