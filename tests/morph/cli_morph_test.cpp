@@ -142,6 +142,23 @@ TEST_F(MorphCli, ListMethodsPrintsTheRegistry) {
         << e->info.name << ": " << out;
 }
 
+// --device gpu for a method without a GPU kernel, and for --perceive (which runs on the CPU only), is a usage error
+// that says what to do.
+TEST_F(MorphCli, DeviceGpuWithoutAKernelIsAUsageError) {
+  const std::string base = tool() + " --input " + in("color") + " --gbuffer " + in("gbuffer") + " --out " +
+                           (dir_ / "x" / "o.####.exr").string();
+  std::string out;
+  EXPECT_EQ(test::run_command(base + " --method repeat --device gpu", &out), 1) << out;
+  EXPECT_NE(out.find("--method repeat has no gpu implementation (it runs on: cpu): pass --device cpu"),
+            std::string::npos)
+      << out;
+  EXPECT_EQ(test::run_command(base + " --method blend --device tpu", &out), 1) << out;
+  EXPECT_NE(out.find("--device"), std::string::npos) << out;
+  EXPECT_EQ(test::run_command(base + " --perceive --device gpu", &out), 1) << out;
+  EXPECT_NE(out.find("--perceive runs on the CPU only: drop --device gpu"), std::string::npos) << out;
+  EXPECT_FALSE(std::filesystem::exists(dir_ / "x")) << "nothing is written";
+}
+
 TEST_F(MorphCli, OutOfRangeAndNonFiniteParametersAreUsageErrors) {
   const std::string base = tool() + " --input " + in("color") + " --gbuffer " + in("gbuffer") + " --out " +
                            (dir_ / "x" / "o.####.exr").string();
