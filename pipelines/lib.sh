@@ -67,9 +67,8 @@ require_tools() {
   done
 }
 
-# methods_of TOOL: the tool's methods, space-separated, from its registry (--list-methods-json, else
-# --list-methods; methods.py says the transitional fallback). Named variants are not methods: method_args
-# resolves them.
+# methods_of TOOL: the tool's methods, space-separated, from its registry (--list-methods-json, read by
+# methods.py). Named variants are not methods: method_args resolves them.
 methods_of() {
   local out
   out="$(python3 "$METHODS_PY" names "$(tool_path "$1")")" || die "cannot read the methods of $1"

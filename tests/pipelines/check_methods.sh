@@ -2,8 +2,8 @@
 # The pipelines' method lists come from the tools (pipelines/lib.sh, pipelines/workflow/scripts/methods.py):
 #  - the built tools: methods_of and method_args of lib.sh against what the tools print,
 #  - a stand-in tool with --list-methods-json (the machine-readable registry): names, a named variant's
-#    arguments and statefulness are the JSON's, and the tab-separated listing's name suffixes still apply,
-#  - a stand-in filter-phlm with neither option: the transitional list,
+#    arguments, name suffixes and statefulness are the JSON's,
+#  - a stand-in tool without --list-methods-json: an error that says to rebuild it,
 #  - require_tools on a missing tool: exit 2 naming the command that builds it.
 # Usage: check_methods.sh BUILD_DIR WORK_DIR
 set -euo pipefail
@@ -45,10 +45,10 @@ case "$1" in
 [{"name": "alpha", "method": "alpha", "args": [], "summary": "a", "stateful": false, "implementations": ["cpu"]},
  {"name": "beta", "method": "beta", "args": [], "summary": "b", "stateful": true, "implementations": ["cpu"]},
  {"name": "beta-fast", "method": "beta", "args": ["--fast", "2"], "summary": "c", "stateful": true,
-  "implementations": ["cpu"]}]
+  "implementations": ["cpu"]},
+ {"suffix": "-x", "args": ["--extra"], "summary": "x"}]
 JSON
   ;;
-  --list-methods) printf 'alpha\t--method alpha\ta\nbeta\t--method beta\tb\n*-x\t--extra\tx\n' ;;
   *) exit 1 ;;
 esac
 SH
@@ -60,13 +60,14 @@ tool="$work/json/apps/demo-tool/demo-tool"
 [[ "$(python3 "$methods" stateful "$tool" alpha)" == false ]] || fail "JSON stateful of alpha"
 [[ "$(python3 "$methods" stateful "$tool" beta)" == true ]] || fail "JSON stateful of beta"
 
-# A filter-phlm with neither option: the transitional list.
+# A tool without the JSON form: an error saying to rebuild it.
 mkdir -p "$work/old/apps/filter-phlm"
 printf '#!/bin/sh\nexit 1\n' > "$work/old/apps/filter-phlm/filter-phlm"
 chmod +x "$work/old/apps/filter-phlm/filter-phlm"
-[[ "$(python3 "$methods" names "$work/old/apps/filter-phlm/filter-phlm" | paste -sd' ')" == "phlm taa ema fxaa" ]] ||
-  fail "transitional filter-phlm list"
-[[ "$(python3 "$methods" stateful "$work/old/apps/filter-phlm/filter-phlm" fxaa)" == false ]] || fail "fxaa"
+if python3 "$methods" names "$work/old/apps/filter-phlm/filter-phlm" 2> "$work/err"; then
+  fail "a tool without --list-methods-json was accepted"
+fi
+grep -q "filter-phlm has no --list-methods-json: rebuild it" "$work/err" || fail "old tool: $(cat "$work/err")"
 
 # require_tools on a missing tool.
 if bash -c 'source "$1/pipelines/lib.sh"; use_build "$2"; require_tools compare' _ "$here" "$work/json" 2> "$work/err"; then

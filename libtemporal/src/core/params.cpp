@@ -74,9 +74,7 @@ Status check_choice(const Param& p, const std::string& value) {
   if (p.choices.empty()) return Status::ok();
   for (const auto& c : p.choices)
     if (value == c) return Status::ok();
-  std::string list;
-  for (const auto& c : p.choices) list += (list.empty() ? "" : ", ") + c;
-  return Error::usage(p.flag + ": '" + value + "' is not one of " + list);
+  return not_one_of(p.flag, value, p.choices);
 }
 }  // namespace
 

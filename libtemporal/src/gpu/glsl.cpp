@@ -48,12 +48,10 @@ std::string storage(int binding, const char* name) {
          "layout(std430, binding = " + b + ") buffer " + n + "_U { uint " + n + "_u[]; };\n";
 }
 
-std::string_view reproject() {
-  static const std::string text = [] {
-    char constants[256];
-    std::snprintf(constants, sizeof constants, "const float kMinHitWeight = %.9g;\n",
-                  double(reproject::kMinHitWeight));
-    return std::string(constants) + R"(
+namespace {
+// The GLSL twin of temporal/core/reproject.h (every kernel includes it through reproject()); kMinHitWeight is
+// prepended from the C++ constant so that the two cannot drift.
+constexpr const char* kReprojectGlsl = R"(
 #ifndef REPROJECT_PREV_Z
 #define REPROJECT_PREV_Z(q) 0.0
 #endif
@@ -192,6 +190,14 @@ CatmullRom catmull_rom(vec2 f) {
 float expect_depth(float depth, float warped_depth, bool has_warped) { return has_warped ? warped_depth : depth; }
 float expect_tolerance(float tol, float warped_tol, bool has_warped) { return has_warped ? warped_tol : tol; }
 )";
+}  // namespace
+
+std::string_view reproject() {
+  static const std::string text = [] {
+    char constants[256];
+    std::snprintf(constants, sizeof constants, "const float kMinHitWeight = %.9g;\n",
+                  double(reproject::kMinHitWeight));
+    return std::string(constants) + kReprojectGlsl;
   }();
   return text;
 }

@@ -251,6 +251,51 @@ Expected<ExrCompression> parse_data_compression(const std::string& name) {
   return *c;
 }
 
+namespace {
+
+// Every file the run reads: no output may replace one of them (an output pattern equal to an input pattern,
+// another spelling of it, or a link to it).
+Expected<ProtectedInputs> run_inputs(const SequenceOptions& options, const Plan& plan, const StageInputs& needs) {
+  ProtectedInputs inputs;
+  for (const int f : plan.frames) {
+    inputs.add(plan.input.path(f));
+    for (int k = 1; k <= needs.lookahead; ++k) inputs.add(plan.input.path(f + k));
+    if (plan.gbuffer) inputs.add(plan.gbuffer->path(f));
+  }
+  if (!options.state_in.empty()) inputs.add(options.state_in);
+  for (const std::string& other : options.other_inputs) {
+    auto p = SequencePattern::parse(other);
+    if (!p) return p.error();
+    for (int f : plan.frames) inputs.add(p->path(f));
+  }
+  return inputs;
+}
+
+// Stamps the stage's outputs of one input frame (the run's identity, the frame, the method's timings) and writes
+// them under the output pattern.
+Status write_outputs(const Plan& plan, const RunIdentity& identity, const ProtectedInputs& inputs,
+                     const Image& input, std::vector<StageOutput>& outputs, RunSummary& summary) {
+  for (auto& o : outputs) {
+    FrameMetadata md = o.keep_input_metadata ? input.metadata() : o.image->metadata();
+    md.frame = o.frame;
+    md.tool = identity.tool;
+    md.parameters = identity.parameters;
+    md.compute_ms = o.compute_ms;
+    md.timings_ms = o.timings_ms;  // the input's pass timings describe another stage
+    for (const auto& k : o.drop_extra) md.extra.erase(k);
+    for (const auto& [k, v] : o.extra) md.extra[k] = v;
+    o.image->metadata() = std::move(md);
+    const std::string path = plan.out.path(o.frame);
+    if (Status s = inputs.check(path, "--out"); !s) return s;
+    if (Status s = write_exr(path, *o.image, plan.write); !s) return s;
+    summary.compute_ms += o.compute_ms;
+    ++summary.outputs;
+  }
+  return Status::ok();
+}
+
+}  // namespace
+
 Expected<RunSummary> run_sequence(const SequenceOptions& options, FrameStage& stage, const RunIdentity& identity,
                                   const RunHooks& hooks) {
   const StageInputs& needs = stage.inputs();
@@ -276,20 +321,9 @@ Expected<RunSummary> run_sequence(const SequenceOptions& options, FrameStage& st
     resumed = true;
   }
 
-  // Every file the run reads: no output may replace one of them (an output pattern equal to an input pattern,
-  // another spelling of it, or a link to it).
-  ProtectedInputs inputs;
-  for (const int f : plan->frames) {
-    inputs.add(plan->input.path(f));
-    for (int k = 1; k <= needs.lookahead; ++k) inputs.add(plan->input.path(f + k));
-    if (plan->gbuffer) inputs.add(plan->gbuffer->path(f));
-  }
-  if (!options.state_in.empty()) inputs.add(options.state_in);
-  for (const std::string& other : options.other_inputs) {
-    auto p = SequencePattern::parse(other);
-    if (!p) return p.error();
-    for (int f : plan->frames) inputs.add(p->path(f));
-  }
+  auto protected_inputs = run_inputs(options, *plan, needs);
+  if (!protected_inputs) return protected_inputs.error();
+  ProtectedInputs& inputs = *protected_inputs;
   if (Status s = inputs.check(plan->out.path(plan->frames.front()), "--out"); !s) return s.error();
   if (plan->state_out)
     if (Status s = inputs.check(plan->state_out->path(plan->frames.front()), "--state-out"); !s) return s.error();
@@ -349,22 +383,7 @@ Expected<RunSummary> run_sequence(const SequenceOptions& options, FrameStage& st
       if (e.file.empty()) e.file = sf.input_path;
       return e;
     }
-    for (auto& o : outputs) {
-      FrameMetadata md = o.keep_input_metadata ? sf.input->metadata() : o.image->metadata();
-      md.frame = o.frame;
-      md.tool = identity.tool;
-      md.parameters = identity.parameters;
-      md.compute_ms = o.compute_ms;
-      md.timings_ms = o.timings_ms;  // the input's pass timings describe another stage
-      for (const auto& k : o.drop_extra) md.extra.erase(k);
-      for (const auto& [k, v] : o.extra) md.extra[k] = v;
-      o.image->metadata() = std::move(md);
-      const std::string path = plan->out.path(o.frame);
-      if (Status s = inputs.check(path, "--out"); !s) return s.error();
-      if (Status s = write_exr(path, *o.image, plan->write); !s) return s.error();
-      summary.compute_ms += o.compute_ms;
-      ++summary.outputs;
-    }
+    if (Status s = write_outputs(*plan, identity, inputs, *sf.input, outputs, summary); !s) return s.error();
     if (plan->state_out && (plan->state_out->has_placeholder() || i + 1 == n))
       if (Status s = write_state(*plan, stage, identity, frame, inputs); !s) return s.error();
     if (const std::string line = stage.frame_summary(); !line.empty())

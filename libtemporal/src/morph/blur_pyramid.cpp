@@ -28,26 +28,31 @@ struct Taps {
   std::vector<float> weight;  // 4 per output sample
 };
 
-// Taps of level `level` (size n) for every full-resolution sample 0..full-1. Level texel i sits at
-// full-resolution pixel i * 2^level (see the header), so pixel x reads the level at u = x / 2^level.
+// Taps of level `level` (size n) for every full-resolution sample (blur_pyramid_taps).
 Taps make_taps(int full, int n, int level) {
   Taps t;
-  t.index.resize(std::size_t(full) * 4);
-  t.weight.resize(std::size_t(full) * 4);
+  blur_pyramid_taps(full, n, level, t.index, t.weight);
+  return t;
+}
+
+}  // namespace
+
+// Level texel i sits at full-resolution pixel i * 2^level (see the header), so pixel x reads the level at
+// u = x / 2^level.
+void blur_pyramid_taps(int full, int n, int level, std::vector<int>& index, std::vector<float>& weight) {
+  index.resize(std::size_t(full) * 4);
+  weight.resize(std::size_t(full) * 4);
   const float scale = 1.0f / float(1 << level);
   for (int x = 0; x < full; ++x) {
     const float u = float(x) * scale;
     const int i0 = static_cast<int>(std::floor(u));
     const auto w = bspline(u - float(i0));
     for (int k = 0; k < 4; ++k) {
-      t.index[std::size_t(x) * 4 + std::size_t(k)] = std::clamp(i0 - 1 + k, 0, n - 1);
-      t.weight[std::size_t(x) * 4 + std::size_t(k)] = w[std::size_t(k)];
+      index[std::size_t(x) * 4 + std::size_t(k)] = std::clamp(i0 - 1 + k, 0, n - 1);
+      weight[std::size_t(x) * 4 + std::size_t(k)] = w[std::size_t(k)];
     }
   }
-  return t;
 }
-
-}  // namespace
 
 void BlurPyramid::build(std::span<const float* const> planes, int width, int height, int levels) {
   levels_ = std::max(levels, 0);

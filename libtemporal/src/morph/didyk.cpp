@@ -14,11 +14,13 @@
 // The low-pass is computed on the rendered frame and warped with the same grid (rather than blurring each
 // warped frame): for a piecewise-affine warp the two agree up to the local scale change, and this way the
 // energy balance of the compensation holds exactly along each motion trajectory, the one the eye follows.
+#include "didyk_options.h"
 #include "method_common.h"
 #include "temporal/core/color.h"
 #include "temporal/core/fast_math.h"
 #include "temporal/core/parallel.h"
 #include "temporal/morph/blur_pyramid.h"
+#include "temporal/morph/gpu_methods.h"
 #include "temporal/morph/grid_warp.h"
 #include "temporal/morph/methods.h"
 
@@ -63,52 +65,6 @@ void compensate_span(const float* o, const float* v, const float* l, const float
     lowlin[i] = keep ? oi : lo;
   }
 }
-
-inline float smoothstep(float lo, float hi, float x) {
-  if (hi <= lo) return x >= hi ? 1.0f : 0.0f;
-  const float t = std::clamp((x - lo) / (hi - lo), 0.0f, 1.0f);
-  return t * t * (3.0f - 2.0f * t);
-}
-
-// didyk's own parameters (the display's gamma and the viewer's pixels per degree are the run's, MorphOptions).
-struct DidykOptions {
-  GridOptions grid;         // cell size and snapping (the eye-tracking limit's fields come from MorphOptions)
-  float blur_level = 2.0f;  // pyramid level read for the low-pass layer L (fractional allowed)
-  // Smooth-step from cell distortion to blur strength of the in-between frames: 0 below distortion_low,
-  // 1 above distortion_high (section 5.1, "Selective Blur").
-  float distortion_low = 0.05f;
-  float distortion_high = 0.5f;
-  float min_blur = 0.0f;   // blur strength floor in [0, 1] (1: blur every in-between frame fully, as [CKL*05])
-  bool compensate = true;  // high-frequency compensation of the rendered frame (section 5.1)
-
-  ParamList params() {
-    const double inf = std::numeric_limits<double>::infinity();
-    return {
-        Param::integer("--grid", "Grid cell size in pixels, a power of two (seed 004: 8)", &grid.cell, 2, 32),
-        Param::real("--snap-threshold", "Smallest motion difference (px per input frame) a vertex snaps to",
-                    &grid.snap_threshold, 0, inf),
-        Param::flag_off("--no-snap", "Keep the grid regular (no snapping to motion discontinuities)", &grid.snap),
-        Param::real("--blur-level", "Blur pyramid level read for the low-pass layer (fractional allowed)", &blur_level,
-                    0, 8),
-        Param::real("--distortion-low", "Cell distortion (fraction of a cell) where the in-between blur starts",
-                    &distortion_low, 0, inf),
-        Param::real("--distortion-high", "Cell distortion where the in-between frame is fully blurred",
-                    &distortion_high, 0, inf),
-        Param::real("--min-blur", "Blur strength floor of the in-between frames (1: blur everywhere, [CKL*05])",
-                    &min_blur, 0, 1),
-        Param::flag_off("--no-compensation", "Do not add compensating high frequencies to the rendered frame",
-                        &compensate),
-    };
-  }
-  // What a range cannot say (the pyramid and the snapping work on power-of-two cells).
-  Status check() const {
-    const int c = grid.cell;
-    if (c < 2 || c > 32 || (c & (c - 1)) != 0)
-      return Error::usage("--grid must be a power of two from 2 to 32 (got " + std::to_string(c) + ")");
-    if (!(blur_level >= 0.0f && blur_level <= 8.0f)) return Error::usage("--blur-level must be in [0, 8]");
-    return Status::ok();
-  }
-};
 
 class Didyk final : public MorphMethod {
  public:
@@ -285,9 +241,13 @@ const MethodEntry& didyk_method() {
                .latency_frames = 0},
       .make_options = OptionsOf<DidykOptions>::make,
       .layers = [](const MorphOptions&) { return std::vector<LayerNeed>{{"motion"}, {"depth"}}; },
-      .implementations = {{kCpuDevice, [](const MorphOptions& o) -> std::unique_ptr<MorphMethod> {
+      // The C++ implementation is the reference of record; the GPU one (didyk_gpu.cpp) runs the same steps as GLSL
+      // compute kernels, within the tolerances of docs/gpu.md.
+      .implementations = {{kCpuDevice,
+                           [](const MorphOptions& o) -> std::unique_ptr<MorphMethod> {
                              return std::make_unique<Didyk>(o, method_options<DidykOptions>(o.per_method, "didyk"));
-                           }}},
+                           }},
+                          {kGpuDevice, make_didyk_method_gpu}},
   };
   return entry;
 }

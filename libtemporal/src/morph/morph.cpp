@@ -97,7 +97,9 @@ Status Morpher::process(const Image& color, const Image* gbuffer, const Image* n
     // The implementation on --device (check() made sure the method has one there).
     const auto* implementation = find_implementation(*entry_, options_.device);
     if (!implementation) return check_method_device(*entry_, options_.device);
-    if (implementation->make.needs_gpu() && !gpu_) {
+    // By the device, not the factory's kind: an adapter with the CPU signature registered for the GPU (one that
+    // makes its own context) still runs there, and the headers name the device's context.
+    if (options_.device == kGpuDevice && !gpu_) {
       auto context = gpu::context_for_device(options_.device);
       if (!context) return context.error();
       gpu_ = std::move(*context);

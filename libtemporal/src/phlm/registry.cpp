@@ -72,8 +72,9 @@ Expected<std::unique_ptr<FrameFilter>> make_filter(const FilterOptions& options,
                                                    std::shared_ptr<gpu::Context> context) {
   if (Status s = check(options); !s) return s.error();
   const auto* implementation = find_implementation(*find_entry(options.method), options.device);
-  if (!implementation) return Error::internal("--method " + options.method + " has no " + options.device + " implementation");
-  if (implementation->make.needs_gpu() && !context) {
+  if (!implementation)
+    return Error::internal("--method " + options.method + " has no " + options.device + " implementation");
+  if (options.device == kGpuDevice && !context) {
     auto made = gpu::context_for_device(options.device);
     if (!made) return made.error();
     context = std::move(*made);

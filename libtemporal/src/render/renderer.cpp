@@ -203,6 +203,13 @@ struct Renderer::Impl {
   // Also sets `dark` to RenderedFrame::dark_fraction of the sum it reads.
   Image shade_image(const Fbo& f, float scale, double* dark = nullptr);
   void set_metadata(Image& image, const FrameInput& in, const View& v, glm::vec2 jitter) const;
+  // The passes of Renderer::render, in their order.
+  Status pass_light_maps(const FrameInput& in, RenderedFrame& result);
+  void pass_gbuffer(const FrameInput& in, const View& full, RenderedFrame& result);
+  void pass_shade_low(const FrameInput& in, std::uint32_t instant, std::uint32_t frame_seed, RenderedFrame& result);
+  void pass_color(const FrameInput& in, std::uint32_t instant, std::uint32_t frame_seed, RenderedFrame& result);
+  void pass_reference(const FrameInput& in, const View& full, std::uint32_t instant, RenderedFrame& result);
+  void warn_if_dark(const FrameInput& in, double dark_fraction);
   void timer_begin(int slot) const {
     if (timer) gl().BeginQuery(GL_TIME_ELAPSED, queries[slot]);
   }
@@ -729,6 +736,130 @@ Expected<Renderer> Renderer::create(const RenderOptions& options, const SceneGeo
   return r;
 }
 
+// One pass of Renderer::render each: they render, time (wall clock after glFinish, GL_TIME_ELAPSED where the
+// context has it) and convert their targets into `result`'s images.
+Status Renderer::Impl::pass_light_maps(const FrameInput& in, RenderedFrame& result) {
+  const auto t0 = Clock::now();
+  timer_begin(0);
+  if (auto s = light_maps(*in.current); !s) return s;
+  timer_end();
+  select_vpls(instant_key(in.frame, in.fps), 0);
+  gl().Finish();
+  result.timings_ms[kPassLightMaps] = ms_since(t0);
+  if (timer) result.gpu_ms[kPassLightMaps] = timer_ms(0);
+  return Status::ok();
+}
+
+void Renderer::Impl::pass_gbuffer(const FrameInput& in, const View& full, RenderedFrame& result) {
+  const auto t0 = Clock::now();
+  timer_begin(0);
+  draw_gbuffer(gbuffer_full, full);
+  timer_end();
+  gl().Finish();
+  result.timings_ms[kPassGbuffer] = ms_since(t0);
+  if (timer) result.gpu_ms[kPassGbuffer] = timer_ms(0);
+  result.gbuffer = gbuffer_image(gbuffer_full, full, in);
+  set_metadata(*result.gbuffer, in, full, {0.0f, 0.0f});
+  result.gbuffer->metadata().compute_ms = result.timings_ms[kPassGbuffer];
+}
+
+// The low-resolution payload: a G-buffer rendered at 1/k with this frame's jitter (in low-res pixels, conventions
+// "Jitter"), shaded directly. Its samples are exactly full-res pixel centres for the regular pattern. Textures are
+// read at the full-resolution mip level (LOD bias -log2 k by default, RenderOptions).
+void Renderer::Impl::pass_shade_low(const FrameInput& in, std::uint32_t instant, std::uint32_t frame_seed,
+                                    RenderedFrame& result) {
+  const RenderOptions& o = options;
+  const int k = o.factor;
+  const glm::vec2 jitter = frame_jitter(o.shade_jitter, jitter_frame(o.shade_jitter, in.frame, instant), k, o.seed);
+  const View low = make_view(in, o.width / k, o.height / k, jitter);
+  const float lod_bias = o.shade_mip_bias ? *o.shade_mip_bias : -std::log2(float(k));
+  const auto t0 = Clock::now();
+  timer_begin(0);
+  draw_gbuffer(gbuffer_low, low, lod_bias);
+  shade(gbuffer_low, shade_low, low, frame_seed, false, true);
+  timer_end();
+  gl().Finish();
+  result.timings_ms[kPassShadeLow] = ms_since(t0);
+  if (timer) result.gpu_ms[kPassShadeLow] = timer_ms(0);
+  result.shade = shade_image(shade_low, 1.0f, &result.dark_fraction);
+  set_metadata(*result.shade, in, low, jitter);
+  result.shade->metadata().jitter_factor = k;
+  if (o.shade_jitter == JitterMode::Regular) result.shade->metadata().jitter_index = regular_jitter_index(in.frame, k);
+  result.shade->metadata().compute_ms = result.timings_ms[kPassShadeLow];
+}
+
+// Colour: the same payload at full resolution, one sample per pixel at the colour jitter (no AA).
+void Renderer::Impl::pass_color(const FrameInput& in, std::uint32_t instant, std::uint32_t frame_seed,
+                                RenderedFrame& result) {
+  const RenderOptions& o = options;
+  const int w = o.width, h = o.height;
+  const glm::vec2 jitter =
+      frame_jitter(o.color_jitter, jitter_frame(o.color_jitter, in.frame, instant), o.factor, o.seed ^ 0xc0104u);
+  const View view = make_view(in, w, h, jitter);
+  const auto t0 = Clock::now();
+  timer_begin(0);
+  draw_gbuffer(gbuffer_full, view);
+  timer_end();
+  gl().Finish();
+  const auto t1 = Clock::now();
+  timer_begin(1);
+  shade(gbuffer_full, shade_full, view, frame_seed, false, true);
+  timer_end();
+  gl().Finish();
+  result.timings_ms[kPassShadeFull] = ms_since(t1);
+  result.timings_ms[kPassColor] = ms_since(t0);
+  if (timer) {
+    result.gpu_ms[kPassShadeFull] = timer_ms(1);
+    result.gpu_ms[kPassColor] = timer_ms(0) + timer_ms(1);
+  }
+  Image full_payload = shade_image(shade_full, 1.0f, &result.dark_fraction);
+  Image color(w, h);
+  for (const char* c : {"R", "G", "B"}) std::copy_n(full_payload.plane(c), full_payload.pixel_count(), color.add_channel(c));
+  result.color = std::move(color);
+  set_metadata(*result.color, in, view, jitter);
+  result.color->metadata().compute_ms = result.timings_ms[kPassColor];
+}
+
+// Reference: reference_spp full-resolution samples at Halton (2,3) sub-pixel positions (or all at the pixel centres
+// with reference_jitter = None), each with its own SSAO pattern and VPL set, accumulated in float targets and
+// averaged.
+void Renderer::Impl::pass_reference(const FrameInput& in, const View& full, std::uint32_t instant,
+                                    RenderedFrame& result) {
+  const RenderOptions& o = options;
+  const auto t0 = Clock::now();
+  timer_begin(0);
+  const bool centred = o.reference_jitter == JitterMode::None;
+  for (int s = 0; s < o.reference_spp; ++s) {
+    const auto i = std::uint32_t(s + 1);
+    const glm::vec2 jitter =
+        centred ? glm::vec2(0.0f) : glm::vec2(radical_inverse(i, 2) - 0.5f, radical_inverse(i, 3) - 0.5f);
+    const View view = make_view(in, o.width, o.height, jitter);
+    if (s > 0 && rsm.fbo) select_vpls(instant, s);
+    draw_gbuffer(gbuffer_full, view);
+    shade(gbuffer_full, shade_full, view, hash_u32(o.seed, instant, 0xbeefu, i), true, s == 0);
+  }
+  timer_end();
+  gl().Finish();
+  result.timings_ms[kPassReference] = ms_since(t0);
+  if (timer) result.gpu_ms[kPassReference] = timer_ms(0);
+  double dark = -1.0;
+  result.reference = shade_image(shade_full, 1.0f / float(o.reference_spp), &dark);
+  if (!o.outputs.color) result.dark_fraction = dark;  // the colour image's count wins
+  set_metadata(*result.reference, in, full, {0.0f, 0.0f});
+  result.reference->metadata().compute_ms = result.timings_ms[kPassReference];
+}
+
+// Warns once, at the first frame that is mostly black.
+void Renderer::Impl::warn_if_dark(const FrameInput& in, double dark_fraction) {
+  if (dark_fraction <= 0.5 || dark_warned || !options.warning) return;
+  dark_warned = true;
+  const int percent = int(std::lround(100.0 * dark_fraction));
+  options.warning("frame " + std::to_string(in.frame) + ": " + std::to_string(percent) +
+                  " % of the covered pixels are below 1 % of the frame's maximum: the render is mostly black and "
+                  "flatters every metric (raise --key-light, --fill-light or --ambient, or --lights auto; later dark "
+                  "frames are not reported)");
+}
+
 Expected<RenderedFrame> Renderer::render(const FrameInput& in) {
   Impl& im = *impl_;
   if (!in.current) return Error::internal("Renderer::render without a frame state");
@@ -736,131 +867,29 @@ Expected<RenderedFrame> Renderer::render(const FrameInput& in) {
   const auto& g = im.gl();
   const RenderOptions& o = im.options;
   const RenderOutputs& out = o.outputs;
-  const int w = o.width, h = o.height, k = o.factor;
   RenderedFrame result;
-  auto finish = [&]() { g.Finish(); };
 
   if (auto s = im.gpu->prepare(*in.current, in.previous); !s) return s.error();
   im.state = in.current;
-  finish();
+  g.Finish();
 
   const bool payload = out.shade || out.reference || out.color;
-  if (payload && (o.payload.shadow || o.payload.gi)) {
-    const auto t0 = Clock::now();
-    im.timer_begin(0);
-    if (auto s = im.light_maps(*in.current); !s) return s.error();
-    im.timer_end();
-    im.select_vpls(instant_key(in.frame, in.fps), 0);
-    finish();
-    result.timings_ms[kPassLightMaps] = ms_since(t0);
-    if (im.timer) result.gpu_ms[kPassLightMaps] = im.timer_ms(0);
-  }
+  if (payload && (o.payload.shadow || o.payload.gi))
+    if (Status s = im.pass_light_maps(in, result); !s) return s.error();
   // Random patterns (SSAO rotations, VPL sets, random jitter) are keyed by the frame's instant, not its number, so
   // a 40 Hz frame n and a 120 Hz frame 3n are the same render (docs/conventions.md, "Jitter" and "Noise").
   const std::uint32_t instant = instant_key(in.frame, in.fps);
   const std::uint32_t frame_seed = hash_u32(o.seed, instant, 0xa0u);
-
-  const Impl::View full = im.make_view(in, w, h, {0.0f, 0.0f});
-  if (out.gbuffer) {
-    const auto t0 = Clock::now();
-    im.timer_begin(0);
-    im.draw_gbuffer(im.gbuffer_full, full);
-    im.timer_end();
-    finish();
-    result.timings_ms[kPassGbuffer] = ms_since(t0);
-    if (im.timer) result.gpu_ms[kPassGbuffer] = im.timer_ms(0);
-    result.gbuffer = im.gbuffer_image(im.gbuffer_full, full, in);
-    im.set_metadata(*result.gbuffer, in, full, {0.0f, 0.0f});
-    result.gbuffer->metadata().compute_ms = result.timings_ms[kPassGbuffer];
-  }
-  if (out.shade) {
-    // The low-resolution payload: a G-buffer rendered at 1/k with this frame's jitter (in low-res pixels,
-    // conventions "Jitter"), shaded directly. Its samples are exactly full-res pixel centres for the regular
-    // pattern. Textures are read at the full-resolution mip level (LOD bias -log2 k by default, RenderOptions).
-    const glm::vec2 jitter = frame_jitter(o.shade_jitter, jitter_frame(o.shade_jitter, in.frame, instant), k, o.seed);
-    const Impl::View low = im.make_view(in, w / k, h / k, jitter);
-    const float lod_bias = o.shade_mip_bias ? *o.shade_mip_bias : -std::log2(float(k));
-    const auto t0 = Clock::now();
-    im.timer_begin(0);
-    im.draw_gbuffer(im.gbuffer_low, low, lod_bias);
-    im.shade(im.gbuffer_low, im.shade_low, low, frame_seed, false, true);
-    im.timer_end();
-    finish();
-    result.timings_ms[kPassShadeLow] = ms_since(t0);
-    if (im.timer) result.gpu_ms[kPassShadeLow] = im.timer_ms(0);
-    result.shade = im.shade_image(im.shade_low, 1.0f, &result.dark_fraction);
-    im.set_metadata(*result.shade, in, low, jitter);
-    result.shade->metadata().jitter_factor = k;
-    if (o.shade_jitter == JitterMode::Regular) result.shade->metadata().jitter_index = regular_jitter_index(in.frame, k);
-    result.shade->metadata().compute_ms = result.timings_ms[kPassShadeLow];
-  }
-  if (out.color) {
-    // Colour: the same payload at full resolution, one sample per pixel at the colour jitter (no AA).
-    const glm::vec2 jitter =
-        frame_jitter(o.color_jitter, jitter_frame(o.color_jitter, in.frame, instant), k, o.seed ^ 0xc0104u);
-    const Impl::View view = im.make_view(in, w, h, jitter);
-    const auto t0 = Clock::now();
-    im.timer_begin(0);
-    im.draw_gbuffer(im.gbuffer_full, view);
-    im.timer_end();
-    finish();
-    const auto t1 = Clock::now();
-    im.timer_begin(1);
-    im.shade(im.gbuffer_full, im.shade_full, view, frame_seed, false, true);
-    im.timer_end();
-    finish();
-    result.timings_ms[kPassShadeFull] = ms_since(t1);
-    result.timings_ms[kPassColor] = ms_since(t0);
-    if (im.timer) {
-      result.gpu_ms[kPassShadeFull] = im.timer_ms(1);
-      result.gpu_ms[kPassColor] = im.timer_ms(0) + im.timer_ms(1);
-    }
-    Image full_payload = im.shade_image(im.shade_full, 1.0f, &result.dark_fraction);
-    Image color(w, h);
-    for (const char* c : {"R", "G", "B"}) std::copy_n(full_payload.plane(c), full_payload.pixel_count(), color.add_channel(c));
-    result.color = std::move(color);
-    im.set_metadata(*result.color, in, view, jitter);
-    result.color->metadata().compute_ms = result.timings_ms[kPassColor];
-  }
-  if (out.reference) {
-    // Reference: reference_spp full-resolution samples at Halton (2,3) sub-pixel positions (or all at the pixel
-    // centres with reference_jitter = None), each with its own SSAO pattern and VPL set, accumulated in float
-    // targets and averaged.
-    const auto t0 = Clock::now();
-    im.timer_begin(0);
-    const bool centred = o.reference_jitter == JitterMode::None;
-    for (int s = 0; s < o.reference_spp; ++s) {
-      const auto i = std::uint32_t(s + 1);
-      const glm::vec2 jitter =
-          centred ? glm::vec2(0.0f) : glm::vec2(radical_inverse(i, 2) - 0.5f, radical_inverse(i, 3) - 0.5f);
-      const Impl::View view = im.make_view(in, w, h, jitter);
-      if (s > 0 && im.rsm.fbo) im.select_vpls(instant, s);
-      im.draw_gbuffer(im.gbuffer_full, view);
-      im.shade(im.gbuffer_full, im.shade_full, view, hash_u32(o.seed, instant, 0xbeefu, i), true,
-               s == 0);
-    }
-    im.timer_end();
-    finish();
-    result.timings_ms[kPassReference] = ms_since(t0);
-    if (im.timer) result.gpu_ms[kPassReference] = im.timer_ms(0);
-    double dark = -1.0;
-    result.reference = im.shade_image(im.shade_full, 1.0f / float(o.reference_spp), &dark);
-    if (!out.color) result.dark_fraction = dark;  // the colour image's count wins
-    im.set_metadata(*result.reference, in, full, {0.0f, 0.0f});
-    result.reference->metadata().compute_ms = result.timings_ms[kPassReference];
-  }
+  const Impl::View full = im.make_view(in, o.width, o.height, {0.0f, 0.0f});
+  if (out.gbuffer) im.pass_gbuffer(in, full, result);
+  if (out.shade) im.pass_shade_low(in, instant, frame_seed, result);
+  if (out.color) im.pass_color(in, instant, frame_seed, result);
+  if (out.reference) im.pass_reference(in, full, instant, result);
   if (auto s = check_gl(g, "frame"); !s) return s.error();
   for (Image* img : {result.gbuffer ? &*result.gbuffer : nullptr, result.shade ? &*result.shade : nullptr,
                      result.color ? &*result.color : nullptr, result.reference ? &*result.reference : nullptr})
     if (img) img->metadata().timings_ms = result.timings_ms;
-  if (result.dark_fraction > 0.5 && !im.dark_warned && o.warning) {
-    im.dark_warned = true;
-    const int percent = int(std::lround(100.0 * result.dark_fraction));
-    o.warning("frame " + std::to_string(in.frame) + ": " + std::to_string(percent) +
-              " % of the covered pixels are below 1 % of the frame's maximum: the render is mostly black and flatters "
-              "every metric (raise --key-light, --fill-light or --ambient, or --lights auto; later dark frames are "
-              "not reported)");
-  }
+  im.warn_if_dark(in, result.dark_fraction);
   return result;
 }
 

@@ -214,7 +214,9 @@ Status Upsampler::Impl::prepare_state(std::span<const std::string> channels, con
     // The implementation on --device (check() made sure the method has one there).
     const auto* implementation = find_implementation(*entry, options.device);
     if (!implementation) return check_method_device(*entry, options.device);
-    if (implementation->make.needs_gpu() && !gpu) {
+    // By the device, not the factory's kind: an adapter with the CPU signature registered for the GPU (one that
+    // makes its own context) still runs there, and the headers name the device's context.
+    if (options.device == kGpuDevice && !gpu) {
       auto context = gpu::context_for_device(options.device);
       if (!context) return context.error();
       gpu = std::move(*context);

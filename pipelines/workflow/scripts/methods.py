@@ -3,16 +3,11 @@
 fact a registry knows). Used by pipelines/lib.sh (`methods_of`, `method_args`) and by the Snakefile (`stateful`,
 the experiments' `methods:` lists).
 
-Where the list comes from, in order:
-  1. `TOOL --list-methods-json`: a JSON array, one object per method or named variant:
-     {"name", "method", "args": [...], "summary", "stateful": bool, "implementations": [...]}.
-  2. `TOOL --list-methods`, tab-separated: upsample-st prints NAME, "--method M ARGS...", SUMMARY per method and
-     named variant and *SUFFIX, ARGS, SUMMARY per name suffix (-demod); morph-120hz prints NAME, SUMMARY.
-  3. TRANSITIONAL (remove once every method tool has --list-methods-json): filter-phlm without either option
-     gets the methods of libtemporal/src/phlm/registry.cpp below, and a tool without the JSON form gets the
-     statefulness of TRANSITIONAL_STATELESS (upsample's MethodInfo::has_state, FrameFilter::has_state).
-Name suffixes (*-demod) are read from the tab-separated listing in every case: the JSON form lists methods and
-variants only.
+The list is `TOOL --list-methods-json` (upsample-st, filter-phlm and morph-120hz print it from their registries): a
+JSON array with one object per method or named variant,
+    {"name", "method", "args": [...], "summary", "stateful": bool, "implementations": [...]},
+and one object per name suffix (upsample-st's `-demod`: any method with extra arguments),
+    {"suffix", "args": [...], "summary"}.
 
   methods.py names TOOL           the methods (not the named variants), one per line
   methods.py args TOOL NAME...    per NAME (a method, a named variant, either with suffixes) "NAME<TAB>ARGUMENTS"
@@ -25,20 +20,11 @@ import shlex
 import subprocess
 import sys
 
-# TRANSITIONAL: filter-phlm before it had --list-methods (libtemporal/src/phlm/registry.cpp, in its order).
-TRANSITIONAL_METHODS = {"filter-phlm": ["phlm", "taa", "ema", "fxaa"]}
-# TRANSITIONAL: the methods without a history, for tools without --list-methods-json (they refuse --state-in /
-# --state-out). morph-120hz has no --state-in / --state-out at all.
-TRANSITIONAL_STATELESS = {"upsample-st": {"spatial"}, "filter-phlm": {"fxaa"}}
-TRANSITIONAL_NO_STATE_TOOLS = {"morph-120hz"}
-
-
 class Registry:
-    def __init__(self, tool, entries, suffixes, source):
+    def __init__(self, tool, entries, suffixes):
         self.tool = tool          # the tool's file name (upsample-st, ...)
         self.entries = entries    # [{name, method, args, summary, stateful}] in the tool's order
         self.suffixes = suffixes  # [(suffix, args, summary)]
-        self.source = source      # "json", "list" or "transitional": where the entries came from
 
     def names(self):
         """The methods themselves (an entry that is its own method with no extra arguments)."""
@@ -73,12 +59,7 @@ class Registry:
 
     def stateful(self, name):
         e, _ = self.resolve(name)
-        if e["stateful"] is not None:
-            return bool(e["stateful"])
-        # TRANSITIONAL: no --list-methods-json yet.
-        if self.tool in TRANSITIONAL_NO_STATE_TOOLS:
-            return False
-        return e["method"] not in TRANSITIONAL_STATELESS.get(self.tool, set())
+        return bool(e["stateful"])
 
 
 def _ask(path, option):
@@ -91,31 +72,14 @@ def _ask(path, option):
 
 
 def _from_json(text):
-    data = json.loads(text)
-    items = data if isinstance(data, list) else data.get("methods", [])
-    entries = []
-    for m in items:
-        entries.append({"name": m["name"], "method": m.get("method", m["name"]), "args": list(m.get("args", [])),
-                        "summary": m.get("summary", ""), "stateful": m.get("stateful")})
-    return entries
-
-
-def _from_list(text):
+    """(entries, suffixes) of the JSON listing."""
     entries, suffixes = [], []
-    for line in text.splitlines():
-        if not line.strip():
-            continue
-        fields = line.split("\t")
-        if fields[0].startswith("*"):  # a name suffix: *SUFFIX, ARGS, SUMMARY
-            suffixes.append((fields[0][1:], shlex.split(fields[1]) if len(fields) > 1 else [],
-                             fields[2] if len(fields) > 2 else ""))
-        elif len(fields) >= 3 and fields[1].startswith("--method "):  # NAME, --method M ARGS, SUMMARY
-            words = shlex.split(fields[1])
-            entries.append({"name": fields[0], "method": words[1], "args": words[2:], "summary": fields[2],
-                            "stateful": None})
-        else:  # NAME, SUMMARY
-            entries.append({"name": fields[0], "method": fields[0], "args": [],
-                            "summary": fields[1] if len(fields) > 1 else "", "stateful": None})
+    for m in json.loads(text):
+        if "suffix" in m:
+            suffixes.append((m["suffix"], list(m.get("args", [])), m.get("summary", "")))
+        else:
+            entries.append({"name": m["name"], "method": m.get("method", m["name"]), "args": list(m.get("args", [])),
+                            "summary": m.get("summary", ""), "stateful": bool(m["stateful"])})
     return entries, suffixes
 
 
@@ -124,21 +88,14 @@ def load(path):
     tool = os.path.basename(path)
     if not (os.path.isfile(path) and os.access(path, os.X_OK)):
         raise SystemExit(f"methods.py: {path} is not built: build the tools first (docs/pipelines.md, \"Running it\")")
-    listing = _ask(path, "--list-methods")
-    list_entries, suffixes = _from_list(listing) if listing is not None else ([], [])
     text = _ask(path, "--list-methods-json")
-    if text is not None:
-        try:
-            return Registry(tool, _from_json(text), suffixes, "json")
-        except (ValueError, KeyError, AttributeError, TypeError) as e:
-            raise SystemExit(f"methods.py: {tool} --list-methods-json: unreadable output ({e})")
-    if listing is not None:
-        return Registry(tool, list_entries, suffixes, "list")
-    if tool in TRANSITIONAL_METHODS:
-        entries = [{"name": m, "method": m, "args": [], "summary": "", "stateful": None}
-                   for m in TRANSITIONAL_METHODS[tool]]
-        return Registry(tool, entries, [], "transitional")
-    raise SystemExit(f"methods.py: {tool} has neither --list-methods-json nor --list-methods")
+    if text is None:
+        raise SystemExit(f"methods.py: {tool} has no --list-methods-json: rebuild it from this checkout")
+    try:
+        entries, suffixes = _from_json(text)
+    except (ValueError, KeyError, AttributeError, TypeError) as e:
+        raise SystemExit(f"methods.py: {tool} --list-methods-json: unreadable output ({e})")
+    return Registry(tool, entries, suffixes)
 
 
 def main(argv):

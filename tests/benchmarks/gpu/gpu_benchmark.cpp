@@ -1,13 +1,14 @@
 // The GPU kernels (temporal/gpu) per frame at the papers' sizes, beside the device's streaming bound: a copy kernel
 // timed in the same run, and each method's bytes moved (every plane it reads or writes counted once). Implemented
-// methods: filter-phlm's phlm, ema, taa and fxaa at 1920x1080 (seed 003's size). The same scene as phlm_bench (RGB noise on a
-// pattern, fractional motion, depth and ids).
+// methods: filter-phlm's phlm, ema, taa and fxaa at 1920x1080 (seed 003's size; the same scene as phlm_bench: RGB
+// noise on a pattern, fractional motion, depth and ids), upsample-st's spatial and temporal at 1280x1024 with k = 4,
+// morph-120hz's blend, warp and didyk at 1024x1024 with factor 3 (seed 004's size).
 //
 // Time per iteration is the kernels' time (gpu::TimedKernel::last_timing: GL_TIME_ELAPSED on hardware, wall clock
 // after glFinish on llvmpipe; the `gpu_clock` counter says which: 1 = GPU queries), not the uploads and downloads
 // around them. Counters: bytes_moved (per frame), bound_ms (bytes_moved / the copy kernel's bandwidth), x_bound.
 // Each benchmark is also registered at a quarter size per axis (phlm/ema/taa/fxaa /480/270, spatial/temporal /320/256,
-// blend/warp /256/256) for quick runs on llvmpipe:
+// blend/warp/didyk /256/256) for quick runs on llvmpipe:
 //   gpu_benchmark --benchmark_filter='/(480|320|256)/'
 // Without an EGL device every benchmark is skipped with the reason.
 #include "temporal/gpu/buffer.h"
@@ -283,10 +284,17 @@ void run_morph(benchmark::State& state, decltype(&make_blend_method_gpu) make) {
   state.counters["bound_ms"] = rate > 0.0 ? k.bytes_moved / rate : 0.0;
   state.counters["x_bound"] = rate > 0.0 ? k.kernel_ms / (k.bytes_moved / rate) : 0.0;
   state.counters["gpu_clock"] = k.clock == gpu::Clock::GpuQuery ? 1.0 : 0.0;
+  // Seed 004 Table 1's split of the last frame (didyk's kernels per step; the others report morph only).
+  state.counters["flow_ms"] = t.flow_ms;
+  state.counters["morph_ms"] = t.morph_ms;
+  state.counters["blur_ms"] = t.blur_ms;
   state.SetLabel(ctx->description());
 }
 void BM_Blend(benchmark::State& state) { run_morph(state, make_blend_method_gpu); }
 void BM_Warp(benchmark::State& state) { run_morph(state, make_warp_method_gpu); }
+// didyk (seed 004) with its defaults (8-pixel snapped grid, blur level 2, compensation): seed 004's 1024 x 1024 at
+// factor 3, the size of its 5.6-7 ms for two in-between frames.
+void BM_Didyk(benchmark::State& state) { run_morph(state, make_didyk_method_gpu); }
 
 BENCHMARK(BM_Copy)->Args({1920, 1080})->Args({1280, 1024})->Args({1024, 1024})->Args({480, 270})->Args({320, 256})
     ->Args({256, 256})->UseManualTime()->Unit(benchmark::kMillisecond);
@@ -298,6 +306,7 @@ BENCHMARK(BM_Spatial)->Args({1280, 1024})->Args({320, 256})->UseManualTime()->Un
 BENCHMARK(BM_Temporal)->Args({1280, 1024})->Args({320, 256})->UseManualTime()->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_Blend)->Args({1024, 1024})->Args({256, 256})->UseManualTime()->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_Warp)->Args({1024, 1024})->Args({256, 256})->UseManualTime()->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_Didyk)->Args({1024, 1024})->Args({256, 256})->UseManualTime()->Unit(benchmark::kMillisecond);
 
 }  // namespace
 

@@ -16,6 +16,11 @@
 
 namespace temporal::morph {
 
+// The reconstruction's taps of level `level` (n texels along the axis) for the full-resolution samples 0..full-1:
+// per sample 4 texel indices (clamped to [0, n-1]) and their 4 cubic B-spline weights. BlurPyramid::reconstruct
+// reads them; the GPU kernel of didyk uploads the same table, so both use the same weights bit for bit.
+void blur_pyramid_taps(int full, int n, int level, std::vector<int>& index, std::vector<float>& weight);
+
 class BlurPyramid {
  public:
   // Builds levels 1..levels of every plane (each width x height floats). Level 0 is the input itself and is

@@ -15,6 +15,12 @@ namespace temporal::morph {
 // `blend` (blend.cpp): slot k = (1 - k/N) frame n + (k/N) frame n+1.
 Expected<std::unique_ptr<MorphMethod>> make_blend_method_gpu(std::shared_ptr<gpu::Context> context,
                                                              const MorphOptions& options);
+// `didyk` (didyk.cpp, seed 004): flow and snapped grid, per-slot distortion and blur strength, the blur pyramid and
+// the compensation H' of section 5.1, the grid rasterised with the depth test; debug layers computed on the GPU
+// too. Registered as didyk's second implementation (device kGpuDevice, on the default EGL device). Usage error for
+// didyk options that are invalid (--grid not a power of two in [2, 32], --blur-level outside [0, 8]).
+Expected<std::unique_ptr<MorphMethod>> make_didyk_method_gpu(std::shared_ptr<gpu::Context> context,
+                                                             const MorphOptions& options);
 // `warp` (warp.cpp): forward splat along the motion with a depth test, holes black.
 Expected<std::unique_ptr<MorphMethod>> make_warp_method_gpu(std::shared_ptr<gpu::Context> context,
                                                             const MorphOptions& options);
