@@ -849,31 +849,9 @@ class DidykGpu final : public MorphMethod, public gpu::TimedKernel {
     return Status::ok();
   }
 
-  Status run_gpu(const Image& color, const Image& gbuffer, std::vector<Image>& out, MorphTimings& t) {
-    const int w = color.width(), h = color.height(), n = int(out.size());
-    const bool debug = options_.debug_layers;
-    if (Status s = allocate(w, h, n); !s) return s;
-    const char* names[6] = {"R", "G", "B", "motion.X", "motion.Y", "depth.Z"};
-    for (int p = 0; p < 6; ++p)
-      if (Status s = img_.upload(p, p < 3 ? color : gbuffer, names[p]); !s) return s;
-    if (Status s = ctx_->make_current(); !s) return s;
-    img_.bind(0);
-    out_.bind(1);
-    keys_.bind(2);
-    mp_.bind(3);
-    bp_.bind(4);
-    grid_.bind(5);
-    taps_.bind(6);
+  // --- flow (section 6): snapped grid and damped vertex motion.
+  Status flow_pass(int w, int h, double np, double nv) {
     const GridOptions& gopt = didyk_.grid;
-    const double np = double(w) * double(h), nv = double(nx_) * double(ny_);
-    set("u_n", std::uint32_t(w * h));
-    set_int2("u_grid", nx_, ny_);
-    set("u_nv", std::uint32_t(nx_ * ny_));
-    set("u_cell", gopt.cell);
-    set("u_half", gopt.cell / 2);
-
-    // --- flow (section 6): snapped grid and damped vertex motion.
-    timer_.start();
     if (gopt.snap) {
       set("u_bias", 1e-3f / float(gopt.cell));
       if (Status s = go(kScore, w, h, 3 * np); !s) return s;
@@ -897,10 +875,13 @@ class DidykGpu final : public MorphMethod, public gpu::TimedKernel {
     set("u_speed_scale",
                  gopt.pixels_per_degree > 0.0f ? float(gopt.fps) / gopt.pixels_per_degree : 0.0f);
     if (Status s = go(kVertex, nx_, ny_, 6 * nv + 2 * nv); !s) return s;
-    t.flow_ms = timer_.stop_ms();
 
-    // --- morph (part 1): per slot the extrapolated vertices, distortion, blur strength; the blur sum B.
-    timer_.start();
+    return Status::ok();
+  }
+
+  // --- morph (part 1): per slot the extrapolated vertices, distortion, blur strength; the blur sum B.
+  Status slot_pass(int n, double nv) {
+    const GridOptions& gopt = didyk_.grid;
     set("u_inv_cell", 1.0f / float(gopt.cell));
     set("u_min_blur", didyk_.min_blur);
     set("u_dist_low", didyk_.distortion_low);
@@ -913,10 +894,12 @@ class DidykGpu final : public MorphMethod, public gpu::TimedKernel {
       if (Status s = go(kCellDistortion, nx_ - 1, ny_ - 1, 5 * nv); !s) return s;
       if (Status s = go(kVertexBlur, nx_, ny_, 5 * nv); !s) return s;
     }
-    t.morph_ms = timer_.stop_ms();
 
-    // --- blur (section 5.1): display values, their low-pass, the blur sum on the source grid, compensation.
-    timer_.start();
+    return Status::ok();
+  }
+
+  // --- blur (section 5.1): display values, their low-pass, the blur sum on the source grid, compensation.
+  Status blur_pass(int w, int h, double np, bool debug) {
     set("u_gamma", options_.gamma);
     set("u_inv_gamma", 1.0f / options_.gamma);
     set("u_compensate", didyk_.compensate ? 1 : 0);
@@ -960,18 +943,13 @@ class DidykGpu final : public MorphMethod, public gpu::TimedKernel {
     if (Status s = go(kCompensate, w, h, 13 * np); !s) return s;
     if (debug)
       if (Status s = go(kDebugH, w, h, 11 * np); !s) return s;
-    t.blur_ms = timer_.stop_ms();
 
-    // Slot 0: the compensated rendered frame; debug.grid (the snapped grid), debug.distortion 0, debug.blur = B.
-    if (debug) {
-      if (Status s = grid_lines(gplane(kGX), gplane(kGY)); !s) return s;
-      set("u_clear_mask", 1u << kDist);
-      if (Status s = go(kClear, w, h, 0.0); !s) return s;
-    }
-    if (Status s = download(out[0], debug); !s) return s;
+    return Status::ok();
+  }
 
-    // --- morph (part 2): the sharp frame and its low-pass through the warped grid, blended by b_k.
-    double ms = 0.0;
+  // --- morph (part 2): the sharp frame and its low-pass through the warped grid, blended by b_k; `ms` gets the
+  // warp's time.
+  Status warp_slots(int w, int h, int n, bool debug, std::vector<Image>& out, double& ms) {
     for (int k = 1; k < n; ++k) {
       const std::uint32_t sp = slot_plane(k);
       timer_.start();
@@ -989,6 +967,51 @@ class DidykGpu final : public MorphMethod, public gpu::TimedKernel {
       }
       if (Status s = download(out[std::size_t(k)], debug); !s) return s;
     }
+    return Status::ok();
+  }
+
+  Status run_gpu(const Image& color, const Image& gbuffer, std::vector<Image>& out, MorphTimings& t) {
+    const int w = color.width(), h = color.height(), n = int(out.size());
+    const bool debug = options_.debug_layers;
+    if (Status s = allocate(w, h, n); !s) return s;
+    const char* names[6] = {"R", "G", "B", "motion.X", "motion.Y", "depth.Z"};
+    for (int p = 0; p < 6; ++p)
+      if (Status s = img_.upload(p, p < 3 ? color : gbuffer, names[p]); !s) return s;
+    if (Status s = ctx_->make_current(); !s) return s;
+    img_.bind(0);
+    out_.bind(1);
+    keys_.bind(2);
+    mp_.bind(3);
+    bp_.bind(4);
+    grid_.bind(5);
+    taps_.bind(6);
+    const GridOptions& gopt = didyk_.grid;
+    const double np = double(w) * double(h), nv = double(nx_) * double(ny_);
+    set("u_n", std::uint32_t(w * h));
+    set_int2("u_grid", nx_, ny_);
+    set("u_nv", std::uint32_t(nx_ * ny_));
+    set("u_cell", gopt.cell);
+    set("u_half", gopt.cell / 2);
+
+    timer_.start();
+    if (Status s = flow_pass(w, h, np, nv); !s) return s;
+    t.flow_ms = timer_.stop_ms();
+    timer_.start();
+    if (Status s = slot_pass(n, nv); !s) return s;
+    t.morph_ms = timer_.stop_ms();
+    timer_.start();
+    if (Status s = blur_pass(w, h, np, debug); !s) return s;
+    t.blur_ms = timer_.stop_ms();
+    // Slot 0: the compensated rendered frame; debug.grid (the snapped grid), debug.distortion 0, debug.blur = B.
+    if (debug) {
+      if (Status s = grid_lines(gplane(kGX), gplane(kGY)); !s) return s;
+      set("u_clear_mask", 1u << kDist);
+      if (Status s = go(kClear, w, h, 0.0); !s) return s;
+    }
+    if (Status s = download(out[0], debug); !s) return s;
+
+    double ms = 0.0;
+    if (Status s = warp_slots(w, h, n, debug, out, ms); !s) return s;
     t.morph_ms += ms;
     timing_.kernel_ms = t.flow_ms + t.morph_ms + t.blur_ms;
     return Status::ok();

@@ -6,15 +6,18 @@ namespace temporal::morph {
 
 // Every method, in the order of --help, --list-methods and the docs (didyk first: the default). Adding a method:
 // its source file defines `const MethodEntry& NAME_method()` (temporal/core/method.h: info, options, layers,
-// implementations, lookahead), declared here and listed in the table.
-const MethodEntry& didyk_method();   // didyk.cpp: seed 004
-const MethodEntry& repeat_method();  // repeat.cpp
-const MethodEntry& blend_method();   // blend.cpp
-const MethodEntry& warp_method();    // warp.cpp
+// implementations, lookahead), and one line X(NAME) in this list declares and registers it.
+#define TEMPORAL_MORPH_METHODS(X) \
+  X(didyk)  /* didyk.cpp: seed 004 */ \
+  X(repeat) /* repeat.cpp */ \
+  X(blend)  /* blend.cpp */ \
+  X(warp)   /* warp.cpp */ \
+  /* a new method: one line above this one */
+
+TEMPORAL_MORPH_METHODS(TEMPORAL_DECLARE_METHOD)
 
 const std::vector<const MethodEntry*>& registry() {
-  static const std::vector<const MethodEntry*> table = {&didyk_method(), &repeat_method(), &blend_method(),
-                                                        &warp_method()};
+  static const std::vector<const MethodEntry*> table = {TEMPORAL_MORPH_METHODS(TEMPORAL_METHOD_ADDRESS)};
   return table;
 }
 
@@ -25,11 +28,7 @@ const std::vector<MethodVariant>& method_variants() {
   return list;
 }
 
-const MethodVariant* find_variant(std::string_view name) {
-  for (const MethodVariant& v : method_variants())
-    if (v.name == name) return &v;
-  return nullptr;
-}
+const MethodVariant* find_variant(std::string_view name) { return find_variant_in(method_variants(), name); }
 
 MethodOptionSet default_method_options() { return method_option_set(registry()); }
 
@@ -51,11 +50,8 @@ ParamList params(MorphOptions& o) {
 }
 
 Expected<MorphOptions> make_options(const std::string& method, const std::vector<std::string>& args) {
-  MorphOptions o;
-  o.method = method;
-  if (Status s = apply_args(params(o), args); !s) return s.error();
-  if (Status s = check(o); !s) return s.error();
-  return o;
+  return make_options_with<MorphOptions>(method, args, [](MorphOptions& o) { return params(o); },
+                               [](const MorphOptions& o) { return check(o); });
 }
 
 std::vector<std::string> morph_gbuffer_channels(const std::string& layer) {

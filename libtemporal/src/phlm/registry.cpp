@@ -7,15 +7,19 @@
 namespace temporal::phlm {
 
 // Every method, in the order of --help, --list-methods and the docs. Adding a method: its source file defines
-// `const MethodEntry& NAME_method()` (temporal/core/method.h: info, options, layers, implementations), declared
-// here and listed in the table.
-const MethodEntry& phlm_method();  // phlm.cpp: seed 003
-const MethodEntry& taa_method();   // taa.cpp
-const MethodEntry& ema_method();   // ema.cpp
-const MethodEntry& fxaa_method();  // fxaa.cpp
+// `const MethodEntry& NAME_method()` (temporal/core/method.h: info, options, layers, implementations), and one
+// line X(NAME) in this list declares and registers it.
+#define TEMPORAL_PHLM_METHODS(X) \
+  X(phlm) /* phlm.cpp: seed 003 */ \
+  X(taa)  /* taa.cpp */ \
+  X(ema)  /* ema.cpp */ \
+  X(fxaa) /* fxaa.cpp */ \
+  /* a new method: one line above this one */
+
+TEMPORAL_PHLM_METHODS(TEMPORAL_DECLARE_METHOD)
 
 const std::vector<const MethodEntry*>& registry() {
-  static const std::vector<const MethodEntry*> table = {&phlm_method(), &taa_method(), &ema_method(), &fxaa_method()};
+  static const std::vector<const MethodEntry*> table = {TEMPORAL_PHLM_METHODS(TEMPORAL_METHOD_ADDRESS)};
   return table;
 }
 
@@ -26,11 +30,7 @@ const std::vector<MethodVariant>& method_variants() {
   return list;
 }
 
-const MethodVariant* find_variant(std::string_view name) {
-  for (const MethodVariant& v : method_variants())
-    if (v.name == name) return &v;
-  return nullptr;
-}
+const MethodVariant* find_variant(std::string_view name) { return find_variant_in(method_variants(), name); }
 
 MethodOptionSet default_method_options() { return method_option_set(registry()); }
 
@@ -61,11 +61,8 @@ Status check(const FilterOptions& options) {
 }
 
 Expected<FilterOptions> make_options(const std::string& method, const std::vector<std::string>& args) {
-  FilterOptions o;
-  o.method = method;
-  if (Status s = apply_args(params(o), args); !s) return s.error();
-  if (Status s = check(o); !s) return s.error();
-  return o;
+  return make_options_with<FilterOptions>(method, args, [](FilterOptions& o) { return params(o); },
+                               [](const FilterOptions& o) { return check(o); });
 }
 
 Expected<std::unique_ptr<FrameFilter>> make_filter(const FilterOptions& options,

@@ -16,7 +16,8 @@
 // pattern). The cache stores one value per k x k block (its centre), so that, as in Figure 7.6, each frame
 // adds one subset of the block's samples and a static cache is never resampled; repeated resampling of a
 // jittered grid blurs it (measured: 7 px of blur at k = 4, docs/upsample-st.md).
-#include "method.h"
+#include "drobot_options.h"
+#include "gpu_methods.h"
 
 #include "temporal/upsample/drobot.h"
 #include "temporal/core/parallel.h"
@@ -24,40 +25,10 @@
 #include <atomic>
 
 namespace temporal::upsample {
-namespace {
-
-// drobot's parameters (seed 002; the choices are in docs/upsample-st.md).
-struct DrobotOptions {
-  std::string mode = "cache";     // cache: the framework of section 7.2; refresh: Figure 7.12
-  float normal_power = 32.0f;     // contrastCoef of Listing 7.1
-  bool depth_only = false;        // depth weights only in Listing 7.1 (the chapter's console variant)
-  float miss_threshold = 0.02f;   // IN_MissThreshold of Listing 7.2 (relative depth)
-  float convergence_time = 50.0f; // IN_ConvergenceTime of Listing 7.2
-  float max_frames = 0.0f;        // frames in the exponential history; 0 = k * k (the pattern length, Figure 7.6)
-  bool cache_point = false;       // point instead of bilinear filtering of the low-resolution cache (Figure 7.5);
-                                  // the depth test always uses bilinear depth (Listing 7.2)
-  float filter_amp = 200.0f;      // IN_BilateralFilterAmp of Listing 7.3 (per relative depth; not given there)
-
-  bool refresh() const { return mode == "refresh"; }
-  ParamList params() {
-    return {
-        Param::choice("--mode", "cache (the framework of section 7.2) or refresh (Figure 7.12)", &mode,
-                      {"cache", "refresh"}),
-        Param::real("--normal-power", "contrastCoef of Listing 7.1", &normal_power, 0.0, 1000.0),
-        Param::flag_on("--depth-only", "depth weights only in Listing 7.1 (the chapter's console variant)", &depth_only),
-        Param::real("--miss-threshold", "IN_MissThreshold of Listing 7.2, relative depth", &miss_threshold, 0.0, 10.0),
-        Param::real("--convergence-time", "IN_ConvergenceTime of Listing 7.2", &convergence_time, 1e-3, 1e6),
-        Param::real("--max-frames", "frames of the exponential history; 0 = k^2 (the pattern length, Figure 7.6)",
-                    &max_frames, 0.0, 1e6),
-        Param::flag_on("--cache-point", "point instead of bilinear filtering of the low-resolution cache (Figure 7.5)",
-                       &cache_point),
-        Param::real("--filter-amp", "IN_BilateralFilterAmp of Listing 7.3, per relative depth difference", &filter_amp,
-                    0.0, 1e6),
-    };
-  }
-};
 
 const DrobotOptions& drobot_options(const Options& o) { return method_options<DrobotOptions>(o.per_method, "drobot"); }
+
+namespace {
 
 // Everything drobot keeps between frames: the low-resolution cache (cache mode, ping-pong) or the full-resolution
 // history and depth (refresh mode), and the per-frame scratch of the filter and the cache grid.
@@ -594,7 +565,9 @@ const MethodEntry& drobot_method() {
       .implementations = {{kCpuDevice,
                            [](const Options& o, const Geometry& g) -> std::unique_ptr<MethodState> {
                              return std::make_unique<DrobotState>(o, g);
-                           }}},
+                           }},
+                          // drobot_gpu.cpp: both modes as GLSL kernels, the same state planes.
+                          {kGpuDevice, gpu_implementation<make_drobot_state_gpu>}},
       .streamed_bytes = streamed_bytes,
       .state_layout = state_layout,
       .header_name = [](const Options& o) { return "drobot-" + drobot_options(o).mode; }};

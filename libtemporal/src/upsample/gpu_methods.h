@@ -19,6 +19,38 @@ Expected<std::unique_ptr<MethodState>> make_spatial_state_gpu(std::shared_ptr<gp
 // `temporal` (temporal.cpp): eq. 4 with the binary weight, holes filled by the joint-bilateral result.
 Expected<std::unique_ptr<MethodState>> make_temporal_state_gpu(std::shared_ptr<gpu::Context> context,
                                                                const Options& options, const Geometry& geometry);
+// `herzog` (herzog.cpp): spatio-temporal upsampling, seed 000 sections 3.3-3.5, as its three passes (A: eq. 6 and
+// the history fetch, B: the gradient's temporal filter, box pyramid and eq. 8, C: eq. 7), every option of
+// HerzogOptions (herzog.h) included.
+Expected<std::unique_ptr<MethodState>> make_herzog_state_gpu(std::shared_ptr<gpu::Context> context,
+                                                             const Options& options, const Geometry& geometry);
+// `taau` (taau.cpp): the FSR 2 / UE4 TAAU steps 1-5 per pixel, after a low-resolution pass for the thin features.
+Expected<std::unique_ptr<MethodState>> make_taau_state_gpu(std::shared_ptr<gpu::Context> context,
+                                                           const Options& options, const Geometry& geometry);
+// `drobot` (drobot.cpp): seed 002's cache mode (cache grid, Listing 7.2 accumulation, Listing 7.3 filter, Listing 7.1
+// upsampling) and the refresh mode of Figure 7.12, chosen by --mode when the state is made.
+Expected<std::unique_ptr<MethodState>> make_drobot_state_gpu(std::shared_ptr<gpu::Context> context,
+                                                             const Options& options, const Geometry& geometry);
+
+// --- Registration as a method's "gpu" implementation (temporal/upsample/methods.h) ------------------------------
+
+// The context the registered GPU implementations share: the one a live state already uses, else a new one on the
+// default device (an error when EGL has none). Held by the states only, so it goes away with the last of them.
+Expected<std::shared_ptr<gpu::Context>> shared_gpu_context();
+
+// A StateFactory's result for a GPU factory's: the state, or (EGL or the kernel's compilation failed) a state that
+// does nothing but return that error from load() and run_status(), which the Upsampler checks (a StateFactory
+// cannot return an error itself).
+std::unique_ptr<MethodState> state_or_failure(Expected<std::unique_ptr<MethodState>> made);
+
+// `{kGpuDevice, gpu_implementation<make_X_state_gpu>}` in a method's `implementations`.
+template <Expected<std::unique_ptr<MethodState>> (*Make)(std::shared_ptr<gpu::Context>, const Options&,
+                                                         const Geometry&)>
+std::unique_ptr<MethodState> gpu_implementation(const Options& options, const Geometry& geometry) {
+  auto context = shared_gpu_context();
+  if (!context) return state_or_failure(context.error());
+  return state_or_failure(Make(std::move(*context), options, geometry));
+}
 
 // GLSL of the joint-bilateral weights (spatial_row / expanded_geometric_weights: the same operations in the same
 // order), shared by the upsampling kernels. Reads binding 0 `gb` (full-resolution planes: depth.Z 0, N.X/Y/Z 1-3)

@@ -25,7 +25,8 @@
 // k(i, j) = hat(x(i) - x(j)) g(||x(i) - x(j)||, r, gamma w_f): at gamma w_f = 0 it is exactly the spatial baseline's
 // kernel, and as gamma w_f grows it still tends to the dirac of temporally-amortised upsampling (both factors are 1
 // at distance 0). `--fallback flat` keeps eq. 3 alone, the literal reading.
-#include "method.h"
+#include "herzog.h"
+#include "gpu_methods.h"
 
 #include "temporal/upsample/history.h"
 #include "temporal/core/parallel.h"
@@ -36,6 +37,9 @@
 #include <limits>
 
 namespace temporal::upsample {
+
+const HerzogOptions& herzog_options(const Options& o) { return method_options<HerzogOptions>(o.per_method, "herzog"); }
+
 namespace {
 
 // Eq. 7 for one row and the bounded history-weight update. wf: w_f per pixel; wt: w~ (adaptive kernel);
@@ -195,73 +199,6 @@ struct RowScratch {
 #pragma GCC ivdep
   for (int gx = 0; gx < n; ++gx) out[gx] = std::fma(1 - ay, h0[gx], ay * h1[gx]);
 }
-
-// --- Options ---------------------------------------------------------------------------------------------------
-
-// herzog's parameters (seed 000 sections 3.3-3.5; the choices are in docs/upsample-st.md).
-struct HerzogOptions {
-  float kernel_gamma = kMaxKernelGamma;      // gamma of k; 4 so that w_f = 1 reaches the cap
-  float max_kernel_gamma = kMaxKernelGamma;  // cap of gamma * w_f (section 3.5: 4)
-  float min_kernel_gamma = 0.0f;             // floor of the fall-off (the paper: 0)
-  std::string fallback = "spatial";          // k at gamma w_f = 0: spatial's hat (default) or flat (eq. 3 alone)
-  float a = 1.0f;                            // eq. 8 sensitivity
-  bool favor_spatial = false;                // a = 0.7, the paper's elephant scene
-  int gradient_scale = 2;                    // the gradient at full / scale (section 4: "e.g. at 2x2 pixels")
-  float gradient_mip_level = 2.5f;           // spatial low-pass: trilinear mip level, in full-resolution levels
-  float max_history_weight = 0.0f;           // bound of h_w; 0 = 2 k^2
-  bool lagged_wf = false;                    // eq. 7 with the previous frame's w_f: one fused pass
-  // Ablations (issue 16): which part of the gradient-driven adaptation carries the gain.
-  float fixed_wf = -1.0f;                    // >= 0: w_f is this constant everywhere (no eq. 8)
-  std::string gradient_filter = "temporal";  // none: |g_t| instead of |(0.4, 0.3, 0.2, 0.1) . (g_t..g_t-3)|
-
-  float sensitivity() const { return favor_spatial ? kFavorSpatialA : a; }
-  ParamList params() {
-    return {
-        Param::real("--kernel-gamma", "gamma of the image kernel k; the fall-off used is min(gamma w_f, cap)",
-                    &kernel_gamma, 0.0, 1000.0),
-        Param::real("--max-kernel-gamma", "cap of gamma w_f (seed 000 section 3.5: 4)", &max_kernel_gamma, 0.0, 1000.0),
-        Param::real("--min-kernel-gamma",
-                    "floor of the fall-off, max(G0, min(gamma w_f, cap)) (the paper: 0)", &min_kernel_gamma, 0.0,
-                    1000.0),
-        Param::choice("--fallback",
-                      "k at gamma w_f = 0 (seed 000 sections 3.3, 3.5: \"falls back to spatial upsampling\"): "
-                      "spatial = the spatial baseline's hat times eq. 3; flat = eq. 3 alone (the literal reading: "
-                      "a box)",
-                      &fallback, {"spatial", "flat"}),
-        Param::real("--a", "sensitivity a of eq. 8 (w_f = a (1 - |grad|)^2)", &a, 0.0, 1.0),
-        Param::flag_on("--favor-spatial", "a = 0.7 (the paper's elephant scene)", &favor_spatial),
-        Param::integer("--gradient-scale",
-                       "the temporal gradient is kept at full/S resolution, S a power of 2 (seed 000 section 4)",
-                       &gradient_scale, 1, 8),
-        Param::real("--gradient-mip-level",
-                    "spatial low-pass of the gradient: trilinear mip level, counted at full resolution",
-                    &gradient_mip_level, 0.0, 8.0),
-        Param::real("--max-history-weight", "bound of the history weight h_w; 0 = 2 k^2", &max_history_weight, 0.0,
-                    std::numeric_limits<double>::infinity()),
-        Param::flag_on("--lagged-wf",
-                       "eq. 7 with the previous frame's w_f (motion-compensated): one pass instead of three, w_f "
-                       "reacts one frame later",
-                       &lagged_wf),
-        Param::real("--fixed-wf",
-                    "ablation: w_f is this constant in [0, 1] everywhere instead of eq. 8 (the kernel and eq. 7 "
-                    "stop adapting to the gradient; a miss still restarts the history); -1 = off (eq. 8)",
-                    &fixed_wf, -1.0, 1.0),
-        Param::choice("--gradient-filter",
-                      "temporal filter of the gradient (section 3.5.1): temporal = |(0.4, 0.3, 0.2, 0.1) . (g_t, "
-                      "g_t-1, g_t-2, g_t-3)|; none = |g_t| (ablation)",
-                      &gradient_filter, {"temporal", "none"}),
-    };
-  }
-  Status check() const {
-    if (fixed_wf < 0.0f && fixed_wf != -1.0f)
-      return Error::usage("--fixed-wf " + std::to_string(fixed_wf) + " must be in [0, 1], or -1 for eq. 8");
-    if (gradient_scale & (gradient_scale - 1))
-      return Error::usage("--gradient-scale " + std::to_string(gradient_scale) + " is not a power of 2 (1, 2, 4, 8)");
-    return Status::ok();
-  }
-};
-
-const HerzogOptions& herzog_options(const Options& o) { return method_options<HerzogOptions>(o.per_method, "herzog"); }
 
 // --- State -----------------------------------------------------------------------------------------------------
 
@@ -984,7 +921,9 @@ const MethodEntry& herzog_method() {
       .implementations = {{kCpuDevice,
                            [](const Options& o, const Geometry& g) -> std::unique_ptr<MethodState> {
                              return std::make_unique<HerzogState>(o, g);
-                           }}},
+                           }},
+                          // herzog_gpu.cpp: the same passes as GLSL kernels, the same state planes.
+                          {kGpuDevice, gpu_implementation<make_herzog_state_gpu>}},
       .streamed_bytes = streamed_bytes,
       .state_layout = state_layout};
   return entry;

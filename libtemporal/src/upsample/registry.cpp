@@ -12,16 +12,19 @@ constexpr double kUnbounded = std::numeric_limits<double>::infinity();
 
 // Every method, in the order of --help, --list-methods and the docs. Adding a method: its source file defines
 // `const MethodEntry& NAME_method()` (temporal/core/method.h: info, options, layers, implementations, streamed
-// bytes), declared here and listed in the table.
-const MethodEntry& spatial_method();   // spatial.cpp
-const MethodEntry& temporal_method();  // temporal.cpp
-const MethodEntry& herzog_method();    // herzog.cpp
-const MethodEntry& drobot_method();    // drobot.cpp
-const MethodEntry& taau_method();      // taau.cpp
+// bytes), and one line X(NAME) in this list declares and registers it.
+#define TEMPORAL_UPSAMPLE_METHODS(X) \
+  X(spatial)  /* spatial.cpp: seed 000 section 3.1 */ \
+  X(temporal) /* temporal.cpp: seed 000 section 3.2 */ \
+  X(herzog)   /* herzog.cpp: seed 000 */ \
+  X(drobot)   /* drobot.cpp: seed 002 */ \
+  X(taau)     /* taau.cpp */ \
+  /* a new method: one line above this one */
+
+TEMPORAL_UPSAMPLE_METHODS(TEMPORAL_DECLARE_METHOD)
 
 const std::vector<const MethodEntry*>& registry() {
-  static const std::vector<const MethodEntry*> table = {&spatial_method(), &temporal_method(), &herzog_method(),
-                                                        &drobot_method(), &taau_method()};
+  static const std::vector<const MethodEntry*> table = {TEMPORAL_UPSAMPLE_METHODS(TEMPORAL_METHOD_ADDRESS)};
   return table;
 }
 
@@ -32,11 +35,7 @@ const std::vector<MethodVariant>& method_variants() {
   return list;
 }
 
-const MethodVariant* find_variant(std::string_view name) {
-  for (const MethodVariant& v : method_variants())
-    if (v.name == name) return &v;
-  return nullptr;
-}
+const MethodVariant* find_variant(std::string_view name) { return find_variant_in(method_variants(), name); }
 
 const std::vector<VariantSuffix>& variant_suffixes() {
   static const std::vector<VariantSuffix> list = {
@@ -98,11 +97,8 @@ Status check(const Options& options) {
 }
 
 Expected<Options> make_options(const std::string& method, const std::vector<std::string>& args) {
-  Options o;
-  o.method = method;
-  if (Status s = apply_args(params(o), args); !s) return s.error();
-  if (Status s = check(o); !s) return s.error();
-  return o;
+  return make_options_with<Options>(method, args, [](Options& o) { return params(o); },
+                               [](const Options& o) { return check(o); });
 }
 
 std::string method_parameters(const Options& o) {

@@ -114,7 +114,8 @@ const MethodEntry& spatial_method() {
                            [](const Options&, const Geometry& g) -> std::unique_ptr<MethodState> {
                              return std::make_unique<SpatialState>(g);
                            }},
-                          {kGpuDevice, make_spatial_state_gpu}},
+                          // spatial_gpu.cpp: eq. 1-3 as one GLSL kernel.
+                          {kGpuDevice, gpu_implementation<make_spatial_state_gpu>}},
       .streamed_bytes = streamed_bytes};
   return entry;
 }

@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <mutex>
 
 namespace temporal::upsample {
 
@@ -150,6 +151,40 @@ Status GpuFrame::upload(const std::shared_ptr<gpu::Context>& context, const Fram
   for (int c = 0; c < f.C; ++c)
     if (Status s = low.upload(c, f.low[std::size_t(c)]); !s) return s;
   return Status::ok();
+}
+
+Expected<std::shared_ptr<gpu::Context>> shared_gpu_context() {
+  static std::mutex mutex;
+  static std::weak_ptr<gpu::Context> shared;
+  const std::lock_guard<std::mutex> lock(mutex);
+  if (auto live = shared.lock()) return live;
+  auto created = gpu::Context::create();
+  if (!created) return created.error();
+  shared = *created;
+  return *created;
+}
+
+namespace {
+
+// What a GPU factory that failed leaves in the Upsampler: every call returns the factory's error.
+class FailedState final : public MethodState {
+ public:
+  explicit FailedState(Error e) : status_(std::move(e)) {}
+  Image& run(const FrameContext&, bool, FrameStats&) override { return empty_; }
+  Status run_status() const override { return status_; }
+  void save(Image&) const override {}
+  Status load(const Image&) override { return status_; }
+
+ private:
+  Status status_;
+  Image empty_;
+};
+
+}  // namespace
+
+std::unique_ptr<MethodState> state_or_failure(Expected<std::unique_ptr<MethodState>> made) {
+  if (!made) return std::make_unique<FailedState>(made.error());
+  return std::move(*made);
 }
 
 namespace {

@@ -28,7 +28,8 @@
 //     lifetime decreases with the accumulated weight (one jitter cycle of average weight takes 1) and the lock dies on
 //     a disocclusion or when the luminance under it changes by more than 10 %.
 // Colour channels are rectified in YCoCg in threes (R, G, B of each payload layer; any channels left over one by one).
-#include "method.h"
+#include "taau.h"
+#include "gpu_methods.h"
 
 #include "temporal/core/color.h"
 #include "temporal/core/parallel.h"
@@ -38,15 +39,10 @@
 #include <limits>
 
 namespace temporal::upsample {
-namespace {
 
-// FSR 2 constants (ffx_fsr2_common.h, 2.2).
-constexpr float kLanczosWeightScale = 1.0f / 12.0f;  // fUpsampleLanczosWeightScale
-constexpr float kMaxAccumulation = 1.0f;             // fMaxAccumulationLanczosWeight
-constexpr float kAverageLanczosWeight = 0.74f * kLanczosWeightScale;    // fAverageLanczosWeightPerFrame
-constexpr float kEpsilon = 1e-3f;                                       // FSR2_EPSILON
-constexpr float kRectifiedAccumulation = 0.1f;  // RectifyHistory: accumulation of a clamped history, at most
-constexpr float kSimilarLuma = 1.05f;           // ComputeThinFeatureConfidence: similar_threshold
+const TaauOptions& taau_options(const Options& o) { return method_options<TaauOptions>(o.per_method, "taau"); }
+
+namespace {
 
 // FSR 2's Lanczos2ApproxSq (from FSR 1's EASU): Lanczos-2 without sin or sqrt, of the squared distance x2:
 // (25/16 (2/5 x2 - 1)^2 - (25/16 - 1)) (1/4 x2 - 1)^2 for x2 < 4, else 0. 1 at 0, 0 at 1, a negative lobe on (1, 2).
@@ -55,37 +51,6 @@ inline float lanczos2_approx_sq(float x2) {
   const float a = 0.4f * x2 - 1.0f, b = 0.25f * x2 - 1.0f;
   return (25.0f / 16.0f * a * a - (25.0f / 16.0f - 1.0f)) * b * b;
 }
-
-// taau's parameters; the FSR 2 constants above are not exposed.
-struct TaauOptions {
-  bool locks = true;  // step 5
-  float box_scale = 0.0f;  // s of step 3; 0 = FSR 2.2's lerp(min(20, k^6), 1, saturate(velocity / 20))
-  float lock_luma_change = 0.1f;  // a lock dies when 1 - min/max of its luminance and this frame's exceeds this
-  float motion_accumulation = 3.0f * kLanczosWeightScale;  // FSR 2.0 accumulationMaxOnMotion
-  std::string history = "catmull-rom";                     // the history's colour filter (step 1)
-
-  ParamList params() {
-    return {
-        Param::flag_off("--no-locks", "no thin-feature locks (FSR 2 ffx_fsr2_lock.h)", &locks),
-        Param::real("--box-scale",
-                    "rectification box mean +- s sigma (in the samples' min/max); 0 = FSR 2.2's, 20 when still and 1 "
-                    "from 20 px/frame",
-                    &box_scale, 0.0, 100.0),
-        Param::real("--lock-luma-change", "a lock dies when its luminance changes by more than this (relative)",
-                    &lock_luma_change, 0.0, 1.0),
-        Param::real("--motion-accumulation",
-                    "cap of the accumulation weight of a moving pixel (FSR 2.0 accumulationMaxOnMotion: 3/12; the "
-                    "still cap is 1)",
-                    &motion_accumulation, 0.0, 1.0),
-        Param::choice("--history",
-                      "filter of the history's colour: catmull-rom (UE4 TAAU, Karis 2014) where the reprojection "
-                      "module kept all four bilinear taps, else its bilinear fetch; bilinear everywhere",
-                      &history, {"catmull-rom", "bilinear"}),
-    };
-  }
-};
-
-const TaauOptions& taau_options(const Options& o) { return method_options<TaauOptions>(o.per_method, "taau"); }
 
 // The payload is filtered in the box space of core/color.h (to_ycgco_box): R, G, B triples as YCoCg (Malvar &
 // Sullivan 2003; Karis 2014 and FSR 2 clamp there), other channels as they are. Linear, so blends are the same in
@@ -225,21 +190,6 @@ SampleBox gather_samples(const FrameContext& f, int xn, int yn, int X, int Y, fl
       bsq[c] += wbs[j] * d * d;
     }
   return b;
-}
-
-// What one frame's pixels share, from the factor k.
-struct TaauConstants {
-  float scale_influence;      // step 3's box scale: FSR 2.2 RectifyHistory, fScaleFactorInfluence = min(20, k^6)
-  float bias_history;         // kernel bias with history (FSR 2 ComputeMaxKernelWeight, fKernelSizeBias = 1)
-  float lifetime_per_weight;  // lock lifetime spent per unit of accumulated weight (FSR 2 FinalizeLockStatus)
-};
-
-TaauConstants taau_constants(int k) {
-  TaauConstants t;
-  t.scale_influence = std::min(20.0f, std::pow(float(k) * float(k), 3.0f));  // (1 / (1/k * 1/k))^3
-  t.bias_history = std::min(1.99f, 1.0f + (float(k) - 1.0f));
-  t.lifetime_per_weight = 1.0f / (float(k * k) * kAverageLanczosWeight);  // a jitter cycle of average weight takes 1
-  return t;
 }
 
 // One pixel's outcome of steps 2-4, in filter space.
@@ -519,7 +469,9 @@ const MethodEntry& taau_method() {
       .implementations = {{kCpuDevice,
                            [](const Options& o, const Geometry& g) -> std::unique_ptr<MethodState> {
                              return std::make_unique<TaauState>(o, g);
-                           }}},
+                           }},
+                          // taau_gpu.cpp: the same steps as GLSL kernels, the same state planes.
+                          {kGpuDevice, gpu_implementation<make_taau_state_gpu>}},
       .streamed_bytes = streamed_bytes};
   return entry;
 }

@@ -161,7 +161,8 @@ const MethodEntry& temporal_method() {
                            [](const Options&, const Geometry& g) -> std::unique_ptr<MethodState> {
                              return std::make_unique<TemporalState>(g);
                            }},
-                          {kGpuDevice, make_temporal_state_gpu}},
+                          // temporal_gpu.cpp: eq. 4 as one GLSL kernel, the same state planes.
+                          {kGpuDevice, gpu_implementation<make_temporal_state_gpu>}},
       .streamed_bytes = streamed_bytes};
   return entry;
 }

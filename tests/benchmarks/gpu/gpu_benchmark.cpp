@@ -7,8 +7,8 @@
 // Time per iteration is the kernels' time (gpu::TimedKernel::last_timing: GL_TIME_ELAPSED on hardware, wall clock
 // after glFinish on llvmpipe; the `gpu_clock` counter says which: 1 = GPU queries), not the uploads and downloads
 // around them. Counters: bytes_moved (per frame), bound_ms (bytes_moved / the copy kernel's bandwidth), x_bound.
-// Each benchmark is also registered at a quarter size per axis (phlm/ema/taa/fxaa /480/270, spatial/temporal /320/256,
-// blend/warp/didyk /256/256) for quick runs on llvmpipe:
+// Each benchmark is also registered at a quarter size per axis (phlm/ema/taa/fxaa /480/270,
+// spatial/temporal/herzog/taau/drobot /320/256, blend/warp/didyk /256/256) for quick runs on llvmpipe:
 //   gpu_benchmark --benchmark_filter='/(480|320|256)/'
 // Without an EGL device every benchmark is skipped with the reason.
 #include "temporal/gpu/buffer.h"
@@ -233,6 +233,9 @@ void run_upsample(benchmark::State& state, decltype(&upsample::make_spatial_stat
 }
 void BM_Spatial(benchmark::State& state) { run_upsample(state, upsample::make_spatial_state_gpu); }
 void BM_Temporal(benchmark::State& state) { run_upsample(state, upsample::make_temporal_state_gpu); }
+void BM_Herzog(benchmark::State& state) { run_upsample(state, upsample::make_herzog_state_gpu); }
+void BM_Taau(benchmark::State& state) { run_upsample(state, upsample::make_taau_state_gpu); }
+void BM_Drobot(benchmark::State& state) { run_upsample(state, upsample::make_drobot_state_gpu); }
 
 // Morphing: one rendered frame into `factor` = 3 slots; a texture moving right, a square moving the other way
 // nearer the camera.
@@ -304,6 +307,9 @@ BENCHMARK(BM_Phlm)->Args({1920, 1080})->Args({480, 270})->UseManualTime()->Unit(
 BENCHMARK(BM_Fxaa)->Args({1920, 1080})->Args({480, 270})->UseManualTime()->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_Spatial)->Args({1280, 1024})->Args({320, 256})->UseManualTime()->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_Temporal)->Args({1280, 1024})->Args({320, 256})->UseManualTime()->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_Herzog)->Args({1280, 1024})->Args({320, 256})->UseManualTime()->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_Taau)->Args({1280, 1024})->Args({320, 256})->UseManualTime()->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_Drobot)->Args({1280, 1024})->Args({320, 256})->UseManualTime()->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_Blend)->Args({1024, 1024})->Args({256, 256})->UseManualTime()->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_Warp)->Args({1024, 1024})->Args({256, 256})->UseManualTime()->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_Didyk)->Args({1024, 1024})->Args({256, 256})->UseManualTime()->Unit(benchmark::kMillisecond);

@@ -2,11 +2,10 @@
 // morph-120hz's methods). A method's source file defines its registry entry: what it is (MethodInfo), its own
 // parameters (an options struct with defaults and `ParamList params()`, wrapped by OptionsOf), the G-buffer
 // layers it reads, and its implementations (one per device: "cpu", and "gpu" where a GLSL kernel exists). The
-// stage's registry.cpp lists the
-// entries, one line each. Everything else is derived from that list: the --method choices and --help, each
-// method's options inside the stage's options (MethodOptionSet), --list-methods and --list-methods-json, the
-// variants the benchmarks and tests run, the layers read. A stage's entry type starts with the three members the
-// helpers below read:
+// stage's registry.cpp lists the entries, one line each. Everything else is derived from that list: the --method
+// choices and --help, each method's options inside the stage's options (MethodOptionSet), --list-methods and
+// --list-methods-json, the variants the benchmarks and tests run, the layers read. A stage's entry type starts
+// with the three members the helpers below read:
 //   struct MethodEntry {
 //     MethodInfo info;
 //     std::unique_ptr<MethodOptions> (*make_options)() = nullptr;  // nullptr: no parameters of its own
@@ -165,6 +164,31 @@ const T& method_options(const MethodOptionSet& set, std::string_view name) {
 }
 
 // --- Helpers every stage's registry.cpp uses on its table (a vector of `const Entry*`) ------------------------
+
+// A stage's table is an X-macro list, one line per method: `X(name)` stands for `const MethodEntry&
+// name_method()`, defined in the method's source file. These two expand a list into the declarations and into the
+// table's initialiser, so that a new method is one line in the list (compare's metrics do the same).
+#define TEMPORAL_DECLARE_METHOD(name) const MethodEntry& name##_method();
+#define TEMPORAL_METHOD_ADDRESS(name) &name##_method(),
+
+template <typename Variant>
+const Variant* find_variant_in(const std::vector<Variant>& variants, std::string_view name) {
+  for (const Variant& v : variants)
+    if (v.name == name) return &v;
+  return nullptr;
+}
+
+// Options of a stage for `method`, with parameters set by command-line style arguments (the stage's params() and
+// check()); usage error for an unknown method or parameter, or an invalid value.
+template <typename Options, typename ParamsFn, typename CheckFn>
+Expected<Options> make_options_with(const std::string& method, const std::vector<std::string>& args,
+                                    ParamsFn&& params, CheckFn&& check) {
+  Options o;
+  o.method = method;
+  if (Status s = apply_args(params(o), args); !s) return s.error();
+  if (Status s = check(o); !s) return s.error();
+  return o;
+}
 
 template <typename Entry>
 const Entry* find_entry_in(const std::vector<const Entry*>& registry, std::string_view name) {
