@@ -43,7 +43,9 @@ std::string method_list_text(const std::vector<MethodRow>& rows, const std::vect
   for (const MethodRow& r : rows) {
     std::vector<std::string> args = {"--method", r.variant.method};
     args.insert(args.end(), r.variant.args.begin(), r.variant.args.end());
-    out += r.variant.name + "\t" + joined(args) + "\t" + r.variant.summary + "\n";
+    std::string devices;
+    for (const auto& d : r.implementations) devices += (devices.empty() ? "" : ",") + d;
+    out += r.variant.name + "\t" + joined(args) + "\t" + r.variant.summary + "\t" + devices + "\n";
   }
   for (const SuffixRow& s : suffixes) out += "*" + s.suffix + "\t" + joined(s.args) + "\t" + s.summary + "\n";
   return out;
@@ -80,7 +82,8 @@ void add_method_lists(Tool& tool, std::vector<MethodRow> rows, std::vector<Suffi
         std::cout << text;
         throw CLI::Success();
       },
-      "Print every method and named variant (name, arguments, summary; tab-separated, one per line) and exit");
+      "Print every method and named variant (name, arguments, summary, devices; tab-separated, one per line) and "
+      "exit");
   tool.app().add_flag_callback(
       "--list-methods-json",
       [json] {

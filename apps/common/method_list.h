@@ -1,10 +1,11 @@
 // --list-methods and --list-methods-json of the method tools (upsample-st, filter-phlm, morph-120hz), printed the
 // same way from each stage's registry (temporal/core/method.h). The text form is for people and shell scripts:
-// one tab-separated line per method and named variant (name, the arguments that select it, summary), then the
-// name suffixes any method takes ("*-demod", its arguments, summary). The JSON form is for the pipelines: an array
-// with one object per method and named variant,
+// one tab-separated line per method and named variant (name, the arguments that select it, summary, the devices
+// of its implementations: `cpu` or `cpu,gpu`, what --device takes), then the name suffixes any method takes
+// ("*-demod", its arguments, summary). The JSON form is for the pipelines: an array with one object per method and
+// named variant,
 //   {"name": "herzog-lagged", "method": "herzog", "args": ["--lagged-wf"], "summary": "...", "stateful": true,
-//    "implementations": ["cpu"], "latency_frames": 1}
+//    "implementations": ["cpu", "gpu"], "latency_frames": 1}
 // ("latency_frames" only where the stage has the notion: morph-120hz, in rendered frames), followed by one object
 // per name suffix, {"suffix": "-demod", "args": ["--demodulate"], "summary": "..."} (objects without "method").
 #pragma once
@@ -22,7 +23,7 @@ namespace temporal::tool {
 struct MethodRow {
   MethodVariant variant;  // name, method, args, summary
   bool stateful = false;
-  std::vector<std::string> implementations;  // devices: {"cpu"}
+  std::vector<std::string> implementations;  // devices: {"cpu"}, {"cpu", "gpu"}
   std::optional<int> latency_frames;
 };
 

@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <utility>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
@@ -16,6 +17,17 @@
 
 namespace temporal::morph {
 namespace {
+
+// The devices of an entry as --list-methods prints them ("cpu,gpu") and as the JSON lists them.
+template <typename Entry>
+std::pair<std::string, std::string> device_lists(const Entry& e) {
+  std::string text, json;
+  for (const auto& d : temporal::implementation_devices(e)) {
+    text += (text.empty() ? "" : ",") + d;
+    json += (json.empty() ? "" : ", ") + ("\"" + d + "\"");
+  }
+  return {text, "\"implementations\": [" + json + "]"};
+}
 
 class MorphCli : public ::testing::Test {
  protected:
@@ -110,21 +122,44 @@ TEST_F(MorphCli, NoCompensationFlagClearsTheDefaultOnField) {
   EXPECT_EQ(slot0_differs_from_input(" --no-compensation", "plain"), 0);
 }
 
-// The method list scripts read (pipelines/morph-120hz.sh) is the registry's, one `name<TAB>arguments<TAB>summary`
-// per line as in every method tool; the JSON form adds statefulness, implementations and latency.
+// The method list scripts read (pipelines/morph-120hz.sh) is the registry's, one
+// `name<TAB>arguments<TAB>summary<TAB>devices` per line as in every method tool; the JSON form adds statefulness,
+// implementations and latency.
 TEST_F(MorphCli, ListMethodsPrintsTheRegistry) {
   std::string out;
   ASSERT_EQ(test::run_command(tool() + " --list-methods 2>/dev/null", &out), 0) << out;
   std::string expected;
   for (const MethodEntry* e : registry())
-    expected += e->info.name + "\t--method " + e->info.name + "\t" + e->info.summary + "\n";
+    expected += e->info.name + "\t--method " + e->info.name + "\t" + e->info.summary + "\t" + device_lists(*e).first + "\n";
   EXPECT_EQ(out, expected);
+  EXPECT_NE(out.find("\tcpu,gpu\n"), std::string::npos) << "blend and warp have GPU kernels: " << out;
   ASSERT_EQ(test::run_command(tool() + " --list-methods-json 2>/dev/null", &out), 0) << out;
   EXPECT_NE(out.find("{\"name\": \"blend\", \"method\": \"blend\", \"args\": [], \"summary\": "), std::string::npos)
       << out;
-  EXPECT_NE(out.find("\"stateful\": false, \"implementations\": [\"cpu\"], \"latency_frames\": 1}"), std::string::npos)
+  EXPECT_NE(out.find("\"stateful\": false, \"implementations\": [\"cpu\", \"gpu\"], \"latency_frames\": 1}"),
+            std::string::npos)
       << out;
-  EXPECT_NE(out.find("\"implementations\": [\"cpu\"], \"latency_frames\": 0}"), std::string::npos) << out;
+  for (const MethodEntry* e : registry())
+    EXPECT_NE(out.find(device_lists(*e).second + ", \"latency_frames\": " + std::to_string(*e->info.latency_frames) + "}"),
+              std::string::npos)
+        << e->info.name << ": " << out;
+}
+
+// --device gpu for a method without a GPU kernel, and for --perceive (which runs on the CPU only), is a usage error
+// that says what to do.
+TEST_F(MorphCli, DeviceGpuWithoutAKernelIsAUsageError) {
+  const std::string base = tool() + " --input " + in("color") + " --gbuffer " + in("gbuffer") + " --out " +
+                           (dir_ / "x" / "o.####.exr").string();
+  std::string out;
+  EXPECT_EQ(test::run_command(base + " --method repeat --device gpu", &out), 1) << out;
+  EXPECT_NE(out.find("--method repeat has no gpu implementation (it runs on: cpu): pass --device cpu"),
+            std::string::npos)
+      << out;
+  EXPECT_EQ(test::run_command(base + " --method blend --device tpu", &out), 1) << out;
+  EXPECT_NE(out.find("--device"), std::string::npos) << out;
+  EXPECT_EQ(test::run_command(base + " --perceive --device gpu", &out), 1) << out;
+  EXPECT_NE(out.find("--perceive runs on the CPU only: drop --device gpu"), std::string::npos) << out;
+  EXPECT_FALSE(std::filesystem::exists(dir_ / "x")) << "nothing is written";
 }
 
 TEST_F(MorphCli, OutOfRangeAndNonFiniteParametersAreUsageErrors) {

@@ -17,6 +17,31 @@ static const temporal::morph::MorphStageIO kMorphIO{&temporal::read_exr_rgb, &te
 namespace temporal::morph {
 namespace {
 
+// --device (temporal/core/method.h): the implementations a method's entry lists decide which devices it takes; any
+// other device is a usage error that names the devices the method has (repeat has no GPU kernel: the issue lists none
+// for it), and a name that is no device names the choices.
+TEST(MorphRegistry, DeviceChecksNameTheMethodsDevices) {
+  EXPECT_EQ(implementation_devices(*find_entry("blend")), (std::vector<std::string>{"cpu", "gpu"}));
+  EXPECT_TRUE(check_method_device(*find_entry("blend"), "gpu"));
+  EXPECT_TRUE(check_method_device(*find_entry("repeat"), "cpu"));
+  const Status s = check_method_device(*find_entry("repeat"), "gpu");
+  ASSERT_FALSE(s);
+  EXPECT_EQ(s.error().kind, ErrorKind::Usage);
+  EXPECT_EQ(s.error().message,
+            "--method repeat has no gpu implementation (it runs on: cpu): pass --device cpu or another --method");
+  const Status unknown = check_method_device(*find_entry("blend"), "tpu");
+  ASSERT_FALSE(unknown);
+  EXPECT_NE(unknown.error().message.find("cpu, gpu"), std::string::npos) << unknown.error().message;
+  MorphOptions o;
+  o.method = "repeat";
+  o.device = "gpu";
+  EXPECT_FALSE(check(o)) << "check() refuses a device the method has no implementation on";
+  // The factories the entry lists: a CPU one cannot fail and needs no context; a GPU one needs the context.
+  EXPECT_FALSE(find_implementation(*find_entry("blend"), kCpuDevice)->make.needs_gpu());
+  EXPECT_TRUE(find_implementation(*find_entry("blend"), kGpuDevice)->make.needs_gpu());
+  EXPECT_TRUE(find_implementation(*find_entry("blend"), kCpuDevice)->make(nullptr, MorphOptions{}));
+}
+
 TEST(MorphRegistry, ListsEveryMethodWithWhatItReadsAndItsLatency) {
   std::vector<std::string> names;
   const MorphOptions defaults;

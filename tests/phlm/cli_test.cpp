@@ -7,6 +7,8 @@
 
 #include <gtest/gtest.h>
 
+#include <utility>
+
 #include <cmath>
 #include <cstring>
 #include <fstream>
@@ -14,6 +16,17 @@
 #include <random>
 
 namespace {
+
+// The devices of an entry as --list-methods prints them ("cpu,gpu") and as the JSON lists them.
+template <typename Entry>
+std::pair<std::string, std::string> device_lists(const Entry& e) {
+  std::string text, json;
+  for (const auto& d : temporal::implementation_devices(e)) {
+    text += (text.empty() ? "" : ",") + d;
+    json += (json.empty() ? "" : ", ") + ("\"" + d + "\"");
+  }
+  return {text, "\"implementations\": [" + json + "]"};
+}
 
 using namespace temporal;
 using namespace temporal::phlm;
@@ -208,14 +221,15 @@ TEST(FilterPhlmCli, ListMethodsPrintsTheRegistry) {
   ASSERT_EQ(test::run_command(tool() + " --list-methods 2>/dev/null", &out), 0) << out;
   std::string expected;
   for (const MethodEntry* e : registry())
-    expected += e->info.name + "\t--method " + e->info.name + "\t" + e->info.summary + "\n";
+    expected += e->info.name + "\t--method " + e->info.name + "\t" + e->info.summary + "\t" + device_lists(*e).first + "\n";
   EXPECT_EQ(out, expected);
+  EXPECT_NE(out.find("\tcpu,gpu\n"), std::string::npos) << "every filter has a GPU kernel: " << out;
   ASSERT_EQ(test::run_command(tool() + " --list-methods-json 2>/dev/null", &out), 0) << out;
   EXPECT_NE(out.find("{\"name\": \"phlm\", \"method\": \"phlm\", \"args\": [], \"summary\": "), std::string::npos)
       << out;
-  EXPECT_NE(out.find("\"stateful\": true, \"implementations\": [\"cpu\"]}"), std::string::npos) << out;
+  EXPECT_NE(out.find("\"stateful\": true, \"implementations\": [\"cpu\", \"gpu\"]}"), std::string::npos) << out;
   EXPECT_NE(out.find("{\"name\": \"fxaa\""), std::string::npos) << out;
-  EXPECT_NE(out.find("\"stateful\": false, \"implementations\": [\"cpu\"]}"), std::string::npos)
+  EXPECT_NE(out.find("\"stateful\": false, " + device_lists(*find_entry("fxaa")).second + "}"), std::string::npos)
       << "fxaa is spatial: " << out;
 }
 

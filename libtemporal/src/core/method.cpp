@@ -1,5 +1,7 @@
 #include "temporal/core/method.h"
 
+#include <algorithm>
+
 namespace temporal {
 
 MethodOptionSet::MethodOptionSet(const MethodOptionSet& other) { *this = other; }
@@ -22,6 +24,17 @@ MethodOptions* MethodOptionSet::find(std::string_view name) {
 }
 const MethodOptions* MethodOptionSet::find(std::string_view name) const {
   return const_cast<MethodOptionSet*>(this)->find(name);
+}
+
+Status check_device(std::string_view method, std::string_view device, const std::vector<std::string>& devices) {
+  const std::vector<std::string>& known = device_names();
+  if (std::find(known.begin(), known.end(), device) == known.end()) return not_one_of("--device", device, known);
+  if (std::find(devices.begin(), devices.end(), device) != devices.end()) return Status::ok();
+  std::string have;
+  for (const auto& d : devices) have += (have.empty() ? "" : ", ") + d;
+  return Error::usage("--method " + std::string(method) + " has no " + std::string(device) +
+                      " implementation (it runs on: " + have + "): pass --device " +
+                      (devices.empty() ? std::string(kCpuDevice) : devices.front()) + " or another --method");
 }
 
 }  // namespace temporal

@@ -327,6 +327,7 @@ Status write_outputs(const Plan& plan, const RunIdentity& identity, const Protec
     md.parameters = identity.parameters;
     md.compute_ms = o.compute_ms;
     md.timings_ms = o.timings_ms;  // the input's pass timings describe another stage
+    for (const auto& k : o.drop_extra) md.extra.erase(k);
     for (const auto& [k, v] : o.extra) md.extra[k] = v;
     o.image->metadata() = std::move(md);
     const std::string path = plan.out.path(o.frame);

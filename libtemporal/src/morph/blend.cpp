@@ -2,6 +2,7 @@
 // can be shown: one rendered frame of added latency. The last frame, without a successor, is repeated.
 #include "method_common.h"
 #include "temporal/core/parallel.h"
+#include "temporal/morph/gpu_methods.h"
 #include "temporal/morph/methods.h"
 
 #include <algorithm>
@@ -43,7 +44,8 @@ const MethodEntry& blend_method() {
       .layers = [](const MorphOptions&) { return std::vector<LayerNeed>{}; },
       .implementations = {{kCpuDevice, [](const MorphOptions&) -> std::unique_ptr<MorphMethod> {
                              return std::make_unique<Blend>();
-                           }}},
+                           }},
+                          {kGpuDevice, make_blend_method_gpu}},
       .lookahead = 1,
   };
   return entry;

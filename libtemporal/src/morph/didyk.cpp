@@ -20,6 +20,7 @@
 #include "temporal/core/fast_math.h"
 #include "temporal/core/parallel.h"
 #include "temporal/morph/blur_pyramid.h"
+#include "temporal/morph/gpu_methods.h"
 #include "temporal/morph/grid_warp.h"
 #include "temporal/morph/methods.h"
 
@@ -246,7 +247,7 @@ const MethodEntry& didyk_method() {
                            [](const MorphOptions& o) -> std::unique_ptr<MorphMethod> {
                              return std::make_unique<Didyk>(o, method_options<DidykOptions>(o.per_method, "didyk"));
                            }},
-                          {kGpuDevice, detail::make_didyk_gpu_implementation}},
+                          {kGpuDevice, make_didyk_method_gpu}},
   };
   return entry;
 }

@@ -1031,18 +1031,6 @@ class DidykGpu final : public MorphMethod, public gpu::TimedKernel {
   gpu::KernelTiming timing_;
 };
 
-// What the registry's factory returns when the GPU implementation cannot be made: run() writes nothing and
-// run_status() says why (Morpher::process returns it).
-class UnavailableMethod final : public MorphMethod {
- public:
-  explicit UnavailableMethod(Error error) : status_(std::move(error)) {}
-  void run(const Image&, const Image*, const Image*, std::vector<Image>&, MorphTimings&) override {}
-  Status run_status() const override { return status_; }
-
- private:
-  Status status_;
-};
-
 }  // namespace
 
 Expected<std::unique_ptr<MorphMethod>> make_didyk_method_gpu(std::shared_ptr<gpu::Context> context,
@@ -1071,14 +1059,4 @@ Expected<std::unique_ptr<MorphMethod>> make_didyk_method_gpu(std::shared_ptr<gpu
   }
   return std::unique_ptr<MorphMethod>(new DidykGpu(std::move(context), std::move(programs), options, didyk));
 }
-
-namespace detail {
-
-std::unique_ptr<MorphMethod> make_didyk_gpu_implementation(const MorphOptions& options) {
-  auto made = make_didyk_method_gpu(nullptr, options);
-  if (!made) return std::make_unique<UnavailableMethod>(made.error());
-  return std::move(*made);
-}
-
-}  // namespace detail
 }  // namespace temporal::morph

@@ -62,10 +62,4 @@ struct DidykOptions {
   }
 };
 
-// The GPU implementation for the registry (didyk's MethodEntry::implementations, device kGpuDevice): the factory
-// of temporal/morph/gpu_methods.h on the default EGL device. The registry's factory cannot return an error, so a
-// context or compile failure comes back from the method's run_status() (Morpher::process returns it after the
-// first frame, before any output is written) with the driver's message.
-std::unique_ptr<MorphMethod> make_didyk_gpu_implementation(const MorphOptions& options);
-
 }  // namespace temporal::morph::detail

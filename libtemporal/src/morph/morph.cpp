@@ -5,6 +5,7 @@
 // leaves open.
 #include "temporal/morph/morph.h"
 
+#include "temporal/gpu/device.h"
 #include "temporal/morph/methods.h"
 
 #include <algorithm>
@@ -81,6 +82,7 @@ Morpher& Morpher::operator=(Morpher&&) noexcept = default;
 
 Status check(const MorphOptions& options) {
   if (Status s = check_method_name(registry(), options.method); !s) return s;
+  if (Status s = check_method_device(*find_entry(options.method), options.device); !s) return s;
   if (options.factor < 2)
     return Error::usage("--factor must be at least 2 (got " + std::to_string(options.factor) + ")");
   if (!(options.gamma > 0.0f)) return Error::usage("--gamma must be positive");
@@ -92,10 +94,19 @@ Status Morpher::process(const Image& color, const Image* gbuffer, const Image* n
   if (!method_) {
     if (Status s = morph::check(options_); !s) return s;
     entry_ = find_entry(options_.method);
-    // The CPU implementation: every method has one (a device option will choose among several).
-    const auto* implementation = find_implementation(*entry_, kCpuDevice);
-    if (!implementation) return Error::internal("--method " + options_.method + " has no CPU implementation");
-    method_ = implementation->make(options_);
+    // The implementation on --device (check() made sure the method has one there).
+    const auto* implementation = find_implementation(*entry_, options_.device);
+    if (!implementation) return check_method_device(*entry_, options_.device);
+    // By the device, not the factory's kind: an adapter with the CPU signature registered for the GPU (one that
+    // makes its own context) still runs there, and the headers name the device's context.
+    if (options_.device == kGpuDevice && !gpu_) {
+      auto context = gpu::context_for_device(options_.device);
+      if (!context) return context.error();
+      gpu_ = std::move(*context);
+    }
+    auto made = implementation->make(gpu_, options_);
+    if (!made) return made.error();
+    method_ = std::move(*made);
   }
   if (Status s = check(color, gbuffer, next); !s) return s;
   const int w = color.width(), h = color.height();

@@ -3,6 +3,7 @@
 
 #include "method_common.h"
 #include "temporal/core/sequence.h"
+#include "temporal/gpu/device.h"
 
 #include <chrono>
 #include <functional>
@@ -144,6 +145,10 @@ class FrameRateStage final : public FrameStage {
       return e;
     }
     const int n = options_.morph.factor;
+    // On the GPU the kernels' time (gpu/device.h: the uploads and downloads around them are not counted); on the
+    // CPU the wall-clock time of the call.
+    const gpu::ComputeTime time = gpu::compute_time(
+        morpher_->gpu_context() ? dynamic_cast<const gpu::TimedKernel*>(morpher_->method()) : nullptr, total_ms_);
     for (int k = 0; k < n; ++k) {
       const int frame = f.frame * n + k;
       FrameMetadata md = f.input->metadata();
@@ -165,7 +170,6 @@ class FrameRateStage final : public FrameStage {
       StageOutput o;
       o.frame = frame;
       o.image = img;
-      o.compute_ms = total_ms_ / n;  // the rendered frame's work produces all its slots: each gets an equal share
       o.timings_ms = {{"flow", timings_.flow_ms}, {"morph", timings_.morph_ms}, {"blur", timings_.blur_ms}};
       o.extra = {{"method", entry_.info.name},
                  // In frames of the output sequence: slot k of rendered frame n can be shown only once the
@@ -175,6 +179,8 @@ class FrameRateStage final : public FrameStage {
                  {"sourceFrame", std::to_string(f.frame)},
                  {"slot", std::to_string(k)}};
       o.keep_input_metadata = false;
+      // The rendered frame's work produces all its slots: each gets an equal share.
+      gpu::record_device(o, morpher_->gpu_context(), {time.ms / n, time.clock});
       out.push_back(std::move(o));
     }
     return Status::ok();
@@ -356,6 +362,8 @@ Expected<std::unique_ptr<FrameStage>> make_morph_stage(const MorphStageOptions& 
     if (layer_items(options.layer) != std::vector<std::string>{"rgb"})
       return Error::usage("--perceive reads the colour channels R, G, B: drop --layer " + options.layer);
     if (options.hold.window < 1) return Error::usage("--window must be at least 1");
+    if (options.morph.device != kCpuDevice)  // an option that would do nothing is an error, not silence
+      return Error::usage("--perceive runs on the CPU only: drop --device " + options.morph.device);
     std::optional<SequencePattern> lag_reference;
     if (!options.lag_reference.empty()) {
       auto p = SequencePattern::parse(options.lag_reference);

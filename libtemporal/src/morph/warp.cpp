@@ -4,6 +4,7 @@
 // independent of the thread schedule.
 #include "method_common.h"
 #include "temporal/core/parallel.h"
+#include "temporal/morph/gpu_methods.h"
 #include "temporal/morph/methods.h"
 
 #include <algorithm>
@@ -93,7 +94,8 @@ const MethodEntry& warp_method() {
       .layers = [](const MorphOptions&) { return std::vector<LayerNeed>{{"motion"}, {"depth"}}; },
       .implementations = {{kCpuDevice, [](const MorphOptions& o) -> std::unique_ptr<MorphMethod> {
                              return std::make_unique<Warp>(o.debug_layers);
-                           }}},
+                           }},
+                          {kGpuDevice, make_warp_method_gpu}},
   };
   return entry;
 }

@@ -3,6 +3,7 @@
 
 #include "filter_common.h"
 #include "temporal/phlm/filters.h"
+#include "temporal/phlm/gpu_filters.h"
 #include "temporal/core/parallel.h"
 #include "temporal/core/reproject.h"
 
@@ -152,6 +153,11 @@ const MethodEntry& ema_method() {
           },
       .implementations = {{kCpuDevice, [](const FilterOptions& o) -> std::unique_ptr<FrameFilter> {
                              return std::make_unique<EmaFilter>(method_options<EmaOptions>(o.per_method, "ema"));
+                           }},
+                          {kGpuDevice,
+                           [](std::shared_ptr<gpu::Context> c,
+                              const FilterOptions& o) -> Expected<std::unique_ptr<FrameFilter>> {
+                             return make_ema_filter_gpu(std::move(c), method_options<EmaOptions>(o.per_method, "ema"));
                            }}},
   };
   return entry;

@@ -2,6 +2,8 @@
 // the method reads, timing, and the state files.
 #include "temporal/phlm/filters.h"
 
+#include "temporal/gpu/device.h"
+
 #include <chrono>
 
 namespace temporal::phlm {
@@ -22,8 +24,9 @@ Expected<std::vector<std::string>> layer_channels(const Image& img, const std::s
 
 class FilterStage final : public FrameStage {
  public:
-  FilterStage(const FilterOptions& options, const MethodEntry& method, std::unique_ptr<FrameFilter> filter)
-      : options_(options), method_(method), filter_(std::move(filter)) {
+  FilterStage(const FilterOptions& options, const MethodEntry& method, std::shared_ptr<gpu::Context> context,
+              std::unique_ptr<FrameFilter> filter)
+      : options_(options), method_(method), context_(std::move(context)), filter_(std::move(filter)) {
     inputs_.input_layers = layer_items(options.layer);
     inputs_.gbuffer_layers = method.layers(options);
     // Every parameter of the method with its value (ablation switches included), for the output headers.
@@ -79,13 +82,18 @@ class FilterStage final : public FrameStage {
     const auto t0 = std::chrono::steady_clock::now();
     stats_ = {};
     if (Status s = filter_->process(in, output_, &stats_); !s) return s;
-    ms_ = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    const double wall_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    // On the GPU the kernels' time (gpu/device.h); `temporal:ms:filter` keeps the call's wall-clock time, with the
+    // uploads and downloads.
+    const gpu::ComputeTime time =
+        gpu::compute_time(context_ ? dynamic_cast<const gpu::TimedKernel*>(filter_.get()) : nullptr, wall_ms);
+    ms_ = time.ms;
     StageOutput o;
     o.frame = f.frame;
     o.image = &output_;
-    o.compute_ms = ms_;
-    o.timings_ms = {{"filter", ms_}};
+    o.timings_ms = {{"filter", wall_ms}};
     o.extra = {{"method", method_.info.name}, {"methodParameters", parameters_}};
+    gpu::record_device(o, context_.get(), time);
     out.push_back(std::move(o));
     return Status::ok();
   }
@@ -98,6 +106,7 @@ class FilterStage final : public FrameStage {
  private:
   FilterOptions options_;
   const MethodEntry& method_;
+  std::shared_ptr<gpu::Context> context_;  // --device gpu: the filter's context; null on the CPU
   std::unique_ptr<FrameFilter> filter_;
   StageInputs inputs_;
   std::optional<Image> pending_state_;
@@ -110,10 +119,13 @@ class FilterStage final : public FrameStage {
 }  // namespace
 
 Expected<std::unique_ptr<FrameStage>> make_filter_stage(const FilterOptions& options) {
-  auto filter = make_filter(options);  // checks the options
+  if (Status s = check(options); !s) return s.error();
+  auto context = gpu::context_for_device(options.device);  // null on the CPU
+  if (!context) return context.error();
+  auto filter = make_filter(options, *context);
   if (!filter) return filter.error();
   return std::unique_ptr<FrameStage>(
-      std::make_unique<FilterStage>(options, *find_entry(options.method), std::move(*filter)));
+      std::make_unique<FilterStage>(options, *find_entry(options.method), *context, std::move(*filter)));
 }
 
 }  // namespace temporal::phlm

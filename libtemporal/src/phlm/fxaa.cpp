@@ -4,6 +4,7 @@
 
 #include "filter_common.h"
 #include "temporal/phlm/filters.h"
+#include "temporal/phlm/gpu_filters.h"
 #include "temporal/core/color.h"
 #include "temporal/core/parallel.h"
 #include "temporal/core/reproject.h"
@@ -236,6 +237,11 @@ const MethodEntry& fxaa_method() {
       .layers = [](const FilterOptions&) { return std::vector<LayerNeed>{}; },
       .implementations = {{kCpuDevice, [](const FilterOptions& o) -> std::unique_ptr<FrameFilter> {
                              return std::make_unique<FxaaFilter>(method_options<FxaaOptions>(o.per_method, "fxaa"));
+                           }},
+                          {kGpuDevice,
+                           [](std::shared_ptr<gpu::Context> c,
+                              const FilterOptions& o) -> Expected<std::unique_ptr<FrameFilter>> {
+                             return make_fxaa_filter_gpu(std::move(c), method_options<FxaaOptions>(o.per_method, "fxaa"));
                            }}},
   };
   return entry;

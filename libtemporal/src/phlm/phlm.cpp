@@ -4,6 +4,7 @@
 
 #include "filter_common.h"
 #include "temporal/phlm/filters.h"
+#include "temporal/phlm/gpu_filters.h"
 #include "temporal/core/color.h"
 #include "temporal/core/minmax.h"
 #include "temporal/core/parallel.h"
@@ -687,6 +688,11 @@ const MethodEntry& phlm_method() {
       .layers = [](const FilterOptions&) { return std::vector<LayerNeed>{{"motion"}}; },
       .implementations = {{kCpuDevice, [](const FilterOptions& o) -> std::unique_ptr<FrameFilter> {
                              return std::make_unique<PhlmFilter>(method_options<PhlmOptions>(o.per_method, "phlm"));
+                           }},
+                          {kGpuDevice,
+                           [](std::shared_ptr<gpu::Context> c,
+                              const FilterOptions& o) -> Expected<std::unique_ptr<FrameFilter>> {
+                             return make_phlm_filter_gpu(std::move(c), method_options<PhlmOptions>(o.per_method, "phlm"));
                            }}},
   };
   return entry;

@@ -2,6 +2,8 @@
 // every method, the parameter list the command line binds, the filter of the chosen method.
 #include "temporal/phlm/filters.h"
 
+#include "temporal/gpu/device.h"
+
 namespace temporal::phlm {
 
 // Every method, in the order of --help, --list-methods and the docs. Adding a method: its source file defines
@@ -37,6 +39,10 @@ ParamList params(FilterOptions& o) {
       Param::choice("--method", "Filter method (filter-phlm --list-methods describes each)", &o.method,
                     method_names(registry())),
       Param::text("--layer", "Layer to filter: rgb (R,G,B) or a layer name (ssao, shadow, direct, ...)", &o.layer),
+      Param::choice("--device",
+                    "Where the method runs: cpu (the C++ reference) or gpu (its GLSL compute kernel through EGL; "
+                    "--list-methods says which methods have one)",
+                    &o.device, device_names()),
       Param::flag_on("--debug-layers",
                      "Add debug.* layers (phlm: feature, alpha, reset, traceP; taa: clip, noHistory, velocity; ema: "
                      "reject; fxaa: edge)",
@@ -50,6 +56,7 @@ Status check(const FilterOptions& options) {
   if (Status s = check_method_name(registry(), options.method); !s) return s;
   FilterOptions copy = options;  // params() points at the fields it is given
   if (Status s = check_params(params(copy)); !s) return s;
+  if (Status s = check_method_device(*find_entry(options.method), options.device); !s) return s;
   return check_method_options(registry(), options.per_method);
 }
 
@@ -58,11 +65,18 @@ Expected<FilterOptions> make_options(const std::string& method, const std::vecto
                                [](const FilterOptions& o) { return check(o); });
 }
 
-Expected<std::unique_ptr<FrameFilter>> make_filter(const FilterOptions& options) {
+Expected<std::unique_ptr<FrameFilter>> make_filter(const FilterOptions& options,
+                                                   std::shared_ptr<gpu::Context> context) {
   if (Status s = check(options); !s) return s.error();
-  const auto* implementation = find_implementation(*find_entry(options.method), kCpuDevice);
-  if (!implementation) return Error::internal("--method " + options.method + " has no CPU implementation");
-  return implementation->make(options);
+  const auto* implementation = find_implementation(*find_entry(options.method), options.device);
+  if (!implementation)
+    return Error::internal("--method " + options.method + " has no " + options.device + " implementation");
+  if (options.device == kGpuDevice && !context) {
+    auto made = gpu::context_for_device(options.device);
+    if (!made) return made.error();
+    context = std::move(*made);
+  }
+  return implementation->make(std::move(context), options);
 }
 
 }  // namespace temporal::phlm

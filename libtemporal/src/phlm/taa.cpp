@@ -4,6 +4,7 @@
 
 #include "filter_common.h"
 #include "temporal/phlm/filters.h"
+#include "temporal/phlm/gpu_filters.h"
 #include "temporal/core/color.h"
 #include "temporal/core/minmax.h"
 #include "temporal/core/parallel.h"
@@ -331,6 +332,11 @@ const MethodEntry& taa_method() {
       .layers = [](const FilterOptions&) { return std::vector<LayerNeed>{{"motion"}, {"depth", false}}; },
       .implementations = {{kCpuDevice, [](const FilterOptions& o) -> std::unique_ptr<FrameFilter> {
                              return std::make_unique<TaaFilter>(method_options<TaaOptions>(o.per_method, "taa"));
+                           }},
+                          {kGpuDevice,
+                           [](std::shared_ptr<gpu::Context> c,
+                              const FilterOptions& o) -> Expected<std::unique_ptr<FrameFilter>> {
+                             return make_taa_filter_gpu(std::move(c), method_options<TaaOptions>(o.per_method, "taa"));
                            }}},
   };
   return entry;

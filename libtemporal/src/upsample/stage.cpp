@@ -2,6 +2,7 @@
 #include "temporal/upsample/stage.h"
 
 #include "method.h"
+#include "temporal/gpu/device.h"
 
 #include <cstdio>
 #include <sstream>
@@ -59,10 +60,10 @@ Status UpsampleStage::process(const StageFrame& frame, std::vector<StageOutput>&
   StageOutput output;
   output.frame = frame.frame;
   output.image = &img;
-  output.compute_ms = last_.compute_ms;
   output.keep_input_metadata = false;
   output.timings_ms = frame.input->metadata().timings_ms;
-  output.timings_ms["upsample"] = last_.compute_ms;
+  output.timings_ms["upsample"] = last_.wall_ms;  // on the GPU with the uploads and downloads
+  gpu::record_device(output, upsampler_.gpu_context(), {last_.compute_ms, last_.compute_clock});
   const MethodEntry* entry = find_entry(o.method);
   output.extra["method"] = entry && entry->header_name ? entry->header_name(o) : o.method;
   if (const std::string p = method_parameters(o); !p.empty()) output.extra["methodParameters"] = p;

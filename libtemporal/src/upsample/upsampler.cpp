@@ -4,6 +4,7 @@
 
 #include "temporal/core/jitter.h"
 #include "temporal/core/parallel.h"
+#include "temporal/gpu/device.h"
 
 #include <algorithm>
 #include <chrono>
@@ -62,6 +63,7 @@ struct Upsampler::Impl {
   FrameContext f;
   Geometry geometry;
   std::unique_ptr<MethodState> state;
+  std::shared_ptr<gpu::Context> gpu;  // --device gpu: the run's context (made with the first state)
   bool have_history = false;
   std::optional<Image> pending;  // a loaded state, applied at the next frame
   Demodulation demod;
@@ -209,10 +211,19 @@ Status Upsampler::Impl::prepare_state(std::span<const std::string> channels, con
   const Geometry g{f.W, f.H, f.grid.k, f.lw, f.lh, std::vector<std::string>(channels.begin(), channels.end())};
   if (!state || !(g == geometry)) {
     geometry = g;
-    // The CPU implementation: every method has one (a device option will choose among several).
-    const auto* implementation = find_implementation(*entry, kCpuDevice);
-    if (!implementation) return Error::internal("--method " + options.method + " has no CPU implementation");
-    state = implementation->make(options, geometry);
+    // The implementation on --device (check() made sure the method has one there).
+    const auto* implementation = find_implementation(*entry, options.device);
+    if (!implementation) return check_method_device(*entry, options.device);
+    // By the device, not the factory's kind: an adapter with the CPU signature registered for the GPU (one that
+    // makes its own context) still runs there, and the headers name the device's context.
+    if (options.device == kGpuDevice && !gpu) {
+      auto context = gpu::context_for_device(options.device);
+      if (!context) return context.error();
+      gpu = std::move(*context);
+    }
+    auto made = implementation->make(gpu, options, geometry);
+    if (!made) return made.error();
+    state = std::move(*made);
     have_history = false;
   }
   if (!pending) return Status::ok();
@@ -311,6 +322,8 @@ Upsampler::~Upsampler() = default;
 
 const Options& Upsampler::options() const { return impl_->options; }
 
+const gpu::Context* Upsampler::gpu_context() const { return impl_->gpu.get(); }
+
 void Upsampler::reset() { impl_->have_history = false; }
 
 bool Upsampler::has_state() const { return impl_->entry && impl_->entry->info.has_state; }
@@ -338,7 +351,12 @@ Expected<Image*> Upsampler::process(const Image& gbuffer, const Image& low, std:
   if (u.options.demodulate) result = u.remodulate(result, channels);
   if (u.options.aa_factor > 1) result = u.downsample(result);
   result->metadata() = FrameMetadata{};
-  stats.compute_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  stats.wall_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  // On the GPU: the kernels' time (gpu/device.h); the frame's checks, uploads and downloads are in wall_ms.
+  const gpu::ComputeTime time =
+      gpu::compute_time(u.gpu ? dynamic_cast<const gpu::TimedKernel*>(u.state.get()) : nullptr, stats.wall_ms);
+  stats.compute_ms = time.ms;
+  stats.compute_clock = time.clock;
   if (stats_out) *stats_out = stats;
   return result;
 }

@@ -10,7 +10,7 @@
 //     MethodInfo info;
 //     std::unique_ptr<MethodOptions> (*make_options)() = nullptr;  // nullptr: no parameters of its own
 //     std::vector<LayerNeed> (*layers)(const StageOptions&) = nullptr;
-//     std::vector<Implementation<Factory>> implementations = {};
+//     std::vector<Implementation<Factory>> implementations = {};  // Factory: a DeviceFactory<...>
 //     ...  // what only that stage needs
 //   };
 // and each stage offers registry(), find_entry(name) (nullptr when unknown), method_variants(), find_variant().
@@ -23,17 +23,26 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <type_traits>
 #include <string_view>
 #include <utility>
 #include <vector>
 
 namespace temporal {
 
+namespace gpu {
+class Context;  // temporal/gpu/context.h (the gpu stage); core only passes it through
+}  // namespace gpu
+
 // The device of the implementations every method has.
 inline constexpr const char* kCpuDevice = "cpu";
-// The device of the GPU implementations (GLSL compute kernels of the gpu stage, docs/gpu.md), registered beside the
-// C++ one where a method has them.
+// The device of the GLSL compute kernels (the gpu stage, docs/gpu.md): a hardware GPU through EGL, or llvmpipe.
 inline constexpr const char* kGpuDevice = "gpu";
+// The devices `--device` accepts, in the order --help lists them.
+inline const std::vector<std::string>& device_names() {
+  static const std::vector<std::string> names = {kCpuDevice, kGpuDevice};
+  return names;
+}
 
 // A named way to run a method: the method and the arguments that select the variant, written as on the command
 // line ("herzog-lagged" = --method herzog --lagged-wf).
@@ -61,6 +70,43 @@ template <typename Factory>
 struct Implementation {
   const char* device;
   Factory make;
+};
+
+// The factory of a stage's implementations: one type for both kinds of factory a method's source file has, so
+// that an entry lists them side by side, `{kCpuDevice, cpu_lambda}, {kGpuDevice, make_NAME_gpu}`:
+//  - a CPU factory, `std::unique_ptr<Product> (Args...)` (a captureless lambda or a function): cannot fail;
+//  - a GPU factory, `Expected<std::unique_ptr<Product>> (std::shared_ptr<gpu::Context>, Args...)`: the form of
+//    the gpu kernels' factories (docs/gpu.md), which fail with the driver's message.
+// Called with the run's GPU context (null on the CPU), it returns the product or the GPU factory's error.
+template <typename Product, typename... Args>
+class DeviceFactory {
+ public:
+  using Cpu = std::unique_ptr<Product> (*)(Args...);
+  using Gpu = Expected<std::unique_ptr<Product>> (*)(std::shared_ptr<gpu::Context>, Args...);
+
+  template <typename F>
+    requires(std::is_convertible_v<F, Cpu> || std::is_convertible_v<F, Gpu>)
+  DeviceFactory(F f) {  // NOLINT: implicit by design, `{kGpuDevice, make_NAME_gpu}`
+    if constexpr (std::is_convertible_v<F, Cpu>)
+      cpu_ = f;
+    else
+      gpu_ = f;
+  }
+
+  Expected<std::unique_ptr<Product>> operator()(std::shared_ptr<gpu::Context> context, Args... args) const {
+    if (cpu_) return cpu_(std::forward<Args>(args)...);
+    return gpu_(std::move(context), std::forward<Args>(args)...);
+  }
+  // A CPU factory called directly (the tests and benchmarks that run the C++ reference); null for a GPU factory.
+  std::unique_ptr<Product> operator()(Args... args) const {
+    return cpu_ ? cpu_(std::forward<Args>(args)...) : nullptr;
+  }
+  // Whether it needs a GPU context (a GPU factory).
+  bool needs_gpu() const { return gpu_ != nullptr; }
+
+ private:
+  Cpu cpu_ = nullptr;
+  Gpu gpu_ = nullptr;
 };
 
 // A method's own parameters: an options struct defined in the method's source file (its fields hold the defaults)
@@ -218,12 +264,20 @@ auto find_implementation(const Entry& entry, std::string_view device) -> decltyp
   return nullptr;
 }
 
-// The devices `entry` has an implementation for, in its order ({"cpu"}).
+// The devices `entry` has an implementation for, in its order ({"cpu"}, {"cpu", "gpu"}).
 template <typename Entry>
 std::vector<std::string> implementation_devices(const Entry& entry) {
   std::vector<std::string> devices;
   for (const auto& i : entry.implementations) devices.emplace_back(i.device);
   return devices;
+}
+
+// Usage error unless `device` is one of device_names() and `entry` has an implementation on it; the message
+// names the devices the method has.
+Status check_device(std::string_view method, std::string_view device, const std::vector<std::string>& devices);
+template <typename Entry>
+Status check_method_device(const Entry& entry, std::string_view device) {
+  return check_device(entry.info.name, device, implementation_devices(entry));
 }
 
 }  // namespace temporal

@@ -58,6 +58,7 @@ struct StageOutput {
   Image* image = nullptr;
   double compute_ms = 0.0;                    // `temporal:computeMs` (the stage's compute time, I/O excluded)
   std::map<std::string, std::string> extra;   // `temporal:<key>` attributes (method, counters)
+  std::vector<std::string> drop_extra;        // `temporal:<key>` attributes of the input header not carried over
   std::map<std::string, double> timings_ms;   // `temporal:ms:<pass>`
   bool keep_input_metadata = true;            // start from the input header (camera, fps, time, clip)
 };

@@ -39,8 +39,12 @@ class MorphMethod {
   virtual Status run_status() const { return Status::ok(); }
 };
 
-// A method's state for these (checked) options, on one device.
-using MethodFactory = std::unique_ptr<MorphMethod> (*)(const MorphOptions&);
+// A method's state for these (checked) options, on one device: a CPU factory
+// `std::unique_ptr<MorphMethod> (const MorphOptions&)` or a GPU one
+// `Expected<std::unique_ptr<MorphMethod>> (std::shared_ptr<gpu::Context>, const MorphOptions&)`
+// (temporal/morph/gpu_methods.h), listed as `{kGpuDevice, make_NAME_method_gpu}` in the method's entry: --device
+// picks it (temporal/core/method.h, DeviceFactory).
+using MethodFactory = DeviceFactory<MorphMethod, const MorphOptions&>;
 
 // One registry entry.
 struct MethodEntry {
@@ -52,7 +56,7 @@ struct MethodEntry {
   std::unique_ptr<MethodOptions> (*make_options)() = nullptr;
   // G-buffer layers it reads ("motion": motion.X/Y, "depth": depth.Z); none: it needs no G-buffer.
   std::vector<LayerNeed> (*layers)(const MorphOptions&) = nullptr;
-  // Its implementations, per device ("cpu").
+  // Its implementations, per device ("cpu", "gpu").
   std::vector<Implementation<MethodFactory>> implementations = {};
   int lookahead = 0;  // rendered frames after the current one it reads (blend: 1)
 };

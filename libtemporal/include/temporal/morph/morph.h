@@ -42,6 +42,7 @@ MethodOptionSet default_method_options();
 // blur and compensation: src/morph/didyk.cpp, DidykOptions).
 struct MorphOptions {
   std::string method = "didyk";  // a name of the registry (temporal/morph/methods.h)
+  std::string device = "cpu";    // the implementation's device: "cpu" or "gpu" (temporal/core/method.h)
   int factor = 3;                // displayed frames per rendered frame, >= 2 (40 Hz -> 120 Hz: 3)
   float gamma = 2.2f;            // display gamma g: displayed light = value^g, value in [0, 1]
   // The eye-tracking limit (seed 004 section 6): pixels per degree of the viewing geometry (<= 0: no limit) and the
@@ -101,6 +102,9 @@ class Morpher {
   Morpher(Morpher&&) noexcept;
   Morpher& operator=(Morpher&&) noexcept;
   const MorphOptions& options() const { return options_; }
+  // The method's state (null before the first process()) and, with --device gpu, its context (else null).
+  const MorphMethod* method() const { return method_.get(); }
+  const gpu::Context* gpu_context() const { return gpu_.get(); }
 
   // color: R,G,B (float, scene-linear) of rendered frame n; gbuffer: the layers the method reads (its registry
   // entry: motion.X, motion.Y, depth.Z for didyk and warp; repeat and blend accept nullptr); next: colour of
@@ -117,6 +121,7 @@ class Morpher {
   MorphOptions options_;
   const MethodEntry* entry_ = nullptr;  // registry entry of options_.method (set on first use)
   std::unique_ptr<MorphMethod> method_;    // its state (buffers kept between frames)
+  std::shared_ptr<gpu::Context> gpu_;      // --device gpu: the method's context
 };
 
 }  // namespace temporal::morph

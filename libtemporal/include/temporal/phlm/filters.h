@@ -26,12 +26,17 @@ MethodOptionSet default_method_options();
 struct FilterOptions {
   std::string method = "phlm";  // a name of the registry
   std::string layer = "rgb";    // rgb (R,G,B) or a layer name (ssao, shadow, direct, ...)
+  std::string device = "cpu";   // the implementation's device: "cpu" or "gpu" (temporal/core/method.h)
   bool debug_layers = false;
   MethodOptionSet per_method = default_method_options();
 };
 
-// A method's filter for these (checked) options, on one device.
-using FilterFactory = std::unique_ptr<FrameFilter> (*)(const FilterOptions&);
+// A method's filter for these (checked) options, on one device: a CPU factory
+// `std::unique_ptr<FrameFilter> (const FilterOptions&)` or a GPU one
+// `Expected<std::unique_ptr<FrameFilter>> (std::shared_ptr<gpu::Context>, const FilterOptions&)` (wrapping
+// temporal/phlm/gpu_filters.h), listed as `{kGpuDevice, ...}` in the method's entry: --device picks it
+// (temporal/core/method.h, DeviceFactory).
+using FilterFactory = DeviceFactory<FrameFilter, const FilterOptions&>;
 
 // One method of filter-phlm.
 struct MethodEntry {
@@ -40,7 +45,7 @@ struct MethodEntry {
   std::unique_ptr<MethodOptions> (*make_options)() = nullptr;
   // G-buffer layers it reads when --gbuffer is given (motion always; EMA also depth and id).
   std::vector<LayerNeed> (*layers)(const FilterOptions&) = nullptr;
-  // Its implementations, per device ("cpu").
+  // Its implementations, per device ("cpu", "gpu").
   std::vector<Implementation<FilterFactory>> implementations = {};
 };
 
@@ -61,8 +66,11 @@ Status check(const FilterOptions& options);
 // Options for `method` with parameters set by command-line style arguments, e.g. make_options("taa",
 // {"--taa-clip", "minmax"}). Usage error for an unknown method or parameter, or an invalid value.
 Expected<FilterOptions> make_options(const std::string& method, const std::vector<std::string>& args = {});
-// The CPU filter of options.method with its parameters (check() first).
-Expected<std::unique_ptr<FrameFilter>> make_filter(const FilterOptions& options);
+// The filter of options.method with its parameters on options.device (check() first). On the GPU it runs in
+// `context`, or in a new context on the default EGL device when `context` is null (a usage error naming the fix
+// when none can be made).
+Expected<std::unique_ptr<FrameFilter>> make_filter(const FilterOptions& options,
+                                                   std::shared_ptr<gpu::Context> context = nullptr);
 
 // The runner stage of filter-phlm (temporal/io/runner.h): selects the layer's channels of each frame, feeds the
 // method with the frame's motion (and depth and ids), times it and saves / resumes its state. Usage error for an

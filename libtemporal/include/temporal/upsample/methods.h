@@ -25,8 +25,12 @@ using temporal::MethodVariant;
 class MethodState;  // a method's per-frame work and history (libtemporal/src/upsample/method.h)
 struct Geometry;    // the sizes a state is allocated for (same file)
 
-// A method's state for frames of one geometry, on one device.
-using StateFactory = std::unique_ptr<MethodState> (*)(const Options&, const Geometry&);
+// A method's state for frames of one geometry, on one device: a CPU factory
+// `std::unique_ptr<MethodState> (const Options&, const Geometry&)` or a GPU one
+// `Expected<std::unique_ptr<MethodState>> (std::shared_ptr<gpu::Context>, const Options&, const Geometry&)`
+// (src/upsample/gpu_methods.h), listed as `{kGpuDevice, make_NAME_state_gpu}` in the method's entry: the tool's
+// --device picks the implementation (temporal/core/method.h, DeviceFactory).
+using StateFactory = DeviceFactory<MethodState, const Options&, const Geometry&>;
 
 // One row of the registry (docs/upsample-st.md, "Methods as units").
 struct MethodEntry {
@@ -35,7 +39,7 @@ struct MethodEntry {
   std::unique_ptr<MethodOptions> (*make_options)() = nullptr;
   // G-buffer layers it reads (albedo for demodulation is added by the Upsampler).
   std::vector<LayerNeed> (*layers)(const Options&) = nullptr;
-  // Its implementations: a state for frames of a geometry, per device ("cpu").
+  // Its implementations: a state for frames of a geometry, per device ("cpu", "gpu").
   std::vector<Implementation<StateFactory>> implementations = {};
   // Bytes per frame it must at least read and write (the benchmark's streaming bound): G-buffer planes, payload in
   // and out, histories read and written once. W, H full resolution, k the factor, C payload channels.

@@ -50,6 +50,7 @@ MethodOptionSet default_method_options();
 struct Options {
   std::string method = "herzog";  // a name of the registry (temporal/upsample/methods.h)
   std::string layer = "rgb";      // payload layers: `rgb` (bare R,G,B) or layer names, comma-separated
+  std::string device = "cpu";     // the implementation's device: "cpu" or "gpu" (temporal/core/method.h)
 
   // --- seed 000, section 3.1 (spatial weights, every method) ---
   float sigma_normal = kSigmaNormal;                 // sigma_n of eq. 2
@@ -108,7 +109,9 @@ struct FrameStats {
   std::size_t hole_pixels = 0;       // full-res pixels neither shaded this frame nor with valid history
   std::size_t history_pixels = 0;    // full-res pixels whose history was valid
   bool history_reset = false;        // history was discarded (first frame, cut, reset, size change)
-  double compute_ms = 0.0;           // time spent in process(), I/O excluded
+  double compute_ms = 0.0;           // time spent in process(), I/O excluded (on the GPU: the kernels' time)
+  std::string compute_clock;         // how compute_ms was measured (gpu::compute_clock_name)
+  double wall_ms = 0.0;              // process()'s wall-clock time (on the GPU with the uploads and downloads)
 };
 
 // Where the frame came from, only for error messages.
@@ -134,6 +137,8 @@ class Upsampler {
   Upsampler& operator=(const Upsampler&) = delete;
 
   const Options& options() const;
+  // The GPU context of a --device gpu run (made with the first frame's state); null on the CPU.
+  const gpu::Context* gpu_context() const;
 
   // Upsamples one frame. `channels` names the payload channels of `low` to rebuild. `cut` discards the
   // history first (also done on the first frame, a size change, or `temporal:cameraCut` in either header).
