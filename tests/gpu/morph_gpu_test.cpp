@@ -12,6 +12,7 @@
 namespace {
 
 using namespace temporal;
+using namespace temporal::morph;
 const std::vector<std::string> kRgb = {"R", "G", "B"};
 
 struct Frames {
@@ -48,9 +49,9 @@ Outcome compare(std::shared_ptr<gpu::Context> ctx, const std::string& method, in
   options.method = method;
   options.factor = factor;
   options.debug_layers = debug;
-  auto info = find_morph_method(method);
-  EXPECT_TRUE(info);
-  auto cpu = (*info)->make(options);
+  const MethodEntry* entry = find_entry(method);
+  EXPECT_TRUE(entry);
+  auto cpu = find_implementation(*entry, kCpuDevice)->make(options);
   auto gpu = method == "blend" ? make_blend_method_gpu(ctx, options) : make_warp_method_gpu(ctx, options);
   EXPECT_TRUE(gpu) << gpu.error().message;
   Outcome r;

@@ -6,6 +6,7 @@
 #include "synthetic.h"
 #include "temporal/gpu/timer.h"
 #include "temporal/phlm/ema.h"
+#include "temporal/phlm/filters.h"
 #include "temporal/phlm/fxaa.h"
 #include "temporal/phlm/gpu_filters.h"
 #include "temporal/phlm/phlm.h"
@@ -20,6 +21,7 @@
 namespace {
 
 using namespace temporal;
+using namespace temporal::phlm;
 const std::vector<std::string> kRgb = {"R", "G", "B"};
 
 // One frame of the test sequence: the reference colour with noise (so that the history matters), a few NaN
@@ -428,7 +430,7 @@ TEST(FxaaGpu, MatchesTheCppFilter) {
     auto gpu = make_fxaa_filter_gpu(ctx);
     ASSERT_TRUE(gpu) << gpu.error().message;
     FxaaFilter cpu;
-    EXPECT_FALSE((*gpu)->has_state());
+    EXPECT_FALSE(find_entry("fxaa")->info.has_state);
     const Comparison r = compare(**gpu, cpu, frames, 0, int(frames.size()), o, {"debug.edge"});
     EXPECT_GE(r.colour.psnr, kFxaaPsnr);
     EXPECT_LE(double(r.values_over), kFxaaMaxShareOver * double(r.values));

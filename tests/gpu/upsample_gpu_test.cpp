@@ -57,7 +57,7 @@ Comparison compare(std::shared_ptr<gpu::Context> ctx, const char* method, GpuFac
                    bool debug, const std::vector<std::string>& exact_debug) {
   Sequence s = sequence(10);
   const Geometry g = geometry_of(s.frames[0]);
-  auto cpu = find_entry(method)->make_state(s.options, g);
+  auto cpu = find_implementation(*find_entry(method), kCpuDevice)->make(s.options, g);
   auto gpu = make_gpu(ctx, s.options, g);
   EXPECT_TRUE(gpu) << gpu.error().message;
   Comparison r;
@@ -140,7 +140,7 @@ TEST(TemporalGpu, StateResumesOnTheCpuAndBack) {
   FrameContext f;
   FrameStats stats;
   // The uninterrupted CPU run.
-  auto reference = find_entry("temporal")->make_state(s.options, g);
+  auto reference = find_implementation(*find_entry("temporal"), kCpuDevice)->make(s.options, g);
   Image expected;
   for (int t = 0; t < 12; ++t) {
     build_context(f, s.options, s.frames[std::size_t(t)], true, false);
@@ -148,7 +148,7 @@ TEST(TemporalGpu, StateResumesOnTheCpuAndBack) {
   }
   for (bool gpu_first : {true, false}) {
     SCOPED_TRACE(gpu_first ? "GPU -> CPU" : "CPU -> GPU");
-    auto cpu = find_entry("temporal")->make_state(s.options, g);
+    auto cpu = find_implementation(*find_entry("temporal"), kCpuDevice)->make(s.options, g);
     auto gpu = make_temporal_state_gpu(ctx, s.options, g);
     ASSERT_TRUE(gpu) << gpu.error().message;
     MethodState& first = gpu_first ? **gpu : *cpu;

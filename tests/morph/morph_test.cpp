@@ -154,7 +154,9 @@ TEST(Didyk, SnappingToTheMotionDiscontinuityReducesTearing) {
   Image color = s.color(), gb = s.gbuffer();
   auto run = [&](bool snap) {
     MorphOptions o;
-    if (!snap) EXPECT_TRUE(apply_args(params(o), {"--no-snap"}));  // didyk's own parameter (DidykOptions)
+    if (!snap) {
+      EXPECT_TRUE(apply_args(params(o), {"--no-snap"}));  // didyk's own parameter (DidykOptions)
+    }
     Morpher m(o);
     std::vector<Image> out;
     EXPECT_TRUE(m.process(color, &gb, nullptr, out));

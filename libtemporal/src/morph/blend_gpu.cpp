@@ -8,10 +8,10 @@
 
 #include <algorithm>
 
-namespace temporal {
+namespace temporal::morph {
 namespace {
 
-using namespace morph_detail;
+using namespace detail;
 
 // frames (binding 0): R, G, B of frame n (planes 0-2) and of frame n+1 (3-5); outb (1): R, G, B of the slot.
 constexpr const char* kBlendMain = R"(
@@ -98,4 +98,4 @@ Expected<std::unique_ptr<MorphMethod>> make_blend_method_gpu(std::shared_ptr<gpu
   return std::unique_ptr<MorphMethod>(new BlendGpu(std::move(context), std::move(*program)));
 }
 
-}  // namespace temporal
+}  // namespace temporal::morph

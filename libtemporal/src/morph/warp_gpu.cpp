@@ -12,10 +12,10 @@
 
 #include <algorithm>
 
-namespace temporal {
+namespace temporal::morph {
 namespace {
 
-using namespace morph_detail;
+using namespace detail;
 
 // src (binding 0): R, G, B, motion.X, motion.Y, depth.Z (planes 0-5); keys (1): per target pixel the winning
 // depth bits (plane 0) and source index (plane 1); outb (2): R, G, B of the slot.
@@ -147,4 +147,4 @@ Expected<std::unique_ptr<MorphMethod>> make_warp_method_gpu(std::shared_ptr<gpu:
   return std::unique_ptr<MorphMethod>(new WarpGpu(std::move(context), std::move(*program), options.debug_layers));
 }
 
-}  // namespace temporal
+}  // namespace temporal::morph

@@ -9,7 +9,7 @@
 
 #include <algorithm>
 
-namespace temporal {
+namespace temporal::phlm {
 namespace {
 
 // Buffers: `src` (binding 0) the frame: colour planes 0..C-1, then motion.X, motion.Y, depth, the warped depth,
@@ -225,4 +225,4 @@ Expected<std::unique_ptr<FrameFilter>> make_ema_filter_gpu(std::shared_ptr<gpu::
       new EmaFilterGpu(std::move(context), params, std::move(*program), std::move(*counters)));
 }
 
-}  // namespace temporal
+}  // namespace temporal::phlm

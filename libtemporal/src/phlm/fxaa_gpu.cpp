@@ -9,7 +9,7 @@
 #include "temporal/phlm/fxaa.h"
 #include "temporal/phlm/gpu_filters.h"
 
-namespace temporal {
+namespace temporal::phlm {
 namespace {
 
 // src (binding 0): the C colour planes; work (1): luma (plane 0) and validity (1, 0/1); outb (2): the C output
@@ -239,7 +239,6 @@ class FxaaFilterGpu final : public FrameFilter, public gpu::TimedKernel {
     }
     return Status::ok();
   }
-  bool has_state() const override { return false; }
   Image saved_state() const override { return {}; }
   Status set_state(const Image& state, int channels) override {
     return FxaaFilter(params_).set_state(state, channels);  // the C++ filter's usage error
@@ -278,4 +277,4 @@ Expected<std::unique_ptr<FrameFilter>> make_fxaa_filter_gpu(std::shared_ptr<gpu:
       new FxaaFilterGpu(std::move(context), params, std::move(*luma), std::move(*fxaa), std::move(*counters)));
 }
 
-}  // namespace temporal
+}  // namespace temporal::phlm

@@ -15,7 +15,7 @@
 
 #include <cstring>
 
-namespace temporal {
+namespace temporal::phlm {
 namespace {
 
 // src (binding 0): colour planes 0..C-1, motion.X C, motion.Y C+1; prev (1) / nxt (2): the KSIZE model planes;
@@ -517,4 +517,4 @@ Expected<std::unique_ptr<FrameFilter>> make_phlm_filter_gpu(std::shared_ptr<gpu:
   return std::unique_ptr<FrameFilter>(std::move(filter));
 }
 
-}  // namespace temporal
+}  // namespace temporal::phlm

@@ -12,7 +12,7 @@
 
 #include <cmath>
 
-namespace temporal {
+namespace temporal::phlm {
 namespace {
 
 // Buffers: `src` (binding 0): colour planes 0..C-1, motion.X C, motion.Y C+1, depth C+2; `hist` (1): history
@@ -350,4 +350,4 @@ Expected<std::unique_ptr<FrameFilter>> make_taa_filter_gpu(std::shared_ptr<gpu::
       new TaaFilterGpu(std::move(context), std::move(params), *cfg, programs, std::move(*counters)));
 }
 
-}  // namespace temporal
+}  // namespace temporal::phlm

@@ -30,6 +30,8 @@
 namespace {
 
 using namespace temporal;
+using namespace temporal::phlm;
+using namespace temporal::morph;
 
 std::shared_ptr<gpu::Context> context(std::string* why) {
   static auto created = gpu::Context::create();

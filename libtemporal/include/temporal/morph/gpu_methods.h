@@ -10,7 +10,7 @@
 
 #include <memory>
 
-namespace temporal {
+namespace temporal::morph {
 
 // `blend` (blend.cpp): slot k = (1 - k/N) frame n + (k/N) frame n+1.
 Expected<std::unique_ptr<MorphMethod>> make_blend_method_gpu(std::shared_ptr<gpu::Context> context,
@@ -19,4 +19,4 @@ Expected<std::unique_ptr<MorphMethod>> make_blend_method_gpu(std::shared_ptr<gpu
 Expected<std::unique_ptr<MorphMethod>> make_warp_method_gpu(std::shared_ptr<gpu::Context> context,
                                                             const MorphOptions& options);
 
-}  // namespace temporal
+}  // namespace temporal::morph

@@ -14,7 +14,7 @@
 
 #include <memory>
 
-namespace temporal {
+namespace temporal::phlm {
 
 // The EMA filter (temporal/phlm/ema.h) on `context` (created on the default device when null).
 Expected<std::unique_ptr<FrameFilter>> make_ema_filter_gpu(std::shared_ptr<gpu::Context> context,
@@ -33,4 +33,4 @@ Expected<std::unique_ptr<FrameFilter>> make_fxaa_filter_gpu(std::shared_ptr<gpu:
 Expected<std::unique_ptr<FrameFilter>> make_phlm_filter_gpu(std::shared_ptr<gpu::Context> context,
                                                            PhlmParams params = {});
 
-}  // namespace temporal
+}  // namespace temporal::phlm
