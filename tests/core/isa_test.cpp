@@ -1,6 +1,6 @@
 // The run-time instruction-set dispatch (temporal/core/isa.h): the levels this CPU reports, forcing a level,
-// and the dispatched kernels (FLIP, SSIM, ...) run at every level this machine supports, whose outputs must
-// agree:
+// and the dispatched kernels (FLIP, SSIM, the upsampling methods with the reprojection rows) run at every level
+// this machine supports, whose outputs must agree:
 //  - v3 (AVX2) and v4 (AVX-512) run the same operations in the same order per pixel, with FMA contraction in
 //    both: bit-identical;
 //  - v2 (SSE4.2) has no FMA, so a * b + c is rounded twice where v3 rounds once: the results differ in the
@@ -8,12 +8,16 @@
 #include "temporal/core/isa.h"
 #include "temporal/metrics/flip.h"
 #include "temporal/metrics/metrics.h"
+#include "temporal/upsample/methods.h"
+#include "temporal/upsample/upsample.h"
+#include "synthetic.h"
 
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
+#include <cstring>
 #include <fstream>
 #include <random>
 #include <sstream>
@@ -219,6 +223,59 @@ TEST(Isa, SsimAgreesAtEveryLevel) {
     EXPECT_EQ(runs[1].plain.mean, runs[2].plain.mean);
     EXPECT_EQ(runs[1].weighted.mean, runs[2].weighted.mean);
     EXPECT_EQ(runs[1].map, runs[2].map);
+  }
+}
+
+// Every upsampling method and variant (spatial, temporal, herzog, drobot, taau: their frame code and the
+// reprojection rows are dispatched) on a 64 x 48 sequence, k = 4: a camera pan and a moving square, 12 frames
+// (history, disocclusions, the locks of taau). Returns every output value of every frame.
+std::vector<float> run_upsample(Level level, const upsample::MethodVariant& v) {
+  isa::ScopedLevel scope(level);  // a state runs the copy of the level active when it is made
+  auto o = upsample::make_options(v.method, v.args);
+  EXPECT_TRUE(o.has_value()) << v.name;
+  if (!o) return {};
+  test::SyntheticScene scene;
+  scene.camera_velocity = {1.25f, 0.5f};
+  scene.object = true;
+  scene.object_velocity = {-0.75f, 0.25f};
+  upsample::Upsampler u(*o);
+  const std::vector<std::string> rgb = {"R", "G", "B"};
+  std::vector<float> out;
+  for (int t = 0; t < 12; ++t) {
+    const test::SyntheticFrame f = test::make_frame(scene, t);
+    auto r = u.process(f.gbuffer, f.low, rgb, false);
+    EXPECT_TRUE(r.has_value()) << v.name << ": " << (r ? "" : r.error().message);
+    if (!r) return {};
+    for (const auto& c : rgb) out.insert(out.end(), (*r)->plane(c), (*r)->plane(c) + (*r)->pixel_count());
+  }
+  return out;
+}
+
+TEST(Isa, UpsamplingAgreesAtEveryLevel) {
+  const std::vector<Level> here = levels_here();
+  if (here.size() < 2) GTEST_SKIP() << "one kernel copy runs on this machine: nothing to compare";
+  for (const upsample::MethodVariant& v : upsample::method_variants()) {
+    std::vector<std::vector<float>> runs;
+    for (Level l : here) runs.push_back(run_upsample(l, v));
+    ASSERT_FALSE(runs[0].empty()) << v.name;
+    for (std::size_t k = 1; k < runs.size(); ++k) {
+      ASSERT_EQ(runs[0].size(), runs[k].size());
+      // Payloads are in [0, 1]. v2 has no FMA: products rounded before a sum. Each method's fast kernels
+      // already differ from their plain reference implementation by up to 5.2e-6 through such rounding
+      // (tests/upsample/reference_test.cpp); a history carries a difference from frame to frame, so the copies
+      // are held to that test's tolerance, 5e-5.
+      float worst = 0.0f;
+      for (std::size_t i = 0; i < runs[0].size(); ++i) {
+        const float a = runs[0][i], b = runs[k][i];
+        worst = std::max(worst, std::isnan(a) != std::isnan(b) ? 1.0f : std::isnan(a) ? 0.0f : std::fabs(a - b));
+      }
+      EXPECT_LE(worst, 5e-5f) << v.name << ": v2 against " << isa::name(here[k]);
+    }
+    if (here.size() == 3) {
+      // v3 and v4: the same operations per pixel. Compared by bits (NaN payloads included).
+      EXPECT_EQ(0, std::memcmp(runs[1].data(), runs[2].data(), runs[1].size() * sizeof(float)))
+          << v.name << ": v3 and v4 differ";
+    }
   }
 }
 
