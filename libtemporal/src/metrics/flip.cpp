@@ -12,6 +12,7 @@
 #include "temporal/metrics/flip.h"
 
 #include "temporal/core/fast_math.h"
+#include "temporal/core/isa.h"
 #include "temporal/core/parallel.h"
 
 #include <algorithm>
@@ -246,7 +247,7 @@ FlipExposures automatic_exposures(const FlipImage& ref, std::size_t count, FlipT
 namespace {
 
 using flip::Color;
-constexpr int kStrip = 64;  // pixels per filter strip: 4 AVX-512 (8 AVX2) registers per accumulator
+constexpr int kStrip = 64;  // pixels per filter strip: 4 AVX-512, 8 AVX2 or 16 SSE registers per accumulator
 
 // How the input images become linear RGB in [0, 1] before YyCxCz.
 enum class Prepare { Srgb, Linear, ToneRational, ToneReinhard };
@@ -272,130 +273,6 @@ struct Plane {
     }
   }
 };
-
-// GCC vector types for the filters: with plain loops GCC vectorised the vertical filter across its taps, with
-// gathers, at a tenth of the speed. A strip of kStrip floats is four Vec16 (four AVX-512 registers, or eight
-// AVX2 ones once lowered).
-using Vec16 = float __attribute__((vector_size(64)));
-static_assert(kStrip == 64, "a strip is four Vec16");
-inline Vec16 load16(const float* p) {
-  Vec16 v;
-  std::memcpy(&v, p, sizeof v);
-  return v;
-}
-inline void store16(float* p, const Vec16& v) { std::memcpy(p, &v, sizeof v); }
-
-// Step (1) on `count` pixels: linear RGB in [0, 1] (decoded, or exposed by `scale` and tone-mapped, then
-// clamped) -> YyCxCz, and Yf = (Y + 16) / 116 for the feature filters. Invalid pixels are black. The pixel
-// loops are free functions with restrict parameters: inside the parallel lambdas GCC could not prove that the
-// outputs do not alias the captured pointers; `valid` is a template choice because a load under a null test
-// keeps a loop from vectorising.
-template <Prepare P, bool Valid>
-[[gnu::noinline]] void prepare_span(const float* __restrict R, const float* __restrict G, const float* __restrict Bl,
-                                    const std::uint8_t* __restrict valid, float scale, const float* __restrict k,
-                                    float* __restrict Y, float* __restrict Cx, float* __restrict Cz,
-                                    float* __restrict Yf, std::size_t count) {
-  const float* m = flip::kRgbToXyz;
-  const float k0 = k[0], k1 = k[1], k2 = k[2], k3 = k[3], k4 = k[4], k5 = k[5];
-  for (std::size_t i = 0; i < count; ++i) {
-    bool ok = true;
-    if constexpr (Valid) ok = valid[i] != 0;
-    float c[3] = {ok ? R[i] : 0.0f, ok ? G[i] : 0.0f, ok ? Bl[i] : 0.0f};
-    if constexpr (P == Prepare::Srgb) {
-      for (float& v : c) {
-        const float curve = fast_math::pow((v + 0.055f) / 1.055f, 2.4f), linear = v / 12.92f;
-        v = v <= 0.04045f ? linear : curve;
-      }
-    } else if constexpr (P == Prepare::ToneRational) {
-      for (float& v : c) {
-        v *= scale;
-        v = (v * v * k0 + v * k1 + k2) / (v * v * k3 + v * k4 + k5);
-      }
-    } else if constexpr (P == Prepare::ToneReinhard) {
-      for (float& v : c) v *= scale;
-      const float s = 1.0f / (1.0f + 0.2126f * c[0] + 0.7152f * c[1] + 0.0722f * c[2]);
-      for (float& v : c) v *= s;
-    }
-    for (float& v : c) v = std::min(std::max(v, 0.0f), 1.0f);
-    const float x = (m[0] * c[0] + m[1] * c[1] + m[2] * c[2]) * flip::kInvWhite[0];
-    const float y = (m[3] * c[0] + m[4] * c[1] + m[5] * c[2]) * flip::kInvWhite[1];
-    const float z = (m[6] * c[0] + m[7] * c[1] + m[8] * c[2]) * flip::kInvWhite[2];
-    const float luma = 116.0f * y - 16.0f;
-    Y[i] = luma;
-    Cx[i] = 500.0f * (x - y);
-    Cz[i] = 200.0f * (y - z);
-    Yf[i] = luma * (1.0f / 116.0f) + 16.0f / 116.0f;  // the feature filters' input, Y normalised to [0, 1]
-  }
-}
-
-// Step (1) for one row: the input pointers at the row's first pixel, the outputs where the row goes.
-using PrepareRow = void (*)(const float*, const float*, const float*, const std::uint8_t*, float, const float*,
-                            float*, float*, float*, float*, std::size_t);
-
-PrepareRow prepare_row(Prepare how, bool valid) {
-  switch (how) {
-    case Prepare::Srgb: return valid ? prepare_span<Prepare::Srgb, true> : prepare_span<Prepare::Srgb, false>;
-    case Prepare::Linear: return valid ? prepare_span<Prepare::Linear, true> : prepare_span<Prepare::Linear, false>;
-    case Prepare::ToneRational:
-      return valid ? prepare_span<Prepare::ToneRational, true> : prepare_span<Prepare::ToneRational, false>;
-    case Prepare::ToneReinhard:
-      return valid ? prepare_span<Prepare::ToneReinhard, true> : prepare_span<Prepare::ToneReinhard, false>;
-  }
-  return nullptr;
-}
-
-// Step (3) per pixel of a strip: filtered YyCxCz -> XYZ -> linear RGB clamped to [0, 1] (the reference's order)
-// -> XYZ -> CIELab -> Hunt. Not inlined: in the caller's tile loop GCC loses the restrict guarantees and does
-// not vectorise it.
-[[gnu::noinline]] void lab_span(const float* __restrict fy, const float* __restrict fcx, const float* __restrict fcz1,
-                                const float* __restrict fcz2, float* __restrict L, float* __restrict A,
-                                float* __restrict B, int count) {
-  const float* mi = flip::kXyzToRgb;
-  const float* mf = flip::kRgbToXyz;
-  const auto fast_cbrt = [](float t) { return fast_math::cbrt(t); };
-  for (int i = 0; i < count; ++i) {
-    const float yy = (fy[i] + 16.0f) * (1.0f / 116.0f);
-    const float X = (yy + fcx[i] * (1.0f / 500.0f)) * flip::kWhite[0];
-    const float Yv = yy * flip::kWhite[1];
-    const float Z = (yy - (fcz1[i] + fcz2[i]) * (1.0f / 200.0f)) * flip::kWhite[2];
-    const float r = flip::clamp01(mi[0] * X + mi[1] * Yv + mi[2] * Z);
-    const float g = flip::clamp01(mi[3] * X + mi[4] * Yv + mi[5] * Z);
-    const float b = flip::clamp01(mi[6] * X + mi[7] * Yv + mi[8] * Z);
-    const Color lab = flip::lab_from_xyz(mf[0] * r + mf[1] * g + mf[2] * b, mf[3] * r + mf[4] * g + mf[5] * b,
-                                         mf[6] * r + mf[7] * g + mf[8] * b, fast_cbrt);
-    L[i] = lab[0];
-    A[i] = 0.01f * lab[0] * lab[1];
-    B[i] = 0.01f * lab[0] * lab[2];
-  }
-}
-
-// Edge and point magnitudes from the filtered first and second derivatives.
-[[gnu::noinline]] void feature_span(const float* __restrict dx, const float* __restrict ddx,
-                                    const float* __restrict dy, const float* __restrict ddy, float* __restrict E,
-                                    float* __restrict P, int count) {
-  for (int i = 0; i < count; ++i) {
-    E[i] = std::sqrt(dx[i] * dx[i] + dy[i] * dy[i]);
-    P[i] = std::sqrt(ddx[i] * ddx[i] + ddy[i] * ddy[i]);
-  }
-}
-
-// out_k[i] = sum_t w_k[t] src[t * step + i] for the kStrip pixels of a strip, K outputs from one input (each
-// input vector loaded once for all K): along a row (step 1) or down a column (step = plane width).
-template <int K>
-inline void strip_fir(const float* src, std::ptrdiff_t step, int taps, const float* const (&w)[K],
-                      float* const (&out)[K]) {
-  Vec16 acc[K][4] = {};
-  for (int t = 0; t < taps; ++t) {
-    const float* s = src + std::ptrdiff_t(t) * step;
-    const Vec16 v[4] = {load16(s), load16(s + 16), load16(s + 32), load16(s + 48)};
-    for (int k = 0; k < K; ++k) {
-      const float wt = w[k][t];
-      for (int j = 0; j < 4; ++j) acc[k][j] += wt * v[j];
-    }
-  }
-  for (int k = 0; k < K; ++k)
-    for (int j = 0; j < 4; ++j) store16(out[k] + 16 * j, acc[k][j]);
-}
 
 struct Filters {
   double ppd = 0.0;
@@ -441,202 +318,66 @@ enum { kL, kA, kB, kEdge, kPoint, kProducts };
 struct RowInput {
   const FlipImage* image;
   const std::uint8_t* valid;
-  PrepareRow prepare;
+  Prepare how;
   float scale;
   const float* k;
 };
 
-void horizontal_pass(const RowInput& in, int w, int h, const Filters& f, Plane (&out)[kHorizontal]) {
-  parallel_rows(h, [&](int y0, int y1) {
-    const int margin = std::max(f.rs, f.rf);
-    const std::size_t len = std::size_t(w + 2 * margin + kStrip);
-    std::vector<float> rows(4 * len);
-    float* const buf[4] = {rows.data(), rows.data() + len, rows.data() + 2 * len, rows.data() + 3 * len};  // Y Cx Cz Yf
-    alignas(64) float sink[kHorizontal][kStrip];  // the last strip's overhang
-    for (int y = y0; y < y1; ++y) {
-      const std::size_t o = std::size_t(y) * std::size_t(w);
-      const std::uint8_t* valid = in.valid ? in.valid + o : nullptr;
-      in.prepare(in.image->r + o, in.image->g + o, in.image->b + o, valid, in.scale, in.k, buf[0] + margin,
-                 buf[1] + margin, buf[2] + margin, buf[3] + margin, std::size_t(w));
-      for (float* b : buf) {
-        std::fill(b, b + margin, b[margin]);
-        std::fill(b + margin + w, b + 2 * margin + w, b[margin + w - 1]);
-      }
-      for (int x0 = 0; x0 < w; x0 += kStrip) {
-        // Full strips write in place; the last one through `sink` so nothing past the row is overwritten.
-        const bool full = x0 + kStrip <= w;
-        float* dst[kHorizontal];
-        for (int p = 0; p < kHorizontal; ++p) dst[p] = full ? out[p].data() + o + std::size_t(x0) : sink[p];
-        auto window = [&](int b, int r) { return buf[b] + margin + x0 - r; };
-        strip_fir<1>(window(0, f.ry), 1, 2 * f.ry + 1, {f.spatial.y.data()}, {dst[kHY]});
-        strip_fir<1>(window(1, f.rcx), 1, 2 * f.rcx + 1, {f.spatial.cx.data()}, {dst[kHCx]});
-        strip_fir<2>(window(2, f.rs), 1, 2 * f.rs + 1, {f.spatial.cz1.data(), f.spatial.cz2.data()},
-                     {dst[kHCz1], dst[kHCz2]});
-        strip_fir<3>(window(3, f.rf), 1, 2 * f.rf + 1, {f.feature.g.data(), f.feature.dg.data(), f.feature.ddg.data()},
-                     {dst[kHG], dst[kHDG], dst[kHDDG]});
-        if (!full)
-          for (int p = 0; p < kHorizontal; ++p) std::copy(sink[p], sink[p] + (w - x0), out[p].data() + o + std::size_t(x0));
-      }
-    }
-  });
-  for (auto& p : out) p.fill_margins(h);
-}
-
-// Tiles of kStrip columns by kBand rows, each walked down its rows: the 2 r + 1 tap rows of one output row,
-// kStrip wide (about 21 kB for the four colour planes at 67 ppd), stay in the 32 kB L1 cache from one output
-// row to the next, which needs one new row per plane. Whole image rows instead (seven planes times 21 taps of
-// 1920 pixels, 1 MB) made the vertical pass wait on memory.
-template <typename Body>
-void for_tiles(int w, int h, Body&& body) {
-  constexpr int kBand = 64;
-  const int strips = (w + kStrip - 1) / kStrip, bands = (h + kBand - 1) / kBand;
-  parallel_chunks(
-      std::size_t(strips) * std::size_t(bands),
-      [&](std::size_t t0, std::size_t t1) {
-        for (std::size_t tile = t0; tile < t1; ++tile) {
-          const int x0 = int(tile % std::size_t(strips)) * kStrip, y0 = int(tile / std::size_t(strips)) * kBand;
-          body(x0, std::min(kStrip, w - x0), y0, std::min(y0 + kBand, h));
-        }
-      },
-      4);
-}
-
-// Two consecutive output rows of a vertical filter on a strip: out0 from input rows 0 .. taps - 1 of `src`,
-// out1 from rows 1 .. taps. Each input row is loaded once for both (taps + 1 loads for two outputs instead of
-// 2 taps), which halves the loads of the vertical passes; the multiply-adds stay.
-template <int K>
-inline void column_fir2(const float* src, std::ptrdiff_t step, int taps, const float* const (&w)[K],
-                        float* const (&out0)[K], float* const (&out1)[K]) {
-  Vec16 a[K][4] = {}, b[K][4] = {};
-  auto load = [&](int t, Vec16 (&v)[4]) {
-    const float* s = src + std::ptrdiff_t(t) * step;
-    for (int j = 0; j < 4; ++j) v[j] = load16(s + 16 * j);
-  };
-  Vec16 v[4];
-  load(0, v);
-  for (int k = 0; k < K; ++k)
-    for (int j = 0; j < 4; ++j) a[k][j] += w[k][0] * v[j];
-  for (int t = 1; t < taps; ++t) {
-    load(t, v);
-    for (int k = 0; k < K; ++k) {
-      const float wa = w[k][t], wb = w[k][t - 1];
-      for (int j = 0; j < 4; ++j) {
-        a[k][j] += wa * v[j];
-        b[k][j] += wb * v[j];
-      }
-    }
-  }
-  load(taps, v);
-  for (int k = 0; k < K; ++k)
-    for (int j = 0; j < 4; ++j) b[k][j] += w[k][taps - 1] * v[j];
-  for (int k = 0; k < K; ++k)
-    for (int j = 0; j < 4; ++j) {
-      store16(out0[k] + 16 * j, a[k][j]);
-      store16(out1[k] + 16 * j, b[k][j]);
-    }
-}
-
-// Runs `rows(y, pair)` down a tile: pairs of output rows where two remain, then a single one.
-template <typename Rows>
-void down_tile(int y0, int y1, Rows&& rows) {
-  int y = y0;
-  for (; y + 1 < y1; y += 2) rows(y, true);
-  if (y < y1) rows(y, false);
-}
-
-// Step (3a): the vertical CSF filters and, per pixel, the Hunt-adjusted CIELab of the filtered colour.
-void vertical_color_pass(const Plane (&in)[kHorizontal], int w, int h, const Filters& f, Plane (&out)[kProducts]) {
-  for_tiles(w, h, [&](int x0, int m, int y0, int y1) {
-    alignas(64) float acc[2][4][kStrip];
-    down_tile(y0, y1, [&](int y, bool pair) {
-      const std::ptrdiff_t step = w;
-      auto filter = [&](int plane, int r, const std::vector<float>& taps, int slot) {
-        const float* top = in[plane].data() + std::ptrdiff_t(y - r) * w + x0;
-        if (pair) column_fir2<1>(top, step, 2 * r + 1, {taps.data()}, {acc[0][slot]}, {acc[1][slot]});
-        else strip_fir<1>(top, step, 2 * r + 1, {taps.data()}, {acc[0][slot]});
-      };
-      filter(kHY, f.ry, f.spatial.y, 0);
-      filter(kHCx, f.rcx, f.spatial.cx, 1);
-      filter(kHCz1, f.rs, f.spatial.cz1, 2);
-      filter(kHCz2, f.rs, f.spatial.cz2, 3);
-      for (int k = 0; k < (pair ? 2 : 1); ++k) {
-        const std::size_t o = std::size_t(y + k) * std::size_t(w) + std::size_t(x0);
-        lab_span(acc[k][0], acc[k][1], acc[k][2], acc[k][3], out[kL].data() + o, out[kA].data() + o,
-                 out[kB].data() + o, m);
-      }
-    });
-  });
-}
-
-// Step (3b): the vertical feature filters (Gaussian down the x-derivatives, derivatives down the x-Gaussian)
-// and, per pixel, the edge and point magnitudes.
-void vertical_feature_pass(const Plane (&in)[kHorizontal], int w, int h, const Filters& f, Plane (&out)[kProducts]) {
-  for_tiles(w, h, [&](int x0, int m, int y0, int y1) {
-    const int r = f.rf, taps = 2 * r + 1;
-    alignas(64) float acc[2][4][kStrip];
-    down_tile(y0, y1, [&](int y, bool pair) {
-      const std::ptrdiff_t top = std::ptrdiff_t(y - r) * w + x0, step = w;
-      const float* g = f.feature.g.data();
-      if (pair) {
-        column_fir2<1>(in[kHDG].data() + top, step, taps, {g}, {acc[0][0]}, {acc[1][0]});   // d/dx
-        column_fir2<1>(in[kHDDG].data() + top, step, taps, {g}, {acc[0][1]}, {acc[1][1]});  // d2/dx2
-        column_fir2<2>(in[kHG].data() + top, step, taps, {f.feature.dg.data(), f.feature.ddg.data()},
-                       {acc[0][2], acc[0][3]}, {acc[1][2], acc[1][3]});  // d/dy, d2/dy2
-      } else {
-        strip_fir<1>(in[kHDG].data() + top, step, taps, {g}, {acc[0][0]});
-        strip_fir<1>(in[kHDDG].data() + top, step, taps, {g}, {acc[0][1]});
-        strip_fir<2>(in[kHG].data() + top, step, taps, {f.feature.dg.data(), f.feature.ddg.data()},
-                     {acc[0][2], acc[0][3]});
-      }
-      for (int k = 0; k < (pair ? 2 : 1); ++k) {
-        const std::size_t o = std::size_t(y + k) * std::size_t(w) + std::size_t(x0);
-        feature_span(acc[k][0], acc[k][1], acc[k][2], acc[k][3], out[kEdge].data() + o, out[kPoint].data() + o, m);
-      }
-    });
-  });
-}
-
-// Step (4): FLIP per pixel from the two images' quantities, on pixels [begin, end). Max: HDR-FLIP's running
-// maximum over exposures (strictly greater replaces, as the reference), recording `exposure` in `which`.
-struct CombineConstants {
-  float knee, below, above;
+// fast_math::cbrt for flip::lab_from_xyz in the kernels. Defined here, for the baseline, so that the baseline
+// template inlines it in every copy (a lambda defined in a copy has the copy's target and would be called).
+struct FastCbrt {
+  float operator()(float t) const { return fast_math::cbrt(t); }
 };
 
-template <bool Max, bool Valid>
-[[gnu::noinline]] void combine_span(const float* __restrict L1, const float* __restrict A1, const float* __restrict B1,
-                  const float* __restrict E1, const float* __restrict P1, const float* __restrict L2,
-                  const float* __restrict A2, const float* __restrict B2, const float* __restrict E2,
-                  const float* __restrict P2, const std::uint8_t* __restrict valid, float* __restrict out,
-                  float* __restrict which, float exposure, CombineConstants k, std::size_t begin, std::size_t end) {
-  const float half = float(1.0 / std::numbers::sqrt2);
-  for (std::size_t i = begin; i < end; ++i) {
-    const float da = A1[i] - A2[i], db = B1[i] - B2[i];
-    const float distance = std::fabs(L1[i] - L2[i]) + std::sqrt(da * da + db * db);  // HyAB
-    const float c = fast_math::pow(distance, flip::kQc);
-    const float color = c < k.knee ? c * k.below : flip::kPt + (c - k.knee) * k.above;
-    const float feature = std::sqrt(std::max(std::fabs(E1[i] - E2[i]), std::fabs(P1[i] - P2[i])) * half);  // ^q_f
-    float v = fast_math::pow(color, 1.0f - feature);
-    if constexpr (Valid) v = valid[i] ? v : 0.0f;
-    if constexpr (Max) {
-      const bool larger = v > out[i];
-      out[i] = larger ? v : out[i];
-      which[i] = larger ? exposure : which[i];
-    } else {
-      out[i] = v;
-    }
-  }
-}
+// ---------------------------------------------------------------------------------------------------------
+// The kernel copies, one per instruction set (temporal/core/isa.h): the same source, flip_kernels.inc, with the
+// vector width and register count of the target. The copies differ only in FMA contraction (v2 has none).
+#if TEMPORAL_ISA_DISPATCH
+namespace v2 {
+constexpr int kLanes = 4, kRegisters = 16;  // SSE
+#include "flip_kernels.inc"
+}  // namespace v2
+TEMPORAL_ISA_V3_BEGIN
+namespace v3 {
+constexpr int kLanes = 8, kRegisters = 16;  // AVX2
+#include "flip_kernels.inc"
+}  // namespace v3
+TEMPORAL_ISA_END
+TEMPORAL_ISA_V4_BEGIN
+namespace v4 {
+constexpr int kLanes = 16, kRegisters = 32;  // AVX-512
+#include "flip_kernels.inc"
+}  // namespace v4
+TEMPORAL_ISA_END
+#else
+namespace native {
+#if defined(__AVX512F__)
+constexpr int kLanes = 16, kRegisters = 32;
+#elif defined(__AVX__)
+constexpr int kLanes = 8, kRegisters = 16;
+#elif defined(__aarch64__)
+constexpr int kLanes = 4, kRegisters = 32;  // NEON
+#else
+constexpr int kLanes = 4, kRegisters = 16;
+#endif
+#include "flip_kernels.inc"
+}  // namespace native
+#endif
 
-template <bool Max, bool Valid>
-void combine_pass(const Plane (&ref)[kProducts], const Plane (&test)[kProducts], std::size_t n,
-                  const std::uint8_t* valid, float* map, float* exposure_map, float exposure) {
-  const float cmax = flip::max_color_difference(), knee = flip::kPc * cmax;
-  const CombineConstants k{knee, flip::kPt / knee, (1.0f - flip::kPt) / (cmax - knee)};
-  parallel_chunks(n, [&](std::size_t b, std::size_t e) {
-    combine_span<Max, Valid>(ref[kL].data(), ref[kA].data(), ref[kB].data(), ref[kEdge].data(), ref[kPoint].data(),
-                             test[kL].data(), test[kA].data(), test[kB].data(), test[kEdge].data(),
-                             test[kPoint].data(), valid, map, exposure_map, exposure, k, b, e);
-  });
+struct Kernels {
+  void (*image)(const RowInput&, int, int, const Filters&, Plane (&)[kHorizontal], Plane (&)[kProducts]);
+  void (*combine)(bool, const Plane (&)[kProducts], const Plane (&)[kProducts], std::size_t, const std::uint8_t*,
+                  float*, float*, float);
+};
+
+const Kernels& kernels() {
+#if TEMPORAL_ISA_DISPATCH
+  static constexpr Kernels table[3] = {{v2::image, v2::combine}, {v3::image, v3::combine}, {v4::image, v4::combine}};
+  return table[int(isa::active())];  // Level::V2, V3, V4 are 0, 1, 2
+#else
+  static constexpr Kernels table{native::image, native::combine};
+  return table;
+#endif
 }
 
 Status check_inputs(const FlipImage& test, const FlipImage& ref, int width, int height, const float* map,
@@ -679,10 +420,8 @@ struct FlipEvaluator::Workspace {
   // Steps (1)-(3) for one image into products[slot].
   void image(const FlipImage& in, int w, int h, const std::uint8_t* valid, Prepare how, float scale,
              FlipToneMapper tone, int slot) {
-    const RowInput rows{&in, valid, prepare_row(how, valid != nullptr), scale, flip::rational_coefficients(tone)};
-    horizontal_pass(rows, w, h, filters, horizontal);
-    vertical_color_pass(horizontal, w, h, filters, products[slot]);
-    vertical_feature_pass(horizontal, w, h, filters, products[slot]);
+    const RowInput rows{&in, valid, how, scale, flip::rational_coefficients(tone)};
+    kernels().image(rows, w, h, filters, horizontal, products[slot]);
   }
 };
 
@@ -699,8 +438,7 @@ Status FlipEvaluator::ldr(const FlipImage& test, const FlipImage& reference, int
   const Prepare how = options_.ldr_input == FlipLdrInput::Srgb ? Prepare::Srgb : Prepare::Linear;
   work_->image(reference, width, height, valid, how, 1.0f, options_.tone_mapper, 0);
   work_->image(test, width, height, valid, how, 1.0f, options_.tone_mapper, 1);
-  if (valid) combine_pass<false, true>(work_->products[0], work_->products[1], n, valid, map, nullptr, 0.0f);
-  else combine_pass<false, false>(work_->products[0], work_->products[1], n, valid, map, nullptr, 0.0f);
+  kernels().combine(false, work_->products[0], work_->products[1], n, valid, map, nullptr, 0.0f);
   return {};
 }
 
@@ -733,8 +471,7 @@ Expected<FlipExposures> FlipEvaluator::hdr(const FlipImage& test, const FlipImag
     work_->image(reference, width, height, valid, how, scale, options_.tone_mapper, 0);
     work_->image(test, width, height, valid, how, scale, options_.tone_mapper, 1);
     const float which = float(i) / float(e.count - 1);
-    if (valid) combine_pass<true, true>(work_->products[0], work_->products[1], n, valid, map, exposures, which);
-    else combine_pass<true, false>(work_->products[0], work_->products[1], n, valid, map, exposures, which);
+    kernels().combine(true, work_->products[0], work_->products[1], n, valid, map, exposures, which);
   }
   return e;
 }

@@ -6,6 +6,7 @@
 
 #include "temporal/core/color.h"
 #include "temporal/core/image.h"
+#include "temporal/core/isa.h"
 #include "temporal/core/parallel.h"
 
 #include <algorithm>
@@ -172,164 +173,40 @@ std::vector<double> ssim_gaussian_taps(double sigma, int radius) {
 
 namespace {
 
-// FIR filters of the separable Gaussian. With the tap count known at compile time (11 for Wang et al.'s
-// window) the tap loop unrolls and the x loop vectorises with one store per output, instead of a
-// read-modify-write of the output row per tap.
-template <int N>
-void fir_row(const double* __restrict in, double* __restrict out, int n, const double* __restrict g) {
-  for (int x = 0; x < n; ++x) {
-    double s = 0.0;
-    for (int k = 0; k < N; ++k) s += g[k] * in[x + k];
-    out[x] = s;
-  }
-}
-template <int N>
-void fir_column(const double* const* rows, double* __restrict out, int n, const double* __restrict g) {
-  const double* r[N];
-  for (int k = 0; k < N; ++k) r[k] = rows[k];
-  for (int x = 0; x < n; ++x) {
-    double s = 0.0;
-    for (int k = 0; k < N; ++k) s += g[k] * r[k][x];
-    out[x] = s;
-  }
-}
-void fir_row_any(const double* __restrict in, double* __restrict out, int n, const double* g, int taps) {
-  std::fill(out, out + n, 0.0);
-  for (int k = 0; k < taps; ++k)
-    for (int x = 0; x < n; ++x) out[x] += g[k] * in[x + k];
-}
-void fir_column_any(const double* const* rows, double* __restrict out, int n, const double* g, int taps) {
-  std::fill(out, out + n, 0.0);
-  for (int k = 0; k < taps; ++k)
-    for (int x = 0; x < n; ++x) out[x] += g[k] * rows[k][x];
-}
+// The SSIM kernel copies, one per instruction set (temporal/core/isa.h); they differ only in FMA contraction of
+// the double-precision filters (v3 and v4 contract, v2 cannot), a few 1e-16 relative.
+#if TEMPORAL_ISA_DISPATCH
+namespace v2 {
+#include "ssim_kernels.inc"
+}  // namespace v2
+TEMPORAL_ISA_V3_BEGIN
+namespace v3 {
+#include "ssim_kernels.inc"
+}  // namespace v3
+TEMPORAL_ISA_END
+TEMPORAL_ISA_V4_BEGIN
+namespace v4 {
+#include "ssim_kernels.inc"
+}  // namespace v4
+TEMPORAL_ISA_END
+#else
+namespace native {
+#include "ssim_kernels.inc"
+}  // namespace native
+#endif
 
-// Weighted: invalid pixels get weight 0 and the window statistics are divided by the remaining weight
-// (normalised convolution); unweighted is Wang et al.'s plain Gaussian filtering (weights sum to 1).
-//
-// Separable and fused: each task takes a band of output rows, runs the horizontal 11-tap pass over the band's
-// input rows into a ring of 2r+1 rows per plane (about 5 x 11 x width doubles, cache-resident), and the
-// vertical pass straight out of the ring, so no full-size intermediate plane is written to memory.
-template <bool Weighted>
-SsimResult ssim_impl(const float* test, const float* reference, int width, int height, const std::uint8_t* valid,
-                     const float* mask, const SsimOptions& o, float* map) {
-  constexpr int kPlanes = Weighted ? 6 : 5;
-  const int r = o.radius, taps_n = 2 * r + 1;
-  const int ow = width - 2 * r, oh = height - 2 * r;  // window centres ("valid" filtering)
-  const std::size_t row_len = std::size_t(ow);
-  const std::vector<double> g = ssim_gaussian_taps(o.sigma, r);
-  const double c1 = (o.k1 * o.peak) * (o.k1 * o.peak);
-  const double c2 = (o.k2 * o.peak) * (o.k2 * o.peak);
-  struct Row {
-    double sum = 0, sum_in = 0;
-    std::size_t n = 0, n_in = 0;
-  };
-  if (map) std::fill(map, map + std::size_t(width) * std::size_t(height), 0.0f);
-  std::vector<Row> rows(std::size_t(std::max(oh, 0)));
+using SsimKernel = SsimResult (*)(const float*, const float*, int, int, const std::uint8_t*, const float*,
+                                  const SsimOptions&, float*);
 
-  parallel_rows(
-      oh,
-      [&](int y0, int y1) {
-        std::vector<double> prod(std::size_t(width) * kPlanes);
-        std::vector<double> ring(std::size_t(taps_n) * row_len * kPlanes);
-        std::vector<double> acc(row_len * kPlanes);
-        std::vector<double> srow(row_len);
-        std::vector<const double*> column(static_cast<std::size_t>(taps_n));
-        auto ring_row = [&](int q, int y) { return ring.data() + (std::size_t(q) * std::size_t(taps_n) + std::size_t(y % taps_n)) * row_len; };
-
-        // Horizontal pass of input row y into the ring: products, then the FIR (tap-outer: unit stride).
-        auto horizontal = [&](int y) {
-          const std::size_t o_in = std::size_t(y) * std::size_t(width);
-          const float* xr = test + o_in;
-          const float* yr = reference + o_in;
-          double* p[6];
-          for (int q = 0; q < kPlanes; ++q) p[q] = prod.data() + std::size_t(q) * std::size_t(width);
-          for (int x = 0; x < width; ++x) {
-            double a = xr[x], b = yr[x], w = 1.0;
-            if constexpr (Weighted) {
-              w = valid[o_in + std::size_t(x)] ? 1.0 : 0.0;
-              a = w != 0.0 ? a : 0.0;
-              b = w != 0.0 ? b : 0.0;
-              p[5][x] = w;
-            }
-            p[0][x] = a;
-            p[1][x] = b;
-            p[2][x] = a * a;
-            p[3][x] = b * b;
-            p[4][x] = a * b;
-          }
-          for (int q = 0; q < kPlanes; ++q) {
-            if (taps_n == 11) fir_row<11>(p[q], ring_row(q, y), ow, g.data());
-            else fir_row_any(p[q], ring_row(q, y), ow, g.data(), taps_n);
-          }
-        };
-
-        for (int y = y0; y < y0 + 2 * r; ++y) horizontal(y);
-        for (int yo = y0; yo < y1; ++yo) {
-          horizontal(yo + 2 * r);
-          // Vertical pass: window sums of the five (six) products for every centre of output row yo.
-          for (int q = 0; q < kPlanes; ++q) {
-            for (int k = 0; k < taps_n; ++k) column[std::size_t(k)] = ring_row(q, yo + k);
-            double* out = acc.data() + std::size_t(q) * row_len;
-            if (taps_n == 11) fir_column<11>(column.data(), out, ow, g.data());
-            else fir_column_any(column.data(), out, ow, g.data(), taps_n);
-          }
-          // Wang et al. eq. 13 for the whole row (branch-free, vectorises), then the sums over kept windows.
-          // Window sums are in double: E[x^2] - E[x]^2 cancels, and float sums moved SSIM by ~1e-4 even on
-          // [0,1] data (C2 = 9e-4 is small against the float rounding of E[x^2] ~ 0.3).
-          const double* __restrict a0 = acc.data();
-          const double* __restrict a1 = a0 + row_len;
-          const double* __restrict a2 = a1 + row_len;
-          const double* __restrict a3 = a2 + row_len;
-          const double* __restrict a4 = a3 + row_len;
-          const double* __restrict a5 = Weighted ? a4 + row_len : nullptr;
-          for (int x = 0; x < ow; ++x) {
-            double inv = 1.0;
-            if constexpr (Weighted) inv = a5[x] > 1e-12 ? 1.0 / a5[x] : 0.0;
-            const double mx = a0[x] * inv, my = a1[x] * inv;
-            const double sxx = a2[x] * inv - mx * mx;
-            const double syy = a3[x] * inv - my * my;
-            const double sxy = a4[x] * inv - mx * my;
-            srow[std::size_t(x)] =
-                ((2.0 * mx * my + c1) * (2.0 * sxy + c2)) / ((mx * mx + my * my + c1) * (sxx + syy + c2));
-          }
-          Row row;
-          const std::size_t centre0 = std::size_t(yo + r) * std::size_t(width) + std::size_t(r);
-          for (int x = 0; x < ow; ++x) {
-            const std::size_t centre = centre0 + std::size_t(x);
-            if constexpr (Weighted) {
-              if (!valid[centre] || !(a5[x] > 1e-12)) continue;
-            }
-            const double v = srow[std::size_t(x)];
-            row.sum += v;
-            ++row.n;
-            if (mask && mask[centre] > 0.5f) {
-              row.sum_in += v;
-              ++row.n_in;
-            }
-            if (map) map[centre] = float(1.0 - v);
-          }
-          rows[std::size_t(yo)] = row;
-        }
-      },
-      32);  // 32 output rows per task: the 2r extra input rows of each band cost ~30% more horizontal work
-
-  SsimResult result;
-  double sum = 0, sum_in = 0;
-  for (const auto& row : rows) {
-    sum += row.sum;
-    sum_in += row.sum_in;
-    result.windows += row.n;
-    result.windows_inside += row.n_in;
-  }
-  const double nan = std::numeric_limits<double>::quiet_NaN();
-  result.mean = result.windows ? sum / double(result.windows) : nan;
-  if (mask) {
-    result.windows_outside = result.windows - result.windows_inside;
-    result.mean_inside = result.windows_inside ? sum_in / double(result.windows_inside) : nan;
-    result.mean_outside = result.windows_outside ? (sum - sum_in) / double(result.windows_outside) : nan;
-  }
-  return result;
+SsimKernel ssim_kernel(bool weighted) {
+#if TEMPORAL_ISA_DISPATCH
+  static constexpr SsimKernel table[3][2] = {{v2::ssim_impl<false>, v2::ssim_impl<true>},
+                                             {v3::ssim_impl<false>, v3::ssim_impl<true>},
+                                             {v4::ssim_impl<false>, v4::ssim_impl<true>}};
+  return table[int(isa::active())][weighted ? 1 : 0];  // Level::V2, V3, V4 are 0, 1, 2
+#else
+  return weighted ? native::ssim_impl<true> : native::ssim_impl<false>;
+#endif
 }
 
 }  // namespace
@@ -348,9 +225,7 @@ Expected<SsimResult> ssim(const float* test, const float* reference, int width, 
     const std::size_t n = std::size_t(width) * std::size_t(height);
     all_valid = std::find(valid, valid + n, std::uint8_t(0)) == valid + n;
   }
-  if (all_valid)
-    return ssim_impl<false>(test, reference, width, height, valid, mask, options, map);
-  return ssim_impl<true>(test, reference, width, height, valid, mask, options, map);
+  return ssim_kernel(!all_valid)(test, reference, width, height, valid, mask, options, map);
 }
 
 }  // namespace temporal
