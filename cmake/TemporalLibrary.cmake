@@ -49,6 +49,9 @@ function(temporal_add_stage stage)
   set_target_properties(${target} PROPERTIES EXPORT_NAME ${stage} POSITION_INDEPENDENT_CODE ON)
   target_include_directories(${target} PUBLIC
     $<BUILD_INTERFACE:${TEMPORAL_INCLUDE_ROOT}> $<INSTALL_INTERFACE:${CMAKE_INSTALL_INCLUDEDIR}>)
+  # The stage's own folder, for the kernel files temporal/core/isa_copies.inc includes by name (a quoted include
+  # in that file searches its own folder first, not the stage's).
+  target_include_directories(${target} PRIVATE ${CMAKE_CURRENT_SOURCE_DIR})
   foreach(dep IN LISTS TEMPORAL_STAGE_DEPS_${stage})
     target_link_libraries(${target} PUBLIC temporal::${dep})
   endforeach()

@@ -55,25 +55,8 @@ namespace {
 
 // The kernel copies, one per instruction set (temporal/core/isa.h). The bilinear sums w0 p0 + w1 p1 + ... may
 // be contracted into fused multiply-adds in v3 and v4 (v2 has none): the history differs in the last bit there.
-#if TEMPORAL_ISA_DISPATCH
-namespace v2 {
-#include "reproject_kernels.inc"
-}  // namespace v2
-TEMPORAL_ISA_V3_BEGIN
-namespace v3 {
-#include "reproject_kernels.inc"
-}  // namespace v3
-TEMPORAL_ISA_END
-TEMPORAL_ISA_V4_BEGIN
-namespace v4 {
-#include "reproject_kernels.inc"
-}  // namespace v4
-TEMPORAL_ISA_END
-#else
-namespace native {
-#include "reproject_kernels.inc"
-}  // namespace native
-#endif
+#define TEMPORAL_ISA_FILE "reproject_kernels.inc"
+#include "temporal/core/isa_copies.inc"
 
 struct Kernels {
   void (*reproject)(const Frames&, int, HistoryRow&);

@@ -4,6 +4,14 @@
 
 namespace temporal::gpu {
 
+Status ImageBuffer::create_cleared(std::shared_ptr<Context> context, int width, int height, int planes,
+                                   ImageBuffer& buffer) {
+  auto created = create(std::move(context), width, height, planes);
+  if (!created) return created.error();
+  buffer = std::move(*created);
+  return buffer.clear(0, planes);
+}
+
 Expected<ImageBuffer> ImageBuffer::create(std::shared_ptr<Context> context, int width, int height, int planes) {
   if (!context) return Error::internal("gpu::ImageBuffer: no context");
   if (width <= 0 || height <= 0 || planes <= 0) return Error::internal("gpu::ImageBuffer: empty size");

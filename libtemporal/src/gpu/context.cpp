@@ -120,6 +120,14 @@ bool probe_timer_queries(const GlFunctions& gl) {
 
 }  // namespace
 
+Status Context::ensure(std::shared_ptr<Context>& context) {
+  if (context) return Status::ok();
+  auto created = create();
+  if (!created) return created.error();
+  context = std::move(*created);
+  return Status::ok();
+}
+
 Expected<std::shared_ptr<Context>> Context::create(const ContextOptions& options) {
   if (!egl().error.empty()) return Error::usage("--device gpu: " + egl().error);
   auto query_devices = reinterpret_cast<PFNEGLQUERYDEVICESEXTPROC>(egl().GetProcAddress("eglQueryDevicesEXT"));

@@ -175,25 +175,8 @@ namespace {
 
 // The SSIM kernel copies, one per instruction set (temporal/core/isa.h); they differ only in FMA contraction of
 // the double-precision filters (v3 and v4 contract, v2 cannot), a few 1e-16 relative.
-#if TEMPORAL_ISA_DISPATCH
-namespace v2 {
-#include "ssim_kernels.inc"
-}  // namespace v2
-TEMPORAL_ISA_V3_BEGIN
-namespace v3 {
-#include "ssim_kernels.inc"
-}  // namespace v3
-TEMPORAL_ISA_END
-TEMPORAL_ISA_V4_BEGIN
-namespace v4 {
-#include "ssim_kernels.inc"
-}  // namespace v4
-TEMPORAL_ISA_END
-#else
-namespace native {
-#include "ssim_kernels.inc"
-}  // namespace native
-#endif
+#define TEMPORAL_ISA_FILE "ssim_kernels.inc"
+#include "temporal/core/isa_copies.inc"
 
 using SsimKernel = SsimResult (*)(const float*, const float*, int, int, const std::uint8_t*, const float*,
                                   const SsimOptions&, float*);

@@ -86,11 +86,7 @@ class BlendGpu final : public MorphMethod, public gpu::TimedKernel {
 
 Expected<std::unique_ptr<MorphMethod>> make_blend_method_gpu(std::shared_ptr<gpu::Context> context,
                                                              const MorphOptions&) {
-  if (!context) {
-    auto created = gpu::Context::create();
-    if (!created) return created.error();
-    context = std::move(*created);
-  }
+  if (Status s = gpu::Context::ensure(context); !s) return s.error();
   auto program = gpu::Program::compile(context, "blend",
                                        {gpu::glsl::prelude(), gpu::glsl::storage(0, "frames"),
                                         gpu::glsl::storage(1, "outb"), kBlendMain});

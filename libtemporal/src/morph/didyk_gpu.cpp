@@ -1038,11 +1038,7 @@ Expected<std::unique_ptr<MorphMethod>> make_didyk_method_gpu(std::shared_ptr<gpu
   using detail::DidykOptions;
   const DidykOptions& didyk = method_options<DidykOptions>(options.per_method, "didyk");
   if (Status s = didyk.check(); !s) return s.error();
-  if (!context) {
-    auto created = gpu::Context::create();
-    if (!created) return created.error();
-    context = std::move(*created);
-  }
+  if (Status s = gpu::Context::ensure(context); !s) return s.error();
   // One program per pass (u_pass a constant): the compiler keeps only that pass's code. (One program switching on
   // a uniform runs every branch under a mask on llvmpipe, which cannot know the switch is uniform.)
   const std::string defines = constants();

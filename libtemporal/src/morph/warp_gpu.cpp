@@ -134,11 +134,7 @@ class WarpGpu final : public MorphMethod, public gpu::TimedKernel {
 
 Expected<std::unique_ptr<MorphMethod>> make_warp_method_gpu(std::shared_ptr<gpu::Context> context,
                                                             const MorphOptions& options) {
-  if (!context) {
-    auto created = gpu::Context::create();
-    if (!created) return created.error();
-    context = std::move(*created);
-  }
+  if (Status s = gpu::Context::ensure(context); !s) return s.error();
   auto program = gpu::Program::compile(context, "warp",
                                        {gpu::glsl::prelude(), gpu::glsl::storage(0, "src"),
                                         gpu::glsl::storage(1, "keys"), gpu::glsl::storage(2, "outb"), kWarpCommon,

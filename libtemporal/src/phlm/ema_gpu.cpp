@@ -210,11 +210,7 @@ class EmaFilterGpu final : public FrameFilter, public gpu::TimedKernel {
 }  // namespace
 
 Expected<std::unique_ptr<FrameFilter>> make_ema_filter_gpu(std::shared_ptr<gpu::Context> context, EmaParams params) {
-  if (!context) {
-    auto created = gpu::Context::create();
-    if (!created) return created.error();
-    context = std::move(*created);
-  }
+  if (Status s = gpu::Context::ensure(context); !s) return s.error();
   auto program = gpu::Program::compile(
       context, "ema", {gpu::glsl::prelude(), gpu::glsl::storage(0, "src"), gpu::glsl::storage(1, "hist"),
                        gpu::glsl::storage(2, "nxt"), kEmaKernel, gpu::glsl::reproject(), kEmaMain});

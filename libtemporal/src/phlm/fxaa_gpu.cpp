@@ -259,11 +259,7 @@ class FxaaFilterGpu final : public FrameFilter, public gpu::TimedKernel {
 
 Expected<std::unique_ptr<FrameFilter>> make_fxaa_filter_gpu(std::shared_ptr<gpu::Context> context,
                                                            FxaaParams params) {
-  if (!context) {
-    auto created = gpu::Context::create();
-    if (!created) return created.error();
-    context = std::move(*created);
-  }
+  if (Status s = gpu::Context::ensure(context); !s) return s.error();
   const std::string decl =
       gpu::glsl::storage(0, "src") + gpu::glsl::storage(1, "work") + gpu::glsl::storage(2, "outb");
   auto luma = gpu::Program::compile(context, "fxaa luma", {gpu::glsl::prelude(), decl, kFxaaDecl, kLumaMain});

@@ -476,11 +476,7 @@ Expected<std::unique_ptr<FrameFilter>> make_phlm_filter_gpu(std::shared_ptr<gpu:
     return Error::usage("--feature-alpha '" + params.alpha_reading + "' is not one of: ue4, eq1");
   auto fetch = parse_history_fetch(params.model_fetch, "--model-fetch");
   if (!fetch) return fetch.error();
-  if (!context) {
-    auto created = gpu::Context::create();
-    if (!created) return created.error();
-    context = std::move(*created);
-  }
+  if (Status s = gpu::Context::ensure(context); !s) return s.error();
   gpu::Program programs[2];
   for (int k = 0; k < 2; ++k) {
     const std::string define = std::string("#define PHLM_C ") + (k == 0 ? "1" : "3") + "\n#define BOX_C PHLM_C\n";

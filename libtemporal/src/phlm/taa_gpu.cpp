@@ -309,11 +309,7 @@ class TaaFilterGpu final : public FrameFilter, public gpu::TimedKernel {
 Expected<std::unique_ptr<FrameFilter>> make_taa_filter_gpu(std::shared_ptr<gpu::Context> context, TaaParams params) {
   auto cfg = detail::resolve_taa(params);
   if (!cfg) return cfg.error();
-  if (!context) {
-    auto created = gpu::Context::create();
-    if (!created) return created.error();
-    context = std::move(*created);
-  }
+  if (Status s = gpu::Context::ensure(context); !s) return s.error();
   gpu::Program programs[2];
   for (int k = 0; k < 2; ++k) {
     const std::string define = std::string("#define TAA_C ") + (k == 0 ? "1" : "3") + "\n#define BOX_C TAA_C\n";

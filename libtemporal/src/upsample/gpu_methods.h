@@ -62,6 +62,10 @@ std::string_view joint_bilateral_glsl();
 // C++ kernels compute them).
 void set_joint_bilateral_uniforms(const gpu::Program& program, const FrameContext& f);
 
+// A state file's previous depth (and ids, when it has them) into planes 0 and 1 of `prevg` (the C++ states'
+// PreviousGeometry, read by get_previous); `has_prev_id` says whether the ids were there.
+Status upload_previous_geometry(const Image& state, const Geometry& g, gpu::ImageBuffer& prevg, bool& has_prev_id);
+
 // One frame's inputs on the GPU: `gb` (binding 0) the full-resolution planes depth.Z, N.X, N.Y, N.Z, motion.X,
 // motion.Y, prevDepth.Z, id (planes 0-7; motion, warped depth and id uploaded only when `history_layers` and
 // present); `low` (binding 1) the C low-resolution payload planes.

@@ -46,36 +46,11 @@ namespace {
 // The frame code's copies, one per instruction set (temporal/core/isa.h); a state runs the copy of the level
 // active when it was made. v3 and v4 may contract multiply-adds into FMAs (v2 has none) outside the row kernels
 // compiled with fp-contract=off, so v2's output can differ from theirs in the last bits.
-#if TEMPORAL_ISA_DISPATCH
-namespace v2 {
-#include "herzog_impl.inc"
-}  // namespace v2
-TEMPORAL_ISA_V3_BEGIN
-namespace v3 {
-#include "herzog_impl.inc"
-}  // namespace v3
-TEMPORAL_ISA_END
-TEMPORAL_ISA_V4_BEGIN
-namespace v4 {
-#include "herzog_impl.inc"
-}  // namespace v4
-TEMPORAL_ISA_END
-#else
-namespace native {
-#include "herzog_impl.inc"
-}  // namespace native
-#endif
+#define TEMPORAL_ISA_FILE "herzog_impl.inc"
+#include "temporal/core/isa_copies.inc"
 
 std::unique_ptr<MethodState> make_state(const Options& o, const Geometry& g) {
-#if TEMPORAL_ISA_DISPATCH
-  switch (isa::active()) {
-    case isa::Level::V4: return std::make_unique<v4::HerzogState>(o, g);
-    case isa::Level::V3: return std::make_unique<v3::HerzogState>(o, g);
-    default: return std::make_unique<v2::HerzogState>(o, g);
-  }
-#else
-  return std::make_unique<native::HerzogState>(o, g);
-#endif
+  TEMPORAL_ISA_CALL(copy, return std::make_unique<copy::HerzogState>(o, g))
 }
 
 // --- Registry entry --------------------------------------------------------------------------------------------

@@ -385,12 +385,7 @@ class HerzogStateGpu final : public MethodState, public gpu::TimedKernel {
       if (Status s = get_plane(state, name, cell.data(), GW_, GH_); !s) return s;
       if (Status s = grid_.upload(4 * cur_ + t, cell.data()); !s) return s;
     }
-    PreviousGeometry prev;
-    if (Status s = get_previous(state, prev, g_.W, g_.H); !s) return s;
-    if (Status s = prevg_.upload(0, prev.z.data()); !s) return s;
-    has_prev_id_ = !prev.id.empty();
-    if (has_prev_id_)
-      if (Status s = prevg_.upload(1, prev.id.data()); !s) return s;
+    if (Status s = upload_previous_geometry(state, g_, prevg_, has_prev_id_); !s) return s;
     return Status::ok();
   }
 
@@ -402,11 +397,8 @@ class HerzogStateGpu final : public MethodState, public gpu::TimedKernel {
   Status allocate() {
     if (!out_[0].empty()) return Status::ok();
     const int C = int(g_.channels.size());
-    auto make = [&](gpu::ImageBuffer& b, int w, int h, int planes) -> Status {
-      auto created = gpu::ImageBuffer::create(ctx_, w, h, planes);
-      if (!created) return created.error();
-      b = std::move(*created);
-      return b.clear(0, planes);
+    auto make = [&](gpu::ImageBuffer& b, int w, int h, int planes) {
+      return gpu::ImageBuffer::create_cleared(ctx_, w, h, planes, b);
     };
     for (auto& b : out_)
       if (Status s = make(b, g_.W, g_.H, C + 6); !s) return s;
@@ -646,11 +638,7 @@ class HerzogStateGpu final : public MethodState, public gpu::TimedKernel {
 
 Expected<std::unique_ptr<MethodState>> make_herzog_state_gpu(std::shared_ptr<gpu::Context> context,
                                                              const Options& options, const Geometry& geometry) {
-  if (!context) {
-    auto created = gpu::Context::create();
-    if (!created) return created.error();
-    context = std::move(*created);
-  }
+  if (Status s = gpu::Context::ensure(context); !s) return s.error();
   const std::string consts = constants();
   auto compile = [&](const char* name, std::vector<std::string_view> parts) -> Expected<gpu::Program> {
     return gpu::Program::compile(context, name, parts);

@@ -14,36 +14,11 @@ namespace {
 
 // The copies, one per instruction set (temporal/core/isa.h); a state runs the copy of the level active when it
 // was made. v3 and v4 may contract the weighted sums into FMAs (v2 has none): v2 differs in the last bits.
-#if TEMPORAL_ISA_DISPATCH
-namespace v2 {
-#include "spatial_impl.inc"
-}  // namespace v2
-TEMPORAL_ISA_V3_BEGIN
-namespace v3 {
-#include "spatial_impl.inc"
-}  // namespace v3
-TEMPORAL_ISA_END
-TEMPORAL_ISA_V4_BEGIN
-namespace v4 {
-#include "spatial_impl.inc"
-}  // namespace v4
-TEMPORAL_ISA_END
-#else
-namespace native {
-#include "spatial_impl.inc"
-}  // namespace native
-#endif
+#define TEMPORAL_ISA_FILE "spatial_impl.inc"
+#include "temporal/core/isa_copies.inc"
 
 std::unique_ptr<MethodState> make_state(const Options&, const Geometry& g) {
-#if TEMPORAL_ISA_DISPATCH
-  switch (isa::active()) {
-    case isa::Level::V4: return std::make_unique<v4::SpatialState>(g);
-    case isa::Level::V3: return std::make_unique<v3::SpatialState>(g);
-    default: return std::make_unique<v2::SpatialState>(g);
-  }
-#else
-  return std::make_unique<native::SpatialState>(g);
-#endif
+  TEMPORAL_ISA_CALL(copy, return std::make_unique<copy::SpatialState>(g))
 }
 
 std::vector<LayerNeed> layers(const Options&) { return {{"depth"}, {"N"}}; }

@@ -124,6 +124,16 @@ void set_joint_bilateral_uniforms(const gpu::Program& program, const FrameContex
   program.set_int2("u_low_size", f.lw, f.lh);
 }
 
+Status upload_previous_geometry(const Image& state, const Geometry& g, gpu::ImageBuffer& prevg, bool& has_prev_id) {
+  PreviousGeometry prev;
+  if (Status s = get_previous(state, prev, g.W, g.H); !s) return s;
+  if (Status s = prevg.upload(0, prev.z.data()); !s) return s;
+  has_prev_id = !prev.id.empty();
+  if (has_prev_id)
+    if (Status s = prevg.upload(1, prev.id.data()); !s) return s;
+  return Status::ok();
+}
+
 Status GpuFrame::upload(const std::shared_ptr<gpu::Context>& context, const FrameContext& f, bool history_layers) {
   if (gb.width() != f.W || gb.height() != f.H) {
     auto b = gpu::ImageBuffer::create(context, f.W, f.H, 8);
@@ -264,11 +274,7 @@ class SpatialStateGpu final : public MethodState, public gpu::TimedKernel {
 
 Expected<std::unique_ptr<MethodState>> make_spatial_state_gpu(std::shared_ptr<gpu::Context> context,
                                                               const Options&, const Geometry& geometry) {
-  if (!context) {
-    auto created = gpu::Context::create();
-    if (!created) return created.error();
-    context = std::move(*created);
-  }
+  if (Status s = gpu::Context::ensure(context); !s) return s.error();
   auto program = gpu::Program::compile(
       context, "spatial",
       {gpu::glsl::prelude(), gpu::glsl::storage(0, "gb"), gpu::glsl::storage(1, "lowb"),

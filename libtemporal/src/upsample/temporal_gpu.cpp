@@ -95,12 +95,7 @@ class TemporalStateGpu final : public MethodState, public gpu::TimedKernel {
         return s;
       if (Status s = out_[cur_].upload(c, plane.data()); !s) return s;
     }
-    PreviousGeometry prev;
-    if (Status s = get_previous(state, prev, g_.W, g_.H); !s) return s;
-    if (Status s = prevg_.upload(0, prev.z.data()); !s) return s;
-    has_prev_id_ = !prev.id.empty();
-    if (has_prev_id_)
-      if (Status s = prevg_.upload(1, prev.id.data()); !s) return s;
+    if (Status s = upload_previous_geometry(state, g_, prevg_, has_prev_id_); !s) return s;
     return Status::ok();
   }
 
@@ -191,11 +186,7 @@ class TemporalStateGpu final : public MethodState, public gpu::TimedKernel {
 
 Expected<std::unique_ptr<MethodState>> make_temporal_state_gpu(std::shared_ptr<gpu::Context> context,
                                                                const Options&, const Geometry& geometry) {
-  if (!context) {
-    auto created = gpu::Context::create();
-    if (!created) return created.error();
-    context = std::move(*created);
-  }
+  if (Status s = gpu::Context::ensure(context); !s) return s.error();
   auto program = gpu::Program::compile(
       context, "temporal",
       {gpu::glsl::prelude(), gpu::glsl::storage(0, "gb"), gpu::glsl::storage(1, "lowb"),

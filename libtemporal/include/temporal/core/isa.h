@@ -35,6 +35,32 @@ avx512cd,avx512dq,avx512vl,prefer-vector-width=512\")")
 #define TEMPORAL_ISA_DISPATCH 0
 #endif
 
+// Runs `...` (a statement, usually a return) with the namespace alias NS naming the kernel copy of the active
+// level (temporal/core/isa_copies.inc): TEMPORAL_ISA_CALL(copy, return std::make_unique<copy::HerzogState>(o, g)).
+#if TEMPORAL_ISA_DISPATCH
+#define TEMPORAL_ISA_CALL(NS, ...)                \
+  switch (::temporal::isa::active()) {            \
+    case ::temporal::isa::Level::V4: {            \
+      namespace NS = v4;                          \
+      __VA_ARGS__;                                \
+    }                                             \
+    case ::temporal::isa::Level::V3: {            \
+      namespace NS = v3;                          \
+      __VA_ARGS__;                                \
+    }                                             \
+    default: {                                    \
+      namespace NS = v2;                          \
+      __VA_ARGS__;                                \
+    }                                             \
+  }
+#else
+#define TEMPORAL_ISA_CALL(NS, ...) \
+  {                                \
+    namespace NS = native;         \
+    __VA_ARGS__;                   \
+  }
+#endif
+
 namespace temporal::isa {
 
 enum class Level {

@@ -22,6 +22,9 @@ class ImageBuffer {
   // A buffer of `planes` planes of width x height values (contents undefined). Fails when the buffer exceeds the
   // device's storage block size or the driver cannot allocate it.
   static Expected<ImageBuffer> create(std::shared_ptr<Context> context, int width, int height, int planes);
+  // Makes `buffer` a new buffer like create()'s with every plane 0 (a state's histories before the first frame).
+  static Status create_cleared(std::shared_ptr<Context> context, int width, int height, int planes,
+                               ImageBuffer& buffer);
   ~ImageBuffer();
   ImageBuffer(ImageBuffer&& other) noexcept;
   ImageBuffer& operator=(ImageBuffer&& other) noexcept;

@@ -88,6 +88,9 @@ class Context {
   // out of range, the device gives no 4.5 core context, or an entry point is missing; the message says which step
   // failed.
   static Expected<std::shared_ptr<Context>> create(const ContextOptions& options = {});
+  // What every kernel factory does with the context it is given: keeps it, or creates one (default options) when
+  // it is null. The error is create()'s.
+  static Status ensure(std::shared_ptr<Context>& context);
   ~Context();
   Context(const Context&) = delete;
   Context& operator=(const Context&) = delete;
