@@ -16,23 +16,7 @@ namespace temporal::phlm {
   X(fxaa) /* fxaa.cpp */ \
   /* a new method: one line above this one */
 
-TEMPORAL_PHLM_METHODS(TEMPORAL_DECLARE_METHOD)
-
-const std::vector<const MethodEntry*>& registry() {
-  static const std::vector<const MethodEntry*> table = {TEMPORAL_PHLM_METHODS(TEMPORAL_METHOD_ADDRESS)};
-  return table;
-}
-
-const MethodEntry* find_entry(std::string_view name) { return find_entry_in(registry(), name); }
-
-const std::vector<MethodVariant>& method_variants() {
-  static const std::vector<MethodVariant> list = method_variants_of(registry());
-  return list;
-}
-
-const MethodVariant* find_variant(std::string_view name) { return find_variant_in(method_variants(), name); }
-
-MethodOptionSet default_method_options() { return method_option_set(registry()); }
+TEMPORAL_DEFINE_REGISTRY(TEMPORAL_PHLM_METHODS)
 
 ParamList params(FilterOptions& o) {
   ParamList list = {

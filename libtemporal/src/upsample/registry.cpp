@@ -20,21 +20,7 @@ namespace {
   X(taau)     /* taau.cpp */ \
   /* a new method: one line above this one */
 
-TEMPORAL_UPSAMPLE_METHODS(TEMPORAL_DECLARE_METHOD)
-
-const std::vector<const MethodEntry*>& registry() {
-  static const std::vector<const MethodEntry*> table = {TEMPORAL_UPSAMPLE_METHODS(TEMPORAL_METHOD_ADDRESS)};
-  return table;
-}
-
-const MethodEntry* find_entry(std::string_view name) { return find_entry_in(registry(), name); }
-
-const std::vector<MethodVariant>& method_variants() {
-  static const std::vector<MethodVariant> list = method_variants_of(registry());
-  return list;
-}
-
-const MethodVariant* find_variant(std::string_view name) { return find_variant_in(method_variants(), name); }
+TEMPORAL_DEFINE_REGISTRY(TEMPORAL_UPSAMPLE_METHODS)
 
 const std::vector<VariantSuffix>& variant_suffixes() {
   static const std::vector<VariantSuffix> list = {
@@ -43,8 +29,6 @@ const std::vector<VariantSuffix>& variant_suffixes() {
 }
 
 // --- Options --------------------------------------------------------------------------------------------------
-
-MethodOptionSet default_method_options() { return method_option_set(registry()); }
 
 ParamList params(Options& o) {
   ParamList list = {

@@ -171,6 +171,23 @@ const T& method_options(const MethodOptionSet& set, std::string_view name) {
 #define TEMPORAL_DECLARE_METHOD(name) const MethodEntry& name##_method();
 #define TEMPORAL_METHOD_ADDRESS(name) &name##_method(),
 
+// Defines, from a stage's X-macro list LIST, the registry functions its header declares: registry(),
+// find_entry(name), method_variants(), find_variant(name) and default_method_options() (the helpers below on the
+// table). One line in the stage's registry file, so that the three stages cannot drift apart.
+#define TEMPORAL_DEFINE_REGISTRY(LIST)                                                                  \
+  LIST(TEMPORAL_DECLARE_METHOD)                                                                         \
+  const std::vector<const MethodEntry*>& registry() {                                                   \
+    static const std::vector<const MethodEntry*> table = {LIST(TEMPORAL_METHOD_ADDRESS)};               \
+    return table;                                                                                       \
+  }                                                                                                     \
+  const MethodEntry* find_entry(std::string_view name) { return find_entry_in(registry(), name); }       \
+  const std::vector<MethodVariant>& method_variants() {                                                 \
+    static const std::vector<MethodVariant> list = method_variants_of(registry());                      \
+    return list;                                                                                        \
+  }                                                                                                     \
+  const MethodVariant* find_variant(std::string_view name) { return find_variant_in(method_variants(), name); } \
+  MethodOptionSet default_method_options() { return method_option_set(registry()); }
+
 template <typename Variant>
 const Variant* find_variant_in(const std::vector<Variant>& variants, std::string_view name) {
   for (const Variant& v : variants)
