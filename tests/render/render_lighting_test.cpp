@@ -102,7 +102,10 @@ Rendered render(const Scene& scene, RenderOptions o) {
 class RenderLighting : public ::testing::Test {
  protected:
   void SetUp() override {
-    dir = test::scratch_dir("render_lighting");
+    // One folder per test: CTest runs this fixture's tests in parallel processes, and scratch_dir empties the folder
+    // it returns (a shared one let a test read another's half-written quad).
+    dir = test::scratch_dir(std::string("render_lighting-") +
+                            ::testing::UnitTest::GetInstance()->current_test_info()->name());
     auto probe = Scene::load(write_quad(dir, "probe", {0, 0, 1}, {1, 0, 0}));
     ASSERT_TRUE(probe) << probe.error().message;
     axes = camera_axes(*probe);
