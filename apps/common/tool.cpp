@@ -1,6 +1,7 @@
 #include "tool.h"
 
 #include "temporal/io/atomic_file.h"
+#include "temporal/core/isa.h"
 #include "temporal/core/parallel.h"
 
 #include <signal.h>
@@ -160,6 +161,12 @@ int Tool::run(int argc, char** argv, const std::function<Status()>& body) {
     if (noted.insert(dir.lexically_normal().string()).second)
       std::cerr << name_ << ": " << dir.string() << ": note: the folder does not exist; it will be created for the outputs\n";
   }
+  // The CPU kernels' instruction set (temporal/core/isa.h): a TEMPORAL_ISA the run cannot honour is said, since the
+  // user asked for it (a benchmark of "v2" that ran v4 would mislead); --verbose names the level in force.
+  if (const std::string_view note = isa::environment_note(); !note.empty())
+    std::cerr << name_ << ": note: " << note << "\n";
+  log("CPU kernels: " + std::string(isa::name(isa::active())) +
+      (isa::dispatching() ? " (chosen at run time; TEMPORAL_ISA=v2|v3|v4 forces one)" : " (one copy in this build)"));
   for (int sig : {SIGINT, SIGTERM, SIGHUP}) {
     struct sigaction action {};
     action.sa_handler = on_termination;

@@ -126,6 +126,20 @@ TEST(OptionValues, EmptyInfiniteAndOverflowingValuesAreUsageErrorsNamingTheOptio
 // sequence (render-gbuffer's shade: R,G,B, direct.R,G,B, ssao.Y, ...) goes through all four tools with the same
 // selections; each writes (or compares) exactly the channels the rule selects, and each refuses a missing layer
 // with exit 2 naming it. What differs is only what a tool can take: filter-phlm 1 or 3 channels, morph-120hz 3.
+// A TEMPORAL_ISA the run cannot honour is said on stderr (the user asked for a level: issue 27), whatever the
+// tool does next; --verbose names the level the CPU kernels run at. The missing input makes the run end at once.
+TEST(IsaNote, AnUnusableTemporalIsaIsSaidAndVerboseNamesTheLevel) {
+  std::string out;
+  const std::string exe = test::tool_path("compare").string();
+  EXPECT_EQ(test::run_command("TEMPORAL_ISA=v9 " + exe + " --reference no/r.####.exr no/t.####.exr --verbose", &out), 2)
+      << out;
+  EXPECT_NE(out.find("compare: note: TEMPORAL_ISA=v9 "), std::string::npos) << out;
+  EXPECT_NE(out.find("compare: CPU kernels: "), std::string::npos) << out;
+  EXPECT_EQ(test::run_command("env -u TEMPORAL_ISA " + exe + " --reference no/r.####.exr no/t.####.exr", &out), 2)
+      << out;
+  EXPECT_EQ(out.find("TEMPORAL_ISA"), std::string::npos) << out;  // nothing asked, nothing said
+}
+
 TEST(LayerRule, EveryToolSelectsTheSameChannels) {
   const auto dir = test::scratch_dir("layer-rule");
   const std::string d = dir.string();
