@@ -124,12 +124,6 @@ struct Outcome {
   std::size_t colour_values = 0;
 };
 
-void merge(test::Agreement& into, const test::Agreement& g) {
-  into.max_abs = std::max(into.max_abs, g.max_abs);
-  into.psnr = std::min(into.psnr, g.psnr);
-  into.finiteness_mismatches += g.finiteness_mismatches;
-}
-
 // Runs the C++ method (the registry's kCpuDevice implementation) and the GPU one on `frames` and compares every
 // slot.
 Outcome compare(std::shared_ptr<gpu::Context> ctx, const std::vector<Frame>& frames, const std::vector<std::string>& args,
@@ -165,14 +159,14 @@ Outcome compare(std::shared_ptr<gpu::Context> ctx, const std::vector<Frame>& fra
     (*gpu)->run(f.color, &f.gbuffer, nullptr, b, tb);
     EXPECT_TRUE((*gpu)->run_status()) << (*gpu)->run_status().error().message;
     for (std::size_t k = 0; k < a.size(); ++k) {
-      merge(r.colour, test::agreement(b[k], a[k], kRgb));
+      r.colour.merge(test::agreement(b[k], a[k], kRgb));
       for (const auto& c : kRgb)
         for (std::size_t i = 0; i < f.color.pixel_count(); ++i) {
           ++r.colour_values;
           r.colour_beyond += std::abs(double(a[k].plane(c)[i]) - double(b[k].plane(c)[i])) > 1e-5;
         }
       if (!debug) continue;
-      merge(r.debug_values, test::agreement(b[k], a[k], {"debug.distortion", "debug.blur", "debug.H", "debug.Hprime"}));
+      r.debug_values.merge(test::agreement(b[k], a[k], {"debug.distortion", "debug.blur", "debug.H", "debug.Hprime"}));
       for (std::size_t i = 0; i < f.color.pixel_count(); ++i) {
         r.grid_pixels += a[k].plane("debug.grid")[i] != 0.0f;
         r.grid_differing += a[k].plane("debug.grid")[i] != b[k].plane("debug.grid")[i];

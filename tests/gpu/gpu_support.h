@@ -36,6 +36,13 @@ struct Agreement {
   double max_abs = 0.0;
   double psnr = INFINITY;
   std::size_t finiteness_mismatches = 0;
+
+  // The worse of the two (over frames, channels or slots): the largest difference, the lowest PSNR, every mismatch.
+  void merge(const Agreement& g) {
+    max_abs = std::max(max_abs, g.max_abs);
+    psnr = std::min(psnr, g.psnr);
+    finiteness_mismatches += g.finiteness_mismatches;
+  }
 };
 
 inline Agreement agreement(const float* a, const float* b, std::size_t n) {
@@ -67,9 +74,7 @@ inline Agreement agreement(const Image& a, const Image& b, const std::vector<std
     EXPECT_TRUE(pa && pb) << "channel " << c;
     if (!pa || !pb) return {INFINITY, 0.0, 0};
     const Agreement g = agreement(pa, pb, a.pixel_count());
-    worst.max_abs = std::max(worst.max_abs, g.max_abs);
-    worst.psnr = std::min(worst.psnr, g.psnr);
-    worst.finiteness_mismatches += g.finiteness_mismatches;
+    worst.merge(g);
   }
   return worst;
 }

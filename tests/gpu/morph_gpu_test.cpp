@@ -77,9 +77,7 @@ Outcome compare(std::shared_ptr<gpu::Context> ctx, const std::string& method, in
       std::vector<std::string> planes = kRgb;
       if (debug) planes.insert(planes.end(), std::begin(kMorphDebugLayers), std::end(kMorphDebugLayers));
       const test::Agreement g = test::agreement(b[std::size_t(k)], a[std::size_t(k)], planes);
-      r.colour.max_abs = std::max(r.colour.max_abs, g.max_abs);
-      r.colour.psnr = std::min(r.colour.psnr, g.psnr);
-      r.colour.finiteness_mismatches += g.finiteness_mismatches;
+      r.colour.merge(g);
       for (const auto& c : kRgb)
         for (std::size_t i = 0; i < f.color.pixel_count(); ++i)
           r.differing_pixels += a[std::size_t(k)].plane(c)[i] != b[std::size_t(k)].plane(c)[i];

@@ -108,9 +108,7 @@ Comparison compare(FrameFilter& gpu, FrameFilter& cpu, const std::vector<Frame>&
         r.values_over += std::abs(out_gpu.plane(ch)[i] - out_cpu.plane(ch)[i]) > 1e-5f;
         ++r.values;
       }
-    r.colour.max_abs = std::max(r.colour.max_abs, g.max_abs);
-    r.colour.psnr = std::min(r.colour.psnr, g.psnr);
-    r.colour.finiteness_mismatches += g.finiteness_mismatches;
+    r.colour.merge(g);
     if (o.debug)
       for (const auto& d : debug_planes) {
         const float* pg = out_gpu.plane(d);

@@ -95,9 +95,7 @@ Result compare(const std::shared_ptr<gpu::Context>& ctx, const char* method, Gpu
     const Image& b = (*gpu)->run(f, history, sg);
     EXPECT_TRUE((*gpu)->run_status()) << (*gpu)->run_status().error().message;
     const test::Agreement ag = test::agreement(b, a, kRgb);
-    r.colour.max_abs = std::max(r.colour.max_abs, ag.max_abs);
-    r.colour.psnr = std::min(r.colour.psnr, ag.psnr);
-    r.colour.finiteness_mismatches += ag.finiteness_mismatches;
+    r.colour.merge(ag);
     for (const auto& c : kRgb)
       for (std::size_t i = 0; i < a.pixel_count(); ++i) r.peak = std::max(r.peak, double(std::abs(a.plane(c)[i])));
     r.stat_mismatches += (sc.hole_pixels != sg.hole_pixels) + (sc.history_pixels != sg.history_pixels);
