@@ -10,6 +10,7 @@
 #include <cstring>
 #include <functional>
 #include <random>
+#include <utility>
 
 namespace {
 
@@ -93,6 +94,53 @@ TEST(Phlm, FeatureWeightFollowsSection51) {
     ASSERT_TRUE(literal.process(in, out));
     EXPECT_NEAR(out.plane("debug.featureG")[12], alpha * 0.5 + (1.0 - alpha) * 0.5125, 1e-6);
   }
+}
+
+// Issue 24: the linear form of phi (--feature-phi linear, UE4's HistoryFactor = DistToClamp * HistoryAmount) on the
+// frames of FeatureWeightFollowsSection51: phi = (a + b v) l, so at pixel (2,2) (l = 0.2, Delta = 0.6)
+//   v = 0: alpha = 0.125 * 0.2 / 0.8 = 0.03125             (the printed form: 0.00625, 5x smaller)
+//   v = 1: alpha = (0.125 + 0.25) * 0.2 / 0.8 = 0.09375    (the printed form: 0.00875)
+//   v = 5: alpha = (0.125 + 1.25) * 0.2 / 0.8 = 0.34375
+// and the feature moves by alpha of the way to the low-pass: z = 0.5 + alpha (0.5125 - 0.5). With l = 0 (the
+// feature on the box's edge) both forms give alpha = 0; with a flat box (Delta = 0, l = 0) alpha = 0 (0/0 rule).
+TEST(Phlm, LinearFeatureWeightFollowsUe4HistoryFactor) {
+  for (const auto& [v, expected] : {std::pair{0.0f, 0.03125}, std::pair{1.0f, 0.09375}, std::pair{5.0f, 0.34375}}) {
+    // 5 x 9 pixels, the motion v pixels per frame along y: q = p + motion = (2, 2 + v) stays on screen, and frame 0
+    // is uniform, so the fetched feature is 0.5 wherever it comes from.
+    Image m(5, 9);
+    float* mx = m.add_channel("motion.X", 0.0f);
+    float* my = m.add_channel("motion.Y", v);
+    const Image f0 = make_frame(5, 9, [](int, int, int) { return 0.5f; });
+    const Image f1 = make_frame(5, 9, [](int x, int y, int) {
+      return (x == 1 && y == 1) ? 0.3f : ((x == 3 && y == 3) ? 0.9f : 0.5f);
+    });
+    PhlmParams linear;
+    linear.feature_phi = "linear";
+    PhlmFilter filter(linear);
+    Image out;
+    FilterInput in = input_for(f0, true);
+    in.motion_x = mx;
+    in.motion_y = my;
+    in.debug = true;
+    ASSERT_TRUE(filter.process(in, out));
+    in.color = &f1;
+    in.reset = false;
+    ASSERT_TRUE(filter.process(in, out));
+    EXPECT_NEAR(out.plane("debug.alpha")[12], expected, 1e-6) << "v = " << v;
+    EXPECT_NEAR(out.plane("debug.featureG")[12], 0.5 + expected * (0.5125 - 0.5), 1e-6) << "v = " << v;
+    // Pixel (4, 0), whose whole neighbourhood is 0.5 (flat box, Delta = 0, l = 0; q = (4, v) on screen): nothing
+    // to blend.
+    EXPECT_EQ(out.plane("debug.alpha")[4], 0.0f) << "v = " << v;
+    EXPECT_EQ(out.plane("debug.reset")[4], 0.0f) << "v = " << v;
+  }
+  PhlmParams bad;
+  bad.feature_phi = "cubic";
+  PhlmFilter rejected(bad);
+  const Image f0 = make_frame(4, 4, [](int, int, int) { return 0.5f; });
+  Image out;
+  const Status s = rejected.process(input_for(f0, true), out);
+  ASSERT_FALSE(s);
+  EXPECT_NE(s.error().message.find("--feature-phi 'cubic'"), std::string::npos);
 }
 
 // Issue 16: with the feature off (--no-feature, x = [1]) PHLM is an intercept-only RLS, i.e. per pixel the

@@ -65,7 +65,7 @@ struct Layout {
 
 // The resolved ablation switches of PhlmParams.
 struct Variant {
-  bool feature = true, box_test = true, alpha_eq1 = false;
+  bool feature = true, box_test = true, alpha_eq1 = false, phi_linear = false;
   HistoryFetch fetch = HistoryFetch::Bilinear;
 };
 
@@ -77,6 +77,10 @@ Expected<Variant> resolve_variant(const PhlmParams& p) {
     v.alpha_eq1 = true;
   else if (p.alpha_reading != "ue4")
     return Error::usage("--feature-alpha '" + p.alpha_reading + "' is not one of: ue4, eq1");
+  if (p.feature_phi == "linear")
+    v.phi_linear = true;
+  else if (p.feature_phi != "paper")
+    return Error::usage("--feature-phi '" + p.feature_phi + "' is not one of: paper, linear");
   auto fetch = parse_history_fetch(p.model_fetch, "--model-fetch");
   if (!fetch) return fetch.error();
   v.fetch = *fetch;
@@ -251,8 +255,10 @@ struct PixelInputs {
   float mvx = 0.0f, mvy = 0.0f;
 };
 
-// Temporal feature z (section 5.1): exponential accumulation of the low-frequency colour with the per-pixel weight
-// alpha = phi(v, l) / (l + Delta(Y)), phi = a l^2 + b v l^3. `zh` is the fetched feature (ignored on a reset).
+// Temporal feature z (section 5.1): exponential accumulation (eq. 1) of the low-frequency colour with the per-pixel
+// weight alpha = phi(v, l) / (l + Delta(Y)), phi = a l^2 + b v l^3 as printed, or with --feature-phi linear
+// phi = (a + b v) l (UE4's HistoryFactor = DistToClamp * HistoryAmount). `zh` is the fetched feature (ignored on a
+// reset).
 // Returns alpha (the debug layer).
 template <int C>
 [[gnu::always_inline]] inline float update_feature(const PixelInputs<C>& p, const PhlmParams& params,
@@ -277,7 +283,10 @@ template <int C>
   const float delta = (p.bmax[0] - p.bmin[0]) * k;  // box[0] is the luma (YCgCo Y)
   const float l = fast_min(std::fabs(lh - p.bmin[0]), std::fabs(lh - p.bmax[0])) * k;
   const float v = std::sqrt(p.mvx * p.mvx + p.mvy * p.mvy);
-  const float phi = params.feature_a * l * l + params.feature_b * v * l * l * l;
+  // Section 5.1 as printed: phi = a l^2 + b v l^3. The linear form (ablation): phi = (a + b v) l, one power of l
+  // fewer in each term, so that on a static pixel alpha = a l / (l + Delta) as UE4's BlendFinal.
+  const float phi = variant.phi_linear ? (params.feature_a + params.feature_b * v) * l
+                                       : params.feature_a * l * l + params.feature_b * v * l * l * l;
   const float den = l + delta;
   const float alpha = den > 0.0f ? fast_min(phi / den, 1.0f) : 0.0f;
   // The accumulated feature is kept inside the current neighbourhood box (as Karis' history), so a disoccluded
@@ -673,6 +682,10 @@ struct PhlmOptions : PhlmParams {
                       "reading of the feature's alpha: ue4 = weight of the new sample, eq1 = history weight of eq. 1 "
                       "(ablation)",
                       &alpha_reading, {"ue4", "eq1"}),
+        Param::choice("--feature-phi",
+                      "phi of the feature's weight alpha = phi / (l + Delta): paper = a l^2 + b v l^3 (section 5.1 "
+                      "as printed), linear = (a + b v) l (UE4's HistoryFactor; ablation)",
+                      &feature_phi, {"paper", "linear"}),
         Param::choice("--model-fetch", "fetch of the previous models at p + motion (section 6: bilinear)",
                       &model_fetch, {"bilinear", "nearest", "catmull-rom"}),
     };

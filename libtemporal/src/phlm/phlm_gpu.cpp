@@ -27,7 +27,7 @@ const int KOFF = N * (N - 1) / 2;
 const int KBETA = 0, KD = C * N, KU = KD + N, KFEATURE = KU + KOFF, KSCALE = KFEATURE + C, KSIZE = KSCALE + 1;
 const float kMinD = 1e-20;
 uniform uint u_n;
-uniform bool u_motion, u_have_prev, u_reset_all, u_feature, u_box_test, u_alpha_eq1, u_debug;
+uniform bool u_motion, u_have_prev, u_reset_all, u_feature, u_box_test, u_alpha_eq1, u_phi_linear, u_debug;
 uniform int u_fetch;  // 0 bilinear, 1 nearest, 2 Catmull-Rom
 uniform float u_p0, u_trace_max, u_a, u_b, u_lambda;
 #define PL(k) (uint(k) * u_n)
@@ -216,7 +216,8 @@ void main() {
         const float delta = (bmax[0] - bmin[0]) * k;
         const float l = min_(abs(lh - bmin[0]), abs(lh - bmax[0])) * k;
         const float v = sqrt(mvx * mvx + mvy * mvy);
-        const float phi = u_a * l * l + u_b * v * l * l * l;
+        // phlm.cpp update_feature: section 5.1 as printed, or the linear (UE4 HistoryFactor) form.
+        const float phi = u_phi_linear ? (u_a + u_b * v) * l : u_a * l * l + u_b * v * l * l * l;
         const float den = l + delta;
         alpha = den > 0.0 ? min_(phi / den, 1.0) : 0.0;
         float zb[C];
@@ -357,6 +358,7 @@ class PhlmFilterGpu final : public FrameFilter, public gpu::TimedKernel {
     program.set("u_feature", int(!params_.no_feature));
     program.set("u_box_test", int(!params_.no_box_test));
     program.set("u_alpha_eq1", int(params_.alpha_reading == "eq1"));
+    program.set("u_phi_linear", int(params_.feature_phi == "linear"));
     program.set("u_debug", int(in.debug));
     program.set("u_fetch", fetch_ == HistoryFetch::Bilinear ? 0 : fetch_ == HistoryFetch::Nearest ? 1 : 2);
     program.set("u_p0", params_.p_init);
@@ -474,6 +476,8 @@ Expected<std::unique_ptr<FrameFilter>> make_phlm_filter_gpu(std::shared_ptr<gpu:
                                                            PhlmParams params) {
   if (params.alpha_reading != "ue4" && params.alpha_reading != "eq1")
     return Error::usage("--feature-alpha '" + params.alpha_reading + "' is not one of: ue4, eq1");
+  if (params.feature_phi != "paper" && params.feature_phi != "linear")
+    return Error::usage("--feature-phi '" + params.feature_phi + "' is not one of: paper, linear");
   auto fetch = parse_history_fetch(params.model_fetch, "--model-fetch");
   if (!fetch) return fetch.error();
   if (Status s = gpu::Context::ensure(context); !s) return s.error();

@@ -42,6 +42,12 @@ struct PhlmParams {
   // BlendFinal, whose code the constants come from); "eq1" = the literal eq. 1 reading, alpha weighs the history:
   // z = alpha z_prev + (1 - alpha) low.
   std::string alpha_reading = "ue4";
+  // Form of phi in the feature's weight alpha = phi(v, l) / (l + Delta(Y)) (section 5.1; docs/filter-phlm.md,
+  // "The feature's weight"): "paper" = a l^2 + b v l^3 as printed, which keeps alpha ~ a l^2 / Delta, near 1e-4 on
+  // noisy static pixels, so the feature barely moves between resets; "linear" = (a + b v) l, UE4's
+  // HistoryFactor = DistToClamp * HistoryAmount (the code the paper says a, b come from), alpha ~ a l / Delta
+  // (ablation, issue 24).
+  std::string feature_phi = "paper";
   // Fetch of the previous models at p + motion: "bilinear" (section 6, hardware bilinear filtering of the model
   // textures), "nearest" (the record of the nearest pixel), "catmull-rom" (beta and the feature with the 4x4
   // Catmull-Rom taps of temporal/core/reproject.h, P's factors and the scale bilinearly: negative weights could
