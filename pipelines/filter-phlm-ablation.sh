@@ -8,6 +8,9 @@
 #   phlm-no-box        --no-box-test           no box test (Algorithm 1 lines 13-19) and none of its resets
 #   phlm-eq1           --feature-alpha eq1     the literal eq. 1 reading of the feature's alpha (history weight)
 #   phlm-mean-no-box   --no-feature --no-box-test   the running mean alone (what the box test adds to it)
+#   phlm-phi-linear    --feature-phi linear    the feature's weight linear in l, phi = (a + b v) l (UE4's
+#                      HistoryFactor) instead of section 5.1's printed a l^2 + b v l^3 (issue 24; docs "The feature's
+#                      weight")
 #   phlm-catmull-rom   --model-fetch catmull-rom    not an ablation: the sharper fetch of docs "Edges"
 # and prints the paired differences variant - phlm with their 95% intervals (compare's, when it has them).
 #
@@ -28,6 +31,7 @@ phlm-nearest phlm --model-fetch nearest
 phlm-no-box phlm --no-box-test
 phlm-eq1 phlm --feature-alpha eq1
 phlm-mean-no-box phlm --no-feature --no-box-test
+phlm-phi-linear phlm --feature-phi linear
 phlm-catmull-rom phlm --model-fetch catmull-rom"
-export PAIRS="phlm-no-feature:phlm,phlm-nearest:phlm,phlm-no-box:phlm,phlm-eq1:phlm,phlm-mean-no-box:phlm,phlm-catmull-rom:phlm,phlm:input"
+export PAIRS="phlm-no-feature:phlm,phlm-nearest:phlm,phlm-no-box:phlm,phlm-eq1:phlm,phlm-mean-no-box:phlm,phlm-phi-linear:phlm,phlm-catmull-rom:phlm,phlm:input"
 exec bash "$ROOT/pipelines/filter-phlm.sh" "$BUILD" "$OUT" "$@"

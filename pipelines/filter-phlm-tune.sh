@@ -24,9 +24,17 @@
 # The criterion is the mean over the tuning sequences of compare's mean PSNR (RGB) per sequence (seed 003 Table 2's
 # measure); flicker is tabulated beside it. Writes OUT_DIR/tuning.md (tables, the chosen values) and
 # OUT_DIR/tuning.csv (every run: method, setting, sequence, psnr, flicker).
+# Per region (issue 24): compare runs with --regions motion (static = no motion, no disocclusion and the reference
+# unchanged over STATIC_FRAMES frames; moving; disoccluded; docs/compare.md "Regions"), and the same criterion per
+# region - the mean over the tuning sequences that have pixels of the region of compare's mean PSNR in it - gives
+# the static-region and moving-region optimum beside the whole-frame one: OUT_DIR/tuning-regions.csv (every run and
+# region: method, setting, sequence, region, share, psnr, pooled psnr, flicker), a per-region section in
+# tuning.md, and OUT_DIR/tuned-variants.txt, the static and moving optimum of taa and ema as filter-phlm.sh
+# VARIANTS lines ("taa-tuned-static taa --taa-clip variance --taa-alpha 0.2"; filter-phlm.sh's TUNED=FILE).
 #
 # Usage: pipelines/filter-phlm-tune.sh [BUILD_DIR=build/release] [OUT_DIR=report/filter-phlm-tune]
-# Environment: SIZE, FPS, TAA_ALPHAS, EMA_ALPHAS, FXAA_SUBPIX, PHLM_LAMBDAS, TUNE_SET (lines
+# Environment: SIZE, FPS, TAA_ALPHAS, TAA_CLIPS (default "variance minmax"), EMA_ALPHAS, FXAA_SUBPIX, PHLM_LAMBDAS,
+#   STATIC_FRAMES (compare --static-frames, default 10), TUNE_SET (lines
 #   "name scene.glb frames render-options"), REUSE_RENDER=1 (keep existing renders), KEEP_OUTPUTS=1 (keep the
 #   filtered sequences; by default they are deleted after compare has measured them), APPEND=1 (add the runs to an
 #   existing OUT_DIR/tuning.csv, e.g. to extend a grid; the tables sort the settings). An empty list (TAA_ALPHAS="")
@@ -42,6 +50,8 @@ TAA_ALPHAS="${TAA_ALPHAS-0.02 0.04 0.06 0.08 0.1 0.125 0.15 0.2 0.25 0.33 0.4 0.
 EMA_ALPHAS="${EMA_ALPHAS-0.2 0.3 0.4 0.5 0.6 0.7 0.8 0.85 0.9 0.95}"
 FXAA_SUBPIX="${FXAA_SUBPIX-0 0.25 0.5 0.75 1}"
 PHLM_LAMBDAS="${PHLM_LAMBDAS-0.9 0.95 0.98 0.99 0.995 0.998 0.999}"
+TAA_CLIPS="${TAA_CLIPS:-variance minmax}"
+STATIC_FRAMES="${STATIC_FRAMES:-10}"
 REUSE_RENDER="${REUSE_RENDER:-0}"
 KEEP_OUTPUTS="${KEEP_OUTPUTS:-0}"
 APPEND="${APPEND:-0}"
@@ -60,14 +70,22 @@ mkdir -p "$OUT"
 # The runs: "method label filter-options" per line.
 runs=()
 for a in $TAA_ALPHAS; do
-  for clip in variance minmax; do runs+=("taa clip=$clip/alpha=$a --taa-clip $clip --taa-alpha $a"); done
+  for clip in $TAA_CLIPS; do runs+=("taa clip=$clip/alpha=$a --taa-clip $clip --taa-alpha $a"); done
 done
 for a in $EMA_ALPHAS; do runs+=("ema alpha=$a --ema-alpha $a"); done
 for s in $FXAA_SUBPIX; do runs+=("fxaa subpix=$s --fxaa-subpix $s"); done
 for l in $PHLM_LAMBDAS; do runs+=("phlm lambda=$l --lambda $l"); done
 
 csv="$OUT/tuning.csv"
+region_csv="$OUT/tuning-regions.csv"
 if [[ "$APPEND" != 1 || ! -f "$csv" ]]; then echo "method,setting,sequence,psnr_rgb_db,flicker" > "$csv"; fi
+if [[ "$APPEND" != 1 || ! -f "$region_csv" ]]; then
+  echo "method,setting,sequence,region,share,psnr_rgb_db,psnr_rgb_pooled_db,flicker" > "$region_csv"
+fi
+region_args=()
+if [[ "$("$compare" --help 2>/dev/null || true)" == *--regions* ]]; then
+  region_args=(--regions motion --static-frames "$STATIC_FRAMES")
+fi
 while read -r name scene frames opts; do
   [[ -z "$name" ]] && continue
   dir="$OUT/$name"
@@ -96,11 +114,16 @@ while read -r name scene frames opts; do
   done
   echo "== $name: compare (${#tests[@]} runs)" >&2
   "$compare" --reference "$dir/render/reference.####.exr" "${tests[@]}" --names "$names" \
-    --gbuffer "$dir/render/gbuffer.####.exr" --json "$dir/metrics.json" > /dev/null
+    --gbuffer "$dir/render/gbuffer.####.exr" --json "$dir/metrics.json" "${region_args[@]}" > /dev/null
   python3 "$TABLES" tuning-rows "$dir/metrics.json" "$name" "${runs[@]}" >> "$csv"
+  python3 "$TABLES" tuning-region-rows "$dir/metrics.json" "$name" "${runs[@]}" >> "$region_csv"
   [[ "$KEEP_OUTPUTS" == 1 ]] || rm -rf "$dir/runs"
 done <<< "$TUNE_SET"
 
 python3 "$TABLES" tuning "$csv" > "$OUT/tuning.md"
+if [[ ${#region_args[@]} -gt 0 ]]; then
+  { echo "## Per region"; echo; python3 "$TABLES" tuning-regions "$region_csv"; } >> "$OUT/tuning.md"
+  python3 "$TABLES" tuned-variants "$region_csv" taa,ema "${runs[@]}" > "$OUT/tuned-variants.txt"
+fi
 cat "$OUT/tuning.md"
-say "$OUT/tuning.md, $OUT/tuning.csv"
+say "$OUT/tuning.md, $OUT/tuning.csv, $OUT/tuning-regions.csv, $OUT/tuned-variants.txt"

@@ -14,7 +14,8 @@
 #   of filter-phlm's registry, as `filter-phlm --list-methods` prints them; a named variant's name works too),
 #   VARIANTS (more runs, one per line "NAME METHOD filter-phlm options", e.g. the previous TAA
 #   "taa-0.1 taa --taa-alpha 0.1" (the engine-typical blend) and "taa-2014 taa --taa-velocity centre --taa-clip
-#   minmax --taa-alpha 0.04" by default; "" for none),
+#   minmax --taa-alpha 0.04" by default; "" for none), TUNED (a file of more VARIANTS lines, e.g. the per-region
+#   optimum of the baselines that pipelines/filter-phlm-tune.sh writes to OUT_DIR/tuned-variants.txt),
 #   RENDER_ARGS (extra render-gbuffer options; default "--payload direct,shadow,ssao": the gi payload's 2000 VPLs
 #   make the 16-spp reference ~10x slower on llvmpipe), FILTER_ARGS (extra filter-phlm options for every run),
 #   REFERENCE_SPP (samples per pixel of the reference, default 16),
@@ -79,6 +80,10 @@ for m in $METHODS; do
   runs+=("$m $args")
 done
 while read -r n m args; do [[ -n "$n" ]] && runs+=("$n --method $m $args"); done <<< "$VARIANTS"
+if [[ -n "${TUNED:-}" ]]; then
+  [[ -f "$TUNED" ]] || die "TUNED=$TUNED: no such file (pipelines/filter-phlm-tune.sh writes OUT_DIR/tuned-variants.txt)"
+  while read -r n m args; do [[ -n "$n" ]] && runs+=("$n --method $m $args"); done < "$TUNED"
+fi
 compare_args=()
 compare_help="$("$compare" --help 2>/dev/null || true)"
 if [[ "$compare_help" == *--warmup* ]]; then compare_args+=(--warmup "$WARMUP"); fi
@@ -92,6 +97,11 @@ fi
   echo
   echo "Input: render-gbuffer colour, 1 spp, random jitter; reference: 16 spp. Size $SIZE, frames $FRAMES at $FPS fps."
   echo "Columns from compare: mean PSNR (RGB, dB), mean flicker (motion-compensated), mean compute ms per frame."
+  echo
+  # Which baseline each column is (issue 24: the tables show the tuned baselines the text compares against): the
+  # filter-phlm arguments of every run; a method's own name runs its defaults (the whole-frame tuned values).
+  echo "Runs (filter-phlm arguments; defaults: docs/filter-phlm.md):"
+  for run in "${runs[@]}"; do read -r n args <<< "$run"; echo "- \`$n\`: \`$args\`"; done
   echo
 } > "$summary"
 

@@ -24,6 +24,16 @@ Tables:
   tables.py tuning-rows METRICS_JSON SEQUENCE RUN...
       rows "method,setting,sequence,psnr_rgb_db,flicker" of TUNING.csv: RUN i ("METHOD SETTING ...") is compare's
       sequence named i
+  tables.py tuning-region-rows METRICS_JSON SEQUENCE RUN...
+      rows "method,setting,sequence,region,share,psnr_rgb_db,psnr_rgb_pooled_db,flicker" of TUNING-REGIONS.csv, one
+      per region (all, static, moving, disoccluded; compare --regions motion): compare's mean PSNR over the frames
+      that have the region, its pooled PSNR, the region's pixel share; empty fields for an empty region
+  tables.py tuning-regions TUNING-REGIONS.csv
+      per method, one row per setting and one column per region: the mean over the tuning sequences that have the
+      region of compare's mean PSNR in it; then the optimum per region (highest such mean), beside the whole-frame one
+  tables.py tuned-variants TUNING-REGIONS.csv METHOD[,METHOD...] RUN...
+      filter-phlm.sh VARIANTS lines "METHOD-tuned-REGION METHOD ARGUMENTS" for the static and moving optimum of each
+      METHOD (RUN i: "METHOD SETTING ARGUMENTS...", the tuning script's runs)
   tables.py interval JSON SEQUENCE METRIC
       "mean,ci_low,ci_high" of a sequence's metric (%.2f; empty fields when absent; "inf" kept)
   tables.py value JSON SEQUENCE KEY[.KEY...] [DIGITS]
@@ -355,6 +365,107 @@ def tuning_rows(path, seq, runs):
         print(f"{method},{label},{seq},{s['psnr_rgb']['mean']},{s['flicker']['mean']}")
 
 
+TUNING_REGIONS = ("all",) + REGIONS
+
+
+def tuning_region_rows(path, seq, runs):
+    """TUNING-REGIONS.csv rows of one tuning sequence: per run (compare's sequence "i") and region, compare's mean
+    PSNR (RGB) over the frames with the region, its pooled PSNR, the region's share and flicker."""
+    def f(v):
+        v = num(v)
+        return "" if v is None else repr(v)
+    by_name = sequences(path)
+    for i, run in enumerate(runs):
+        method, label = run.split()[:2]
+        q = by_name[str(i)]
+        for region in TUNING_REGIONS:
+            r = q if region == "all" else (q.get("regions") or {}).get(region)
+            if r is None:
+                continue  # compare ran without --regions
+            share = 1.0 if region == "all" else r.get("share")
+            print(",".join([method, label, seq, region, f(share), f((r.get("psnr_rgb") or {}).get("mean")),
+                            f((r.get("psnr_rgb_pooled") or {}).get("value")), f((r.get("flicker") or {}).get("mean"))]))
+
+
+def _tuning_region_means(path):
+    """{method: {setting: {region: (mean over the sequences of compare's mean PSNR, sequences)}}} and the sequences
+    per region. The mean over the tuning sequences is not compare's (one compare run sees one sequence), as in
+    `tuning`; a sequence without pixels of a region (e.g. no static pixels under a moving camera) is left out of
+    that region's mean."""
+    acc = OrderedDict()
+    seqs = defaultdict(list)
+    for r in csv.DictReader(open(path)):
+        v = num(float(r["psnr_rgb_db"])) if r["psnr_rgb_db"] not in ("", "inf") else None
+        if v is None:
+            continue
+        if r["sequence"] not in seqs[r["region"]]:
+            seqs[r["region"]].append(r["sequence"])
+        acc.setdefault(r["method"], OrderedDict()).setdefault(r["setting"], OrderedDict()).setdefault(
+            r["region"], []).append(v)
+    out = OrderedDict()
+    for method, settings in acc.items():
+        out[method] = OrderedDict()
+        for setting, by_region in settings.items():
+            out[method][setting] = {g: (sum(v) / len(v), len(v)) for g, v in by_region.items()}
+    return out, seqs
+
+
+def _setting_key(setting):
+    """Sort key of a tuning setting label "name=value/name=value": numeric values in numeric order."""
+    parts = []
+    for item in setting.split("/"):
+        name, _, value = item.partition("=")
+        try:
+            parts.append((name, 0, float(value), ""))
+        except ValueError:
+            parts.append((name, 1, 0.0, value))
+    return parts
+
+
+def _tuning_optimum(settings, region):
+    best = None
+    for setting, by_region in settings.items():
+        m = by_region.get(region)
+        if m is not None and (best is None or m[0] > best[1]):
+            best = (setting, m[0])
+    return best
+
+
+def tuning_regions(path):
+    means, seqs = _tuning_region_means(path)
+    out = ["Per region (compare --regions motion): the mean over the tuning sequences that have the region of compare's"
+           " mean PSNR (RGB, dB) in it. Sequences per region: "
+           + "; ".join(f"{g}: {', '.join(seqs[g]) if seqs[g] else 'none'}" for g in TUNING_REGIONS) + ".\n"]
+    for method, settings in means.items():
+        out.append(f"### {method} per region\n")
+        out.append("| setting | " + " | ".join(TUNING_REGIONS) + " |")
+        out.append("|---|" + "---|" * len(TUNING_REGIONS))
+        for setting, by_region in sorted(settings.items(), key=lambda kv: _setting_key(kv[0])):
+            out.append(f"| {setting} | " + " | ".join(fmt(by_region[g][0]) if g in by_region else "n/a"
+                                                       for g in TUNING_REGIONS) + " |")
+        out.append("")
+        parts = []
+        for g in TUNING_REGIONS:
+            best = _tuning_optimum(settings, g)
+            parts.append(f"{'whole frame' if g == 'all' else g}: **{best[0]}** ({fmt(best[1])} dB)" if best
+                         else f"{g}: none (no sequence has the region)")
+        out.append(f"Optimum of {method} per region: " + "; ".join(parts) + ".\n")
+    print("\n".join(out))
+
+
+def tuned_variants(path, methods, runs):
+    means, _ = _tuning_region_means(path)
+    args = {}
+    for run in runs:
+        method, label, *rest = run.split()
+        args[(method, label)] = " ".join(rest)
+    for method in methods:
+        for region in ("static", "moving"):
+            best = _tuning_optimum(means.get(method, {}), region)
+            if best is not None and (method, best[0]) in args:
+                print(f"{method}-tuned-{region} {method} {args[(method, best[0])]}")
+
+
 def interval(path, seq, key):
     def f(v):  # compare writes +infinity (an identical frame) as "inf": shown, never dropped
         return "" if v is None else "%.2f" % v if isinstance(v, (int, float)) else str(v)
@@ -526,6 +637,9 @@ def main(argv):
         "upsample-st": (3, 5, lambda a: upsample_st(*a)),
         "tuning": (1, 1, lambda a: tuning(a[0])),
         "tuning-rows": (2, None, lambda a: tuning_rows(a[0], a[1], a[2:])),
+        "tuning-region-rows": (2, None, lambda a: tuning_region_rows(a[0], a[1], a[2:])),
+        "tuning-regions": (1, 1, lambda a: tuning_regions(a[0])),
+        "tuned-variants": (2, None, lambda a: tuned_variants(a[0], a[1].split(","), a[2:])),
         "interval": (3, 3, lambda a: interval(*a)),
         "value": (3, 4, lambda a: value(*a)),
         "paired-rows": (4, 4, lambda a: paired_rows(*a)),

@@ -3,7 +3,7 @@
 # scene (64x48, 6 frames, 2-spp reference), every method and the default variants, then the ablation on the same
 # render. Checks the Table 2 summary (a row per scene with a finite PSNR for every sequence, the mean row, the
 # paired-difference table, the noise floor, the region table and its paired differences) and the ablation's paired
-# table.
+# table; issue 24: the list of the runs' arguments and the ablation's phlm-phi-linear row.
 # Usage: check_filter_phlm_pipeline.sh BUILD_DIR OUT_DIR
 set -euo pipefail
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)"
@@ -19,6 +19,8 @@ summary="$out/table2/summary.md"
 [[ -f "$summary" ]] || fail "no summary.md" "$out/table2.log"
 header="$(grep -E '^\| scene \| input \| phlm \| taa \| ema \| fxaa \| taa-0.1 \| taa-2014 \|$' "$summary" || true)"
 [[ -n "$header" ]] || fail "no Table 2 header with every sequence" "$summary"
+# Issue 24: which baseline each column is (every run's filter-phlm arguments).
+grep -qF -- '- `taa-0.1`: `--method taa --taa-alpha 0.1`' "$summary" || fail "no list of the runs' arguments" "$summary"
 row="$(grep -E '^\| fence \|' "$summary" | head -1)"
 # Every cell starts with a PSNR between 5 and 100 dB.
 awk -F'|' '{ for (i = 3; i < NF; ++i) { v = $i + 0; if (!(v > 5 && v < 100)) { print "cell " i ": " $i; exit 1 } } }' \
@@ -41,6 +43,11 @@ SIZE=64x48 FRAMES=0-5 WARMUP=2 RENDERS="$out/table2" \
 grep -q "reusing" "$out/ablation.log" || fail "the ablation rendered again" "$out/ablation.log"
 grep -qE '^\| scene \| phlm-no-feature - phlm: PSNR dB / flicker \|' "$out/ablation/summary.md" ||
   fail "no ablation table" "$out/ablation/summary.md"
+# Issue 24: the linear feature weight's row (--feature-phi linear) beside the paper's form.
+grep -qE '\| phlm-phi-linear - phlm: PSNR dB / flicker \|' "$out/ablation/summary.md" ||
+  fail "no phlm-phi-linear column in the ablation table" "$out/ablation/summary.md"
+grep -qa -- "--feature-phi=linear" "$out/ablation/fence/phlm-phi-linear/phlm-phi-linear.0003.exr" ||
+  fail "temporal:methodParameters does not record --feature-phi linear"
 # The variant is recorded in the output header.
 grep -qa -- "--no-feature=on" "$out/ablation/fence/phlm-no-feature/phlm-no-feature.0003.exr" ||
   fail "temporal:methodParameters does not record --no-feature"
