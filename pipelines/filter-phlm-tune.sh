@@ -123,7 +123,12 @@ done <<< "$TUNE_SET"
 python3 "$TABLES" tuning "$csv" > "$OUT/tuning.md"
 if [[ ${#region_args[@]} -gt 0 ]]; then
   { echo "## Per region"; echo; python3 "$TABLES" tuning-regions "$region_csv"; } >> "$OUT/tuning.md"
-  python3 "$TABLES" tuned-variants "$region_csv" taa,ema "${runs[@]}" > "$OUT/tuned-variants.txt"
+  # Every run's arguments so far (APPEND=1 adds to the CSVs: the optimum may be a run of an earlier invocation).
+  runs_file="$OUT/runs.txt"
+  [[ "$APPEND" == 1 && -f "$runs_file" ]] || : > "$runs_file"
+  printf '%s\n' "${runs[@]}" >> "$runs_file"
+  mapfile -t all_runs < <(sort -u "$runs_file")
+  python3 "$TABLES" tuned-variants "$region_csv" taa,ema "${all_runs[@]}" > "$OUT/tuned-variants.txt"
 fi
 cat "$OUT/tuning.md"
 say "$OUT/tuning.md, $OUT/tuning.csv, $OUT/tuning-regions.csv, $OUT/tuned-variants.txt"

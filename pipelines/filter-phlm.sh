@@ -13,8 +13,11 @@
 # Environment: SIZE (default 512x288), FRAMES (default 0-47), FPS (default 40), METHODS (default: every method
 #   of filter-phlm's registry, as `filter-phlm --list-methods` prints them; a named variant's name works too),
 #   VARIANTS (more runs, one per line "NAME METHOD filter-phlm options", e.g. the previous TAA
-#   "taa-0.1 taa --taa-alpha 0.1" (the engine-typical blend) and "taa-2014 taa --taa-velocity centre --taa-clip
-#   minmax --taa-alpha 0.04" by default; "" for none), TUNED (a file of more VARIANTS lines, e.g. the per-region
+#   "taa-0.1 taa --taa-alpha 0.1" (the engine-typical blend), "taa-2014 taa --taa-velocity centre --taa-clip
+#   minmax --taa-alpha 0.04" and "ema-tuned-static ema --ema-alpha 0.9" by default; "" for none; the tuned
+#   baselines, issue 24: on the tuning set (pipelines/filter-phlm-tune.sh at 256x144, 2026-11-26) TAA's optimum is
+#   alpha 0.6 (the `taa` default) over the whole frame and on moving pixels and alpha 0.1 (`taa-0.1`) on static
+#   pixels; EMA's is 0.5 (the `ema` default) over the whole frame and on moving pixels and 0.9 on static ones), TUNED (a file of more VARIANTS lines, e.g. the per-region
 #   optimum of the baselines that pipelines/filter-phlm-tune.sh writes to OUT_DIR/tuned-variants.txt),
 #   RENDER_ARGS (extra render-gbuffer options; default "--payload direct,shadow,ssao": the gi payload's 2000 VPLs
 #   make the 16-spp reference ~10x slower on llvmpipe), FILTER_ARGS (extra filter-phlm options for every run),
@@ -47,13 +50,14 @@ REUSE_RENDER="${REUSE_RENDER:-0}"
 REUSE_OUTPUTS="${REUSE_OUTPUTS:-0}"
 FILTER_ARGS="${FILTER_ARGS:-}"
 VARIANTS="${VARIANTS-taa-0.1 taa --taa-alpha 0.1
-taa-2014 taa --taa-velocity centre --taa-clip minmax --taa-alpha 0.04}"
+taa-2014 taa --taa-velocity centre --taa-clip minmax --taa-alpha 0.04
+ema-tuned-static ema --ema-alpha 0.9}"
 RENDERS="${RENDERS:-$OUT}"
 WARMUP="${WARMUP:-10}"
 REGIONS="${REGIONS:-motion}"
 NOISE_FLOOR_FRAMES="${NOISE_FLOOR_FRAMES:-3}"
 STATIC_FRAMES="${STATIC_FRAMES:-10}"
-PAIRS="${PAIRS:-phlm:taa,phlm:taa-0.1,phlm:input,taa:input,taa:taa-0.1,phlm:fxaa,phlm:ema,taa-0.1:taa-2014}"
+PAIRS="${PAIRS:-phlm:taa,phlm:taa-0.1,phlm:input,taa:input,taa:taa-0.1,phlm:fxaa,phlm:ema,phlm:ema-tuned-static,taa-0.1:taa-2014}"
 
 require_tools render-gbuffer filter-phlm compare
 render="$(tool_path render-gbuffer)"

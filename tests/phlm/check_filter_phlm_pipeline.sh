@@ -17,7 +17,7 @@ SIZE=64x48 FRAMES=0-5 WARMUP=2 REFERENCE_SPP=2 RENDER_ARGS="--payload direct,sha
   fail "filter-phlm.sh failed" "$out/table2.log"
 summary="$out/table2/summary.md"
 [[ -f "$summary" ]] || fail "no summary.md" "$out/table2.log"
-header="$(grep -E '^\| scene \| input \| phlm \| taa \| ema \| fxaa \| taa-0.1 \| taa-2014 \|$' "$summary" || true)"
+header="$(grep -E '^\| scene \| input \| phlm \| taa \| ema \| fxaa \| taa-0.1 \| taa-2014 \| ema-tuned-static \|$' "$summary" || true)"
 [[ -n "$header" ]] || fail "no Table 2 header with every sequence" "$summary"
 # Issue 24: which baseline each column is (every run's filter-phlm arguments).
 grep -qF -- '- `taa-0.1`: `--method taa --taa-alpha 0.1`' "$summary" || fail "no list of the runs' arguments" "$summary"
