@@ -4,7 +4,7 @@
 # --static-frames 2. Checks tuning-regions.csv (a row per run and region; the shares of static, moving and
 # disoccluded sum to 1 per run; the `all` row's PSNR equals tuning.csv's), the per-region section of tuning.md with
 # the optimum per region, and tuned-variants.txt (the static and moving optimum as filter-phlm.sh VARIANTS lines,
-# consistent with the CSV's highest mean).
+# consistent with the CSV's highest mean), and that APPEND=1 keeps the optimum over every run so far.
 # Usage: check_filter_phlm_tune.sh BUILD_DIR OUT_DIR
 set -euo pipefail
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)"
@@ -50,4 +50,16 @@ grep -qE '^Optimum of taa per region: whole frame: \*\*clip=variance/alpha=(0.2|
   "$out/tune/tuning.md" || fail "no per-region optimum in tuning.md" "$out/tune/tuning.md"
 grep -qE '^\| clip=variance/alpha=0.2 \| [0-9.]+ \| [0-9.]+ \| [0-9.]+ \| ' "$out/tune/tuning.md" ||
   fail "no per-region row in tuning.md" "$out/tune/tuning.md"
+# APPEND=1 extends the grid (here EMA at 0.7, the render reused): the optimum is taken over every run so far, so
+# tuned-variants.txt keeps TAA's lines although this invocation ran no TAA.
+SIZE=64x48 TUNE_SET="walkers-tiny walkers.glb 0-5 --seed 7" TAA_ALPHAS="" EMA_ALPHAS="0.7" FXAA_SUBPIX="" \
+  PHLM_LAMBDAS="" STATIC_FRAMES=2 APPEND=1 REUSE_RENDER=1 \
+  bash "$here/pipelines/filter-phlm-tune.sh" "$build" "$out/tune" > "$out/tune-append.log" 2>&1 ||
+  fail "filter-phlm-tune.sh APPEND=1 failed" "$out/tune-append.log"
+grep -q "reusing" "$out/tune-append.log" || fail "APPEND=1 REUSE_RENDER=1 rendered again" "$out/tune-append.log"
+[[ "$(grep -c ',walkers-tiny,' "$csv")" == 20 ]] || fail "tuning-regions.csv does not have 5 runs x 4 regions" "$csv"
+grep -qE '^taa-tuned-static taa --taa-clip variance --taa-alpha (0.2|1)$' "$out/tune/tuned-variants.txt" ||
+  fail "APPEND=1 lost TAA's optimum" "$out/tune/tuned-variants.txt"
+grep -qE '^ema-tuned-static ema --ema-alpha (0.5|0.7|0.9)$' "$out/tune/tuned-variants.txt" ||
+  fail "no EMA static optimum after APPEND=1" "$out/tune/tuned-variants.txt"
 echo "check_filter_phlm_tune.sh: ok"
