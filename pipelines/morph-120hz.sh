@@ -286,7 +286,8 @@ echo "Table: $TABLE"
   echo "smooth-pursuit perceived images (hold-type blur, seed 004 section 3) against those of the native 120 Hz render"
   echo "(as perceived, at the instant shown, and with the lag removed), lag in ms; compute = the method's own time per"
   echo "output frame (I/O excluded), command = whole command per output frame (EXR in and out); render ms ="
-  echo "render-gbuffer per 120 Hz frame. Paired differences: paired.csv. Plots: <scene>/psnr*.png, <scene>/perceived*.png."
+  echo "render-gbuffer per 120 Hz frame. Paired differences: paired.csv. Plots: <scene>/psnr*.png, <scene>/inbetween*.png (per region too),"
+  echo "<scene>/perceived*.png."
   echo
   python3 "$TABLES" morph-summary "$TABLE"
   echo
