@@ -26,7 +26,9 @@ for a, b in (("size: 160x128, fps: 30, frames: 0-23, chunk: 12", "size: 64x48, f
     s = s.replace(a, b)
 open(sys.argv[2], "w").write(s)
 PY
-(cd "$here" && snakemake -s pipelines/workflow/Snakefile --cores 2 --configfile "$out/config.yaml" \
+# Run from OUT_DIR: snakemake keeps its .snakemake folder (and lock) in the working folder, so this test does not
+# lock the checkout against another workflow run (the Snakefile resolves config paths from the repository root).
+(cd "$out" && snakemake -s "$here/pipelines/workflow/Snakefile" --cores 2 --configfile "$out/config.yaml" \
   --config build="$build" out="$out/out" -q) > "$out/snakemake.log" 2>&1 || {
   cat "$out/snakemake.log"
   echo "check_workflow.sh: the workflow failed" >&2
