@@ -82,3 +82,34 @@ method_args() {
   out="$(python3 "$METHODS_PY" args "$(tool_path "$1")" "$2")" || return 2
   echo "${out#*$'\t'}"
 }
+
+# The reference's noise floor (issue 24; docs/pipelines.md, "Noise floor"): a pipeline renders the first few frames
+# of its reference again at 4x the samples and compare scores the reference against that render; tables.py
+# noise-floor prints the PSNR above the pipeline's table and says when the best score comes within 10 dB of it
+# (then the table cannot rank methods finer than the reference's own noise).
+#
+# floor_frames FRAMES COUNT: the first COUNT frames of the range FRAMES ("A-B", "A-BxN", ...), as "A-(A+COUNT-1)".
+floor_frames() {
+  local first="${1%%-*}"
+  echo "$first-$(( first + $2 - 1 ))"
+}
+
+# noise_floor_render SCENE DIR FRAMES SPP RENDER_ARG...: SCENE's reference at SPP samples per pixel, frames FRAMES,
+# into DIR/reference.####.exr; RENDER_ARG are the reference's own render-gbuffer options (size, fps, payload,
+# --reference-jitter) so that only the sample count differs. Kept when REUSE_RENDER=1 and DIR exists.
+noise_floor_render() {
+  local scene="$1" dir="$2" frames="$3" spp="$4"
+  shift 4
+  if [[ "${REUSE_RENDER:-0}" == 1 && -d "$dir" ]]; then
+    echo "== $(basename "${scene%.*}"): reusing $dir (noise floor)" >&2
+    return 0
+  fi
+  echo "== $(basename "${scene%.*}"): the reference at $spp spp, frames $frames (noise floor)" >&2
+  "$(tool_path render-gbuffer)" "$scene" --out "$dir" --frames "$frames" --outputs reference --reference-spp "$spp" "$@"
+}
+
+# noise_floor_score REFERENCE FLOOR FRAMES JSON: compare's JSON (one sequence, "reference") of the reference
+# sequence REFERENCE scored against FLOOR (its 4x render), frames FRAMES: the input of tables.py noise-floor.
+noise_floor_score() {
+  "$(tool_path compare)" --reference "$2" "$1" --names reference --frames "$3" --json "$4" > /dev/null
+}

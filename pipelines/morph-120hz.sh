@@ -20,7 +20,26 @@
 #   method of the registry, `morph-120hz --list-methods`), VARIANTS (more runs, one per line "NAME METHOD
 #   morph-120hz options", e.g. "didyk-nosnap didyk --no-snap"; pipelines/morph-120hz-ablation.sh sets didyk's
 #   ablations), FFMPEG=0 to skip minterpolate, REPEAT (timed runs of each command, default 3; the median is
-#   reported).
+#   reported), REGIONS (compare --regions for the in-between frames: motion (default) or none; STATIC_FRAMES its
+#   --static-frames, default 10), PAIRS (paired differences per region, "A:B,..."; default didyk against repeat,
+#   blend, warp and minterpolate, those run), NOISE_FLOOR_FRAMES (default 3; 0: none; see below).
+#
+# The in-between frames are scored by compare alone (--frames 3-Ly3: oiiotool's "all but every third"), so their
+# means, 95 % intervals and paired differences are compare's and finite (a rendered frame repeats the native one
+# exactly: PSNR inf). With --regions motion and the native 120 Hz G-buffer every metric is also split into static
+# (still, with an unchanged reference, for STATIC_FRAMES 120 Hz frames), moving and disoccluded pixels (the
+# reprojection test between consecutive 120 Hz frames fails): summary.md has the table per region and the paired
+# differences per region. pipelines/morph-120hz-regions.sh splits the error further (the pixels that moved since
+# the rendered frame a method extrapolates from, moving shadows on static surfaces), from this script's folders.
+#
+# The reference and its noise floor: the target is the native 120 Hz render by the same renderer as the 40 Hz
+# input - one sample at every pixel centre (--jitter none), that instant's SSAO pattern and VPL set, clamped to
+# [0, 1]. Antialiasing is not the task (the input is sampled at pixel centres too, and a method is right to
+# reproduce its aliasing), but the per-instant SSAO / VPL noise of an in-between instant is something no method can
+# predict from the rendered frames. So the 4x render of the noise floor is 4 samples at every pixel centre, each
+# with its own SSAO pattern and VPL set (render-gbuffer --reference-jitter none --reference-spp 4), clamped the
+# same way, of the first NOISE_FLOOR_FRAMES compared frames; summary.md prints PSNR(native, 4x) above the tables
+# and says when the best in-between mean comes within 10 dB of it.
 # shellcheck source=pipelines/lib.sh
 source "$(dirname "${BASH_SOURCE[0]}")/lib.sh"
 
@@ -32,12 +51,18 @@ FRAMES=${FRAMES:-8}
 FACTOR=3
 REPEAT=${REPEAT:-3}
 WINDOW=3  # morph-120hz --perceive's default window
+REGIONS=${REGIONS:-motion}
+STATIC_FRAMES=${STATIC_FRAMES:-10}
+NOISE_FLOOR_FRAMES=${NOISE_FLOOR_FRAMES:-3}
+PAIRS=${PAIRS:-didyk:repeat,didyk:blend,didyk:warp,didyk:minterpolate}
 
 require_tools render-gbuffer morph-120hz compare
 RENDER="$(tool_path render-gbuffer)"
 MORPH="$(tool_path morph-120hz)"
 COMPARE="$(tool_path compare)"
 if (( FRAMES < 2 )); then die "FRAMES must be at least 2" 1; fi
+region_args=()
+if [[ "$REGIONS" != none ]]; then region_args=(--regions "$REGIONS" --static-frames "$STATIC_FRAMES"); fi
 # The methods come from the tool's registry.
 METHODS=${METHODS:-$(methods_of morph-120hz)}
 # Every run: "NAME ARGUMENTS" (the METHODS through the registry, then the VARIANTS lines).
@@ -90,11 +115,6 @@ median_ms() {
   done | python3 "$TABLES" median-ms
 }
 
-# Keep the header and the rows of compare's CSV whose frame is an in-between frame (frame % FACTOR != 0).
-inbetween_rows() {
-  awk -F, -v factor=$FACTOR 'NR == 1 { for (i = 1; i <= NF; ++i) if ($i == "frame") c = i; print; next } ($c % factor) != 0' "$1" > "$2"
-}
-
 # sequence METRIC -> "mean,ci_low,ci_high" from compare's JSON (empty fields when absent)
 json_interval() { python3 "$TABLES" interval "$@"; }
 
@@ -106,8 +126,10 @@ header_value() {
   oiiotool --info -v "$1" 2>/dev/null | awk -v key="temporal:$2" '$1 == key":" { v = $2; gsub(/"/, "", v); print v; exit }'
 }
 
+SCENE_NAMES=()
 for scene in "${SCENES[@]}"; do
   name=$(basename "$scene"); name=${name%.*}
+  SCENE_NAMES+=("$name")
   D="$OUT/$name"
   echo "== $name: rendering $FRAMES frames at 40 Hz and $((LASTNATIVE + 1)) at 120 Hz ($SIZE)" >&2
   "$RENDER" "$scene" --out "$D/r40" --fps 40 --frames "0-$LAST40" --size "$SIZE" --outputs gbuffer,color --jitter none
@@ -177,11 +199,33 @@ for scene in "${SCENES[@]}"; do
 
   echo "== $name: compare (in-between frames vs native 120 Hz)" >&2
   IFS=, ; name_list="${names[*]}"; unset IFS
+  # The PAIRS whose two sequences ran.
+  pair_list=""
+  for p in ${PAIRS//,/ }; do
+    [[ ",$name_list," == *",${p%%:*},"* && ",$name_list," == *",${p#*:},"* ]] && pair_list+="${pair_list:+,}$p"
+  done
   "$COMPARE" --reference "$D/ldr120/color.####.exr" "${tests[@]}" --names "$name_list" --frames "$FIRSTCMP-$LASTCMP" \
     --latency-aware --csv "$D/compare.csv" --json "$D/compare.json" --plot "$D/psnr.png"
-  # The in-between frames alone, with their intervals and paired differences (compare --merge of those rows).
-  inbetween_rows "$D/compare.csv" "$D/inbetween.csv"
-  "$COMPARE" --merge "$D/inbetween.csv" --json "$D/inbetween.json" > /dev/null
+  # The in-between frames alone (3n+1, 3n+2: "all but every third"), with their intervals, paired differences and,
+  # with REGIONS=motion, every metric per region of the native 120 Hz G-buffer.
+  echo "== $name: compare (in-between frames${region_args[*]:+, per region})" >&2
+  "$COMPARE" --reference "$D/ldr120/color.####.exr" "${tests[@]}" --names "$name_list" \
+    --frames "$FIRSTCMP-${LASTCMP}y$FACTOR" --latency-aware --gbuffer "$D/r120/gbuffer.####.exr" "${region_args[@]}" \
+    --csv "$D/inbetween.csv" --json "$D/inbetween.json" --plot "$D/inbetween.png" > "$D/inbetween.txt"
+
+  # The reference's noise floor (see the header): the native 120 Hz render's first NOISE_FLOOR_FRAMES compared
+  # frames at 4 samples per pixel centre, clamped as ldr120 is (lib.sh noise_floor_render / noise_floor_score).
+  if (( NOISE_FLOOR_FRAMES > 0 )); then
+    floor_range="$(floor_frames "$FIRSTCMP-$LASTCMP" "$NOISE_FLOOR_FRAMES")"
+    noise_floor_render "$scene" "$D/r120-4x" "$floor_range" 4 --fps 120 --size "$SIZE" --reference-jitter none
+    mkdir -p "$D/ldr120-4x"
+    for ((n = ${floor_range%-*}; n <= ${floor_range#*-}; ++n)); do
+      printf -v f "%04d" "$n"
+      oiiotool "$D/r120-4x/reference.$f.exr" --ch R,G,B --clamp:min=0:max=1 -d float --compression zip \
+        -o "$D/ldr120-4x/reference.$f.exr"
+    done
+    noise_floor_score "$D/ldr120/color.####.exr" "$D/ldr120-4x/reference.####.exr" "$floor_range" "$D/noise-floor.json"
+  fi
 
   echo "== $name: perceived images (hold-type blur under smooth pursuit)" >&2
   # The native stream's perceived images through LASTCMP + FACTOR (for the latency-aware score of a test shown
@@ -242,7 +286,26 @@ echo "Table: $TABLE"
   echo "smooth-pursuit perceived images (hold-type blur, seed 004 section 3) against those of the native 120 Hz render"
   echo "(as perceived, at the instant shown, and with the lag removed), lag in ms; compute = the method's own time per"
   echo "output frame (I/O excluded), command = whole command per output frame (EXR in and out); render ms ="
-  echo "render-gbuffer per 120 Hz frame. Paired differences: paired.csv. Plots: <scene>/psnr*.png, <scene>/perceived*.png."
+  echo "render-gbuffer per 120 Hz frame. Paired differences: paired.csv. Plots: <scene>/psnr*.png, <scene>/inbetween*.png (per region too),"
+  echo "<scene>/perceived*.png."
   echo
   python3 "$TABLES" morph-summary "$TABLE"
+  echo
+  if (( NOISE_FLOOR_FRAMES > 0 )); then
+    echo "The reference's noise floor per scene (the native 120 Hz render against 4 samples at every pixel centre,"
+    echo "the SSAO / VPL noise averaged; the best score is the best in-between mean, latency-free):"
+    echo
+    for s in "${SCENE_NAMES[@]}"; do
+      echo "- $s: $(python3 "$TABLES" noise-floor "$OUT/$s/noise-floor.json" "$OUT/$s/inbetween.json" 1 4)"
+    done
+    echo
+  fi
+  if [[ "$REGIONS" != none ]]; then
+    echo "In-between frames per region of the native 120 Hz G-buffer (compare --frames $FIRSTCMP-${LASTCMP}y$FACTOR"
+    echo "--regions $REGIONS --static-frames $STATIC_FRAMES, latency-free):"
+    python3 "$TABLES" region-table "$OUT" inbetween.json "$(IFS=,; echo "${SCENE_NAMES[*]}")" "$name_list" "$pair_list"
+  fi
 } > "$OUT/summary.md"
+if [[ "$REGIONS" != none ]]; then
+  python3 "$TABLES" region-table "$OUT" inbetween.json "$(IFS=,; echo "${SCENE_NAMES[*]}")" "$name_list" "$pair_list"
+fi

@@ -41,6 +41,9 @@ Tables:
       (default: as written); "nan" when absent
   tables.py paired-rows JSON SCENE SCORE METRIC
       rows "scene,score,metric,a,b,frames,mean_difference_db,ci_low,ci_high" of compare's paired differences
+  tables.py region-table OUT_DIR JSON_NAME SCENE[,SCENE...] SEQ[,SEQ...] [A:B,A:B...]
+      the per-region tables of `scenes` alone (share, mean PSNR [95%] / pooled PSNR per region, then the paired
+      differences per region) from OUT_DIR/SCENE/JSON_NAME (e.g. morph-120hz.sh's inbetween.json)
   tables.py morph-summary SUMMARY.csv
       morph-120hz.sh's summary table (Markdown) from its summary.csv
   tables.py noise-floor FLOOR_JSON METRICS_JSON SPP SPP4
@@ -320,6 +323,15 @@ def region_tables(data, scene_list, seq_list, pair_list):
                 d, ci = paired_value(data[s].get("paired"), "psnr_rgb", a, b, "all", region)
                 cells.append(cell(d, ci, 2, sign=True) if d is not None else "n/a")
             print(f"| {s} | {region} | " + " | ".join(cells) + " |")
+
+
+def region_table(out_dir, json_name, scene_list, seq_list, pair_list):
+    """`scenes`' per-region tables alone, from OUT_DIR/SCENE/JSON_NAME; says so when compare ran without regions."""
+    data = {s: json.load(open(os.path.join(out_dir, s, json_name))) for s in scene_list}
+    if not any("regions" in q for s in scene_list for q in data[s]["sequences"]):
+        print("No per-region values: compare ran without --regions motion.")
+        return
+    region_tables(data, scene_list, seq_list, pair_list)
 
 
 def upsample_st(scene_dir, low, full, ss_json=None, ss_label=None):
@@ -643,6 +655,8 @@ def main(argv):
         "interval": (3, 3, lambda a: interval(*a)),
         "value": (3, 4, lambda a: value(*a)),
         "paired-rows": (4, 4, lambda a: paired_rows(*a)),
+        "region-table": (4, 5, lambda a: region_table(a[0], a[1], a[2].split(","), a[3].split(","),
+                                                      pairs(a[4] if len(a) > 4 else ""))),
         "morph-summary": (1, 1, lambda a: morph_summary(a[0])),
         "noise-floor": (4, 4, lambda a: noise_floor(*a)),
         "csv-mean": (2, 3, lambda a: csv_mean(*a)),

@@ -28,7 +28,17 @@
 #   render-gbuffer --reference-jitter none - and scores every method against it too: the target of methods that
 #   accumulate, issue 15 item 6), REGIONS (compare --regions for the main comparison: motion (default) or none;
 #   STATIC_FRAMES its --static-frames, default 10), RENDERS (folder holding SCENE/render, default OUT_DIR), REUSE_RENDER=1 (keep an
-#   existing render folder).
+#   existing render folder), NOISE_FLOOR_FRAMES (default 3; 0: none): the first N frames of each reference are
+#   rendered again at 4x its samples and compare scores the reference against them (its noise floor, issue 24),
+#   printed above the scene's table with a note when the best mean PSNR comes within 10 dB of it.
+#
+# Noise floors (which 4x render each reference is measured against): the full-resolution payload (`color`, one
+# sample at each pixel centre with that frame's SSAO pattern and VPL set) against 4 samples at every pixel centre,
+# each with its own SSAO pattern and VPL set (render-gbuffer --reference-jitter none --reference-spp 4): the
+# payload's own per-frame noise, which a method that accumulates averages away and is then scored down for; the
+# noise-averaged reference (NOISE_AVERAGED_SPP = N) against 4N samples at the pixel centres (--reference-jitter
+# none again: the issue 24 audit's choice for this task, since upsample-st reconstructs the payload at pixel
+# centres and is not asked to antialias); the supersampled reference (REFERENCE_SPP = N) against 4N Halton samples.
 #
 # Ground truth: the issue and the paper's Figure 8 measure against full-resolution rendering of the same payload
 # (render-gbuffer's `color` with `--jitter none`: one sample at every pixel centre, the samples the regular
@@ -59,6 +69,7 @@ WARMUP="${WARMUP:-$(( FACTOR * FACTOR ))}"
 NOISE_AVERAGED_SPP="${NOISE_AVERAGED_SPP:-0}"
 RENDERS="${RENDERS:-}"
 REUSE_RENDER="${REUSE_RENDER:-0}"
+NOISE_FLOOR_FRAMES="${NOISE_FLOOR_FRAMES:-3}"
 if [[ "$REFERENCE_SPP" -gt 0 && "$NOISE_AVERAGED_SPP" -gt 0 ]]; then
   die "REFERENCE_SPP and NOISE_AVERAGED_SPP both need render-gbuffer's reference output: set one" 1
 fi
@@ -171,8 +182,39 @@ for scene in "${scenes[@]}"; do
     echo "== $name: compare against the noise-averaged payload ($NOISE_AVERAGED_SPP samples at the pixel centres)" >&2
     mkdir -p "$OUT/noise-averaged/$name"
     "$compare" --reference "$render_dir/reference.####.exr" "${tests[@]}" --names "$seq_names" \
-      --csv "$OUT/noise-averaged/$name/metrics.csv" --json "$OUT/noise-averaged/$name/metrics.json" \
-      --warmup "$WARMUP" --plot "$OUT/noise-averaged/$name/psnr.png" | tee "$dir/compare-noise-averaged.txt"
+      --gbuffer "$render_dir/gbuffer.####.exr" --csv "$OUT/noise-averaged/$name/metrics.csv" \
+      --json "$OUT/noise-averaged/$name/metrics.json" --warmup "$WARMUP" --plot "$OUT/noise-averaged/$name/psnr.png" \
+      "${region_args[@]}" | tee "$dir/compare-noise-averaged.txt"
+  fi
+
+  # The noise floor of each reference scored against (see the header): the reference's first NOISE_FLOOR_FRAMES
+  # frames at 4x its samples (lib.sh noise_floor_render / noise_floor_score), the line tables.py noise-floor prints.
+  floors=()
+  if [[ "$NOISE_FLOOR_FRAMES" -gt 0 ]]; then
+    floor_range="$(floor_frames "$FRAMES" "$NOISE_FLOOR_FRAMES")"
+    floor_root="${RENDERS:-$OUT}/$name"
+    # shellcheck disable=SC2086
+    noise_floor_render "$scene" "$floor_root/floor-payload" "$floor_range" 4 --size "$SIZE" --fps "$FPS" \
+      --reference-jitter none $RENDER_ARGS
+    noise_floor_score "$render_dir/color.####.exr" "$floor_root/floor-payload/reference.####.exr" "$floor_range" \
+      "$dir/noise-floor.json"
+    floors+=("full-resolution payload|$dir/noise-floor.json|$dir/metrics.json|1|4")
+    if [[ "$NOISE_AVERAGED_SPP" -gt 0 ]]; then
+      # shellcheck disable=SC2086
+      noise_floor_render "$scene" "$floor_root/floor-noise-averaged" "$floor_range" $(( 4 * NOISE_AVERAGED_SPP )) \
+        --size "$SIZE" --fps "$FPS" --reference-jitter none $RENDER_ARGS
+      noise_floor_score "$render_dir/reference.####.exr" "$floor_root/floor-noise-averaged/reference.####.exr" \
+        "$floor_range" "$OUT/noise-averaged/$name/noise-floor.json"
+      floors+=("noise-averaged reference|$OUT/noise-averaged/$name/noise-floor.json|$OUT/noise-averaged/$name/metrics.json|$NOISE_AVERAGED_SPP|$(( 4 * NOISE_AVERAGED_SPP ))")
+    fi
+    if [[ "$REFERENCE_SPP" -gt 0 ]]; then
+      # shellcheck disable=SC2086
+      noise_floor_render "$scene" "$floor_root/floor-supersampled" "$floor_range" $(( 4 * REFERENCE_SPP )) \
+        --size "$SIZE" --fps "$FPS" $RENDER_ARGS
+      noise_floor_score "$render_dir/reference.####.exr" "$floor_root/floor-supersampled/reference.####.exr" \
+        "$floor_range" "$dir/noise-floor-supersampled.json"
+      floors+=("supersampled reference|$dir/noise-floor-supersampled.json|$dir/metrics-supersampled.json|$REFERENCE_SPP|$(( 4 * REFERENCE_SPP ))")
+    fi
   fi
 
   # The shading ms: render-gbuffer's timings.csv, which compare does not read (tables.py, "Numbers compare does
@@ -184,6 +226,11 @@ for scene in "${scenes[@]}"; do
   {
     echo "## $name"
     echo
+    for f in "${floors[@]}"; do
+      IFS='|' read -r label floor_json metrics_json spp spp4 <<< "$f"
+      echo "Against the $label: $(python3 "$TABLES" noise-floor "$floor_json" "$metrics_json" "$spp" "$spp4")"
+      echo
+    done
     python3 "$TABLES" upsample-st "$dir" "$shade_low" "$shade_full" "${ss[@]}"
     echo
     echo "Per-frame PSNR: $name/psnr.png; metrics: $name/metrics.csv, $name/metrics.json."

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Runs pipelines/upsample-st.sh on a tiny render of the built-in tower scene (64x48, 6 frames, every payload
 # term, a 2-spp supersampled reference) and checks its summary: one table row per method with a finite PSNR
-# against the full-resolution payload and against the reference, a speed-up, and herzog's margins line.
+# against the full-resolution payload and against the reference, a speed-up, herzog's margins line, the noise
+# floors and the per-region table.
 # Usage: check_upsample_st.sh BUILD_DIR OUT_DIR
 set -euo pipefail
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)"
@@ -30,4 +31,17 @@ for m in spatial temporal herzog herzog-favor-spatial taau spatial-demod; do
 done
 grep -qE '^herzog - spatial: [+-][0-9.]+ dB, herzog - temporal: [+-][0-9.]+ dB\.$' "$summary" || fail "no margins line"
 [[ -f "$out/tower/psnr.png" && -f "$out/tower/metrics.csv" ]] || fail "no per-frame chart or metrics"
+# Issue 24: each reference's noise floor above the scene's table (the payload's against 4 samples at the pixel
+# centres, the 2-spp reference's against 8 spp), and the per-region table with its paired differences (6 frames
+# are fewer than --static-frames 10: the static share is 0 %, the rows are there).
+grep -qE '^Against the full-resolution payload: Noise floor: PSNR \(RGB\) of the 1-spp reference against a 4-spp render of its first 3 frames: [0-9.]+ \[' \
+  "$summary" || fail "no noise-floor line for the payload"
+grep -qE '^Against the supersampled reference: Noise floor: PSNR \(RGB\) of the 2-spp reference against a 8-spp render of its first 3 frames: [0-9.]+ \[' \
+  "$summary" || fail "no noise-floor line for the supersampled reference"
+grep -qE 'The best mean PSNR \(herzog(-favor-spatial)?, [0-9.]+ dB\) (is within 10 dB of it|is [0-9.]+ dB below it)' "$summary" ||
+  fail "the noise-floor line does not compare the best score with the floor"
+for region in all static moving disoccluded; do
+  grep -qE "^\| tower \| $region \| [0-9.]+ % \|" "$summary" || fail "no $region row in the region table"
+done
+grep -qE '^\| tower \| moving \| [+-][0-9.]+ \[' "$summary" || fail "no per-region paired differences"
 echo "check_upsample_st.sh: ok"

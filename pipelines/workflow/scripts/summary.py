@@ -3,9 +3,12 @@
 with its 95 % interval, the mean compute time from the output headers, whether the variant is on the Pareto front
 of compute time against PSNR (compare's `pareto` flag, the front of its speed chart), and its paired PSNR
 difference against the baseline with the interval; with compare --regions, a table per scene of the regions'
-shares and each variant's mean PSNR [95 % CI] / pooled PSNR per region. It only formats what compare computed
-(docs/pipelines.md)."""
+shares and each variant's mean PSNR [95 % CI] / pooled PSNR per region; with --noise-floor-spp, the reference's
+noise floor above each scene's table (from the noise-floor.json files among the inputs, beside each compare.json:
+tables.py noise-floor's line). It only formats what compare computed (docs/pipelines.md)."""
 import argparse
+import contextlib
+import io
 import json
 import os
 import sys
@@ -13,6 +16,7 @@ import sys
 # The cells are formatted by pipelines/tables.py, the pipelines' one table formatter.
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", ".."))
 from tables import fmt_value as fmt, num, with_ci  # noqa: E402
+from tables import noise_floor  # noqa: E402
 
 
 def main():
@@ -20,14 +24,26 @@ def main():
     ap.add_argument("--title", default="")
     ap.add_argument("--baseline", default="")
     ap.add_argument("--out", required=True)
+    ap.add_argument("--noise-floor-spp", type=int, default=0,
+                    help="samples per pixel of the reference; its noise-floor.json files were rendered at 4x")
     ap.add_argument("json", nargs="+")
     a = ap.parse_args()
+    floors = {os.path.dirname(p): p for p in a.json if os.path.basename(p) == "noise-floor.json"}
     lines = [f"# {a.title}", ""]
     for path in a.json:
+        if os.path.basename(path) == "noise-floor.json":
+            continue
         scene = os.path.basename(os.path.dirname(path))
         report = json.load(open(path))
         seqs = report["sequences"]
-        lines += [f"## {scene}", "",
+        lines += [f"## {scene}", ""]
+        floor = floors.get(os.path.dirname(path))
+        if floor and a.noise_floor_spp > 0:
+            text = io.StringIO()
+            with contextlib.redirect_stdout(text):
+                noise_floor(floor, path, a.noise_floor_spp, 4 * a.noise_floor_spp)
+            lines += [text.getvalue().strip(), ""]
+        lines += [
                   "| variant | PSNR dB [95% CI] | SSIM | flicker | compute ms | Pareto | PSNR - " + (a.baseline or "baseline") + " [95% CI] |",
                   "|---|---|---|---|---|---|---|"]
         paired = {}
