@@ -143,20 +143,17 @@ for scene in "${scenes[@]}"; do
       --out "$dir/$n/$n.####.exr" $args $FILTER_ARGS
   done
 
-  # The reference's noise floor: its first NOISE_FLOOR_FRAMES frames at 4x the samples, scored by compare.
+  # The reference's noise floor: its first NOISE_FLOOR_FRAMES frames at 4x the samples, scored by compare
+  # (lib.sh noise_floor_render / noise_floor_score, shared with upsample-st.sh and morph-120hz.sh).
   floor_json=""
   if [[ "$NOISE_FLOOR_FRAMES" -gt 0 ]]; then
-    first="${FRAMES%%-*}"
-    floor_frames="$first-$(( first + NOISE_FLOOR_FRAMES - 1 ))"
+    floor_range="$(floor_frames "$FRAMES" "$NOISE_FLOOR_FRAMES")"
     floor_dir="$RENDERS/$name/render-4x"
-    if [[ ! ( "$REUSE_RENDER" == 1 && -d "$floor_dir" ) ]]; then
-      echo "== $name: the reference at $(( 4 * REFERENCE_SPP )) spp, frames $floor_frames (noise floor)" >&2
-      # shellcheck disable=SC2086
-      "$render" "$scene" --out "$floor_dir" --size "$SIZE" --fps "$FPS" --frames "$floor_frames" \
-        --outputs reference --jitter random --reference-spp $(( 4 * REFERENCE_SPP )) $RENDER_ARGS
-    fi
-    "$compare" --reference "$floor_dir/reference.####.exr" "$render_dir/reference.####.exr" --names reference \
-      --frames "$floor_frames" --json "$dir/noise-floor.json" > /dev/null
+    # shellcheck disable=SC2086
+    noise_floor_render "$scene" "$floor_dir" "$floor_range" $(( 4 * REFERENCE_SPP )) --size "$SIZE" --fps "$FPS" \
+      --jitter random $RENDER_ARGS
+    noise_floor_score "$render_dir/reference.####.exr" "$floor_dir/reference.####.exr" "$floor_range" \
+      "$dir/noise-floor.json"
     floor_json="$dir/noise-floor.json"
   fi
 
