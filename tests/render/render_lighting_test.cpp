@@ -160,6 +160,39 @@ TEST_F(RenderLighting, FillAndAmbientGiveHandComputedRadiance) {
   }
 }
 
+// A USD DomeLight of radiance L (colour c) and nothing else: a Lambertian quad facing the camera reflects
+// albedo x L x c (the hemisphere integral of albedo / pi x L (n.w)), as docs/usd.md says. Before this test the
+// renderer gave albedo x L x c / pi.
+TEST_F(RenderLighting, ADomeLightOfRadianceLMakesALambertianSurfaceReflectAlbedoTimesL) {
+  const glm::vec3 r = glm::normalize(axes.right), u = glm::normalize(axes.up);
+  char points[512];
+  const glm::vec3 p[4] = {-r - u, r - u, r + u, -r + u};
+  std::snprintf(points, sizeof points, "[(%.9g, %.9g, %.9g), (%.9g, %.9g, %.9g), (%.9g, %.9g, %.9g), (%.9g, %.9g, %.9g)]",
+                p[0].x, p[0].y, p[0].z, p[1].x, p[1].y, p[1].z, p[2].x, p[2].y, p[2].z, p[3].x, p[3].y, p[3].z);
+  const fs::path usda = dir / "dome.usda";
+  std::ofstream(usda) << "#usda 1.0\ndef Mesh \"Quad\" {\n int[] faceVertexCounts = [4]\n int[] faceVertexIndices = [0, 1, 2, 3]\n"
+                      << " point3f[] points = " << points << "\n"
+                      << " color3f[] primvars:displayColor = [(0.8, 0.6, 0.4)]\n uniform token subdivisionScheme = \"none\"\n}\n"
+                      << "def DomeLight \"Sky\" {\n float inputs:intensity = 0.5\n color3f inputs:color = (1, 0.5, 0.25)\n}\n";
+  auto s = Scene::load(usda.string());
+  ASSERT_TRUE(s) << s.error().message;
+  RenderOptions o;
+  o.payload.direct = o.payload.shadow = o.payload.ssao = false;
+  o.lighting.key = o.lighting.fill = o.lighting.ambient = 0.0f;  // whatever the rig does, it adds nothing
+  const Rendered out = render(*s, o);
+  const float expected[3] = {0.8f * 0.5f, 0.6f * 0.25f, 0.4f * 0.125f};
+  int covered = 0;
+  for (int ch = 0; ch < 3; ++ch) {
+    const float* px = out.color.plane(std::string(1, "RGB"[ch]));
+    for (std::size_t i = 0; i < out.color.pixel_count(); ++i) {
+      if (px[i] == 0.0f) continue;  // background
+      covered += ch == 0;
+      ASSERT_NEAR(px[i], expected[ch], 2e-5f) << "channel " << "RGB"[ch];
+    }
+  }
+  EXPECT_GT(covered, 200) << "the quad covers too few pixels";
+}
+
 TEST_F(RenderLighting, TheKeyScalesDirectLightLinearly) {
   // A quad facing the camera is lit by the key: direct light is E (n.l) BRDF, so it doubles with --key-light.
   auto s = Scene::load(write_quad(dir, "lit", glm::normalize(axes.back), glm::normalize(axes.right)));

@@ -540,8 +540,9 @@ void Renderer::Impl::shade(const Fbo& gb, const Fbo& target, const View& v, std:
   const float clamp_d = p.vpl_clamp > 0 ? p.vpl_clamp : 0.02f * scene_diagonal;
   g.Uniform1f(g.GetUniformLocation(prog, "u_vpl_clamp2"), clamp_d * clamp_d);
   if (scene.ambient != glm::vec3(0.0f) || rig) {
-    // The rig's ambient A is a radiance: gi adds a(1-m)/pi * u_ambient, so pi A makes a white surface reflect A.
-    const glm::vec3 a = state->ambient + glm::vec3(rig ? 3.14159265f * options.lighting.ambient : 0.0f);
+    // Both ambients are radiances L (the scene's DomeLight, the rig's A): gi adds a(1-m)/pi * u_ambient, so
+    // pi L makes a Lambertian surface reflect a(1-m) L, the integral of a/pi L (n.w) over the hemisphere (docs/usd.md).
+    const glm::vec3 a = 3.14159265f * (state->ambient + glm::vec3(rig ? options.lighting.ambient : 0.0f));
     g.Uniform3f(g.GetUniformLocation(prog, "u_ambient"), a.x, a.y, a.z);
   }
   if (rig) {

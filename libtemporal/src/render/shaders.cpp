@@ -186,7 +186,7 @@ uniform float u_proj_scale;    // pixels per world unit at depth 1 (P[1][1] * he
 uniform uint u_seed;           // changes every frame (and every reference sample)
 uniform int u_vpl_count;
 uniform float u_vpl_clamp2;    // minimum squared VPL distance
-uniform vec3 u_ambient;        // radiance of the environment (AMBIENT only)
+uniform vec3 u_ambient;        // pi x the environment's radiance (AMBIENT only; renderer.cpp)
 uniform vec3 u_fill_irradiance;  // the automatic fill light (FILL only): irradiance facing it
 uniform vec3 u_fill_direction;   // the direction it travels (unit)
 const float PI = 3.14159265358979;
@@ -305,7 +305,8 @@ void main() {
   }
   gi = diffuse * acc / PI;
 #ifdef AMBIENT
-  // A uniform environment (USD DomeLight) of radiance L: a Lambertian surface reflects diffuse * L (docs/usd.md).
+  // A uniform environment (USD DomeLight, the rig's ambient) of radiance L: u_ambient = pi L (renderer.cpp), so a
+  // Lambertian surface reflects albedo (1 - metallic) L (docs/usd.md).
   gi += diffuse * u_ambient;
 #endif
 #ifdef FILL
