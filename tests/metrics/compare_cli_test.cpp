@@ -452,6 +452,11 @@ TEST_F(CompareCli, OverflowingCropsAndPixelsPerDegreeAreUsageErrors) {
   EXPECT_NE(out.find("--crop 60,60,2147483647,2147483647 does not fit in the 64x40 image"), std::string::npos) << out;
   EXPECT_EQ(run("--reference ref.####.exr a.####.exr --png pics --crop 2147483647,0,1,1", &out), 1) << out;
   EXPECT_NE(out.find("--crop"), std::string::npos) << out;
+  // Found at the first frame, before any frame is scored: no CSV and no table (it was found when the sheet was drawn,
+  // after the whole comparison had run).
+  EXPECT_EQ(run("--reference ref.####.exr a.####.exr --png pics --csv crop.csv --crop 60,0,8,8", &out), 1) << out;
+  EXPECT_NE(out.find("--crop 60,0,8,8 does not fit in the 64x40 image"), std::string::npos) << out;
+  EXPECT_FALSE(fs::exists(dir_ / "crop.csv")) << out;
   for (const char* ppd : {"1e30", "1001", "0.5", "1e-40", "inf"}) {
     EXPECT_EQ(run(std::string("--reference ref.####.exr a.####.exr --flip ldr --ppd ") + ppd, &out), 1) << ppd << out;
     EXPECT_NE(out.find("--ppd"), std::string::npos) << out;

@@ -187,6 +187,13 @@ Status ComparisonPictures::Impl::start(const ComparedFrame& cf) {
                      : nc == 1 ? std::vector<std::string>{"Y"}
                                : std::vector<std::string>(cf.reference_channels.begin(), cf.reference_channels.end());
   if (auto line = o.profile.resolve(width, height); !line) return line.error();  // a usage error stops the run
+  // --crop is checked here, at the first frame, not when the sheet is drawn after the whole comparison. In 64 bits:
+  // x + w of --crop 60,60,2147483647,2147483647 overflows an int (and then passed, issue 26 item 8).
+  for (const Rect& r : o.crops)
+    if (std::int64_t(r.x) + r.width > width || std::int64_t(r.y) + r.height > height)
+      return Error::usage("--crop " + std::to_string(r.x) + "," + std::to_string(r.y) + "," + std::to_string(r.width) +
+                          "," + std::to_string(r.height) + " does not fit in the " + std::to_string(width) + "x" +
+                          std::to_string(height) + " image");
   for (std::size_t i = 0; i < names.size(); ++i) profiles.emplace_back(o.profile, profile_channels);
 
   // --png error maps: one range for every frame and method, from the first frame (values above it saturate).
@@ -391,14 +398,7 @@ Expected<PictureProducts> ComparisonPictures::Impl::finish(const ComparisonRepor
 Expected<std::vector<Rect>> ComparisonPictures::Impl::sheet_crops(bool flip) const {
   const Captured& c = *captured;
   std::vector<Rect> crops;
-  for (const Rect& r : o.crops) {
-    // In 64 bits: x + w of --crop 60,60,2147483647,2147483647 overflows an int (and then passed, issue 26 item 8).
-    if (std::int64_t(r.x) + r.width > width || std::int64_t(r.y) + r.height > height)
-      return Error::usage("--crop " + std::to_string(r.x) + "," + std::to_string(r.y) + "," + std::to_string(r.width) +
-                          "," + std::to_string(r.height) + " does not fit in the " + std::to_string(width) + "x" +
-                          std::to_string(height) + " image");
-    crops.push_back(r);
-  }
+  for (const Rect& r : o.crops) crops.push_back(r);  // checked against the image at the first frame (start)
   if (!crops.empty()) return crops;
   std::vector<float> score(std::size_t(width) * std::size_t(height), 0.0f);
   for (const auto& t : c.tests) {
