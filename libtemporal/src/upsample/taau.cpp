@@ -35,8 +35,11 @@
 #include "temporal/core/isa.h"
 #include "temporal/core/parallel.h"
 
+#include <algorithm>
 #include <atomic>
+#include <bit>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 
 namespace temporal::upsample {
