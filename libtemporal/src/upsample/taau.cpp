@@ -3,7 +3,8 @@
 // shader source, ffx_fsr2_upsample.h / ffx_fsr2_accumulate.h / ffx_fsr2_lock.h, versions 2.0-2.2) and of Unreal
 // Engine 4's TAAU (Karis 2014, "High Quality Temporal Supersampling": YCoCg neighbourhood clamp of the history).
 // Not a port: one CPU pass per frame over full-resolution rows, with the choices below (docs/upsample-st.md, "taau",
-// lists each with its source).
+// lists each with its source). taau_impl.inc runs each step below as a plain loop over a tile of the row (planar
+// buffers, every branch computed and selected), so that the compiler vectorises it (issue 27).
 //
 // Per full-resolution pixel p (this frame's jittered low-resolution samples sit at full-resolution pixel centres,
 // docs/conventions.md, "Jitter"):
@@ -35,8 +36,11 @@
 #include "temporal/core/isa.h"
 #include "temporal/core/parallel.h"
 
+#include <algorithm>
 #include <atomic>
+#include <bit>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 
 namespace temporal::upsample {

@@ -133,8 +133,9 @@ int main(int argc, char** argv) {
   const int last = int(up::method_variants().size()) - 1;
   auto* u = benchmark::RegisterBenchmark("BM_Upsample", BM_Upsample)->DenseRange(0, last)->Unit(benchmark::kMillisecond)->UseRealTime();
   auto* m = benchmark::RegisterBenchmark("BM_Stream", BM_Stream)->DenseRange(0, last)->Unit(benchmark::kMillisecond)->UseRealTime();
-  // One thread's time per pixel of spatial, temporal and herzog.
-  const std::vector<int64_t> per_pixel = {variant_index("spatial"), variant_index("temporal"), variant_index("herzog")};
+  // One thread's time per pixel of spatial, temporal, herzog, drobot and taau.
+  const std::vector<int64_t> per_pixel = {variant_index("spatial"), variant_index("temporal"), variant_index("herzog"),
+                                          variant_index("drobot"), variant_index("taau")};
   auto* p = benchmark::RegisterBenchmark("BM_PerPixel", BM_PerPixel)
                 ->ArgsProduct({per_pixel, {1, 4}})
                 ->Unit(benchmark::kMillisecond)

@@ -27,7 +27,7 @@ const std::vector<std::string> kRGB = {"R", "G", "B"};
 
 // The variants of the file, in its order (the file has no names: a file written before a variant was added stays
 // comparable). Each must be a variant of the method table.
-const char* const kNames[] = {"spatial", "temporal", "herzog", "drobot", "drobot-refresh", "herzog-lagged"};
+const char* const kNames[] = {"spatial", "temporal", "herzog", "drobot", "drobot-refresh", "herzog-lagged", "taau"};
 constexpr int kVariants = int(std::size(kNames));
 
 up::Options options(int m, std::vector<std::string> extra = {}) {
