@@ -9,6 +9,7 @@
 #include "temporal/metrics/flip.h"
 #include "temporal/metrics/metrics.h"
 #include "temporal/morph/morph.h"
+#include "temporal/phlm/ema.h"
 #include "temporal/phlm/phlm.h"
 #include "temporal/phlm/taa.h"
 #include "temporal/upsample/methods.h"
@@ -282,7 +283,7 @@ TEST(Isa, UpsamplingAgreesAtEveryLevel) {
   }
 }
 
-// filter-phlm's dispatched filters on a 61 x 37 sequence (odd sizes: the vector loops' remainders run), 10 frames:
+// filter-phlm's dispatched filters (phlm, taa, ema) on a 61 x 37 sequence (odd sizes: the vector loops' remainders run), 10 frames:
 // a fractional camera pan, a square moving against it (disocclusions, box-test resets), noise, and a column of
 // NaN samples (invalid pixels). Returns every output value and the final state of every frame.
 template <typename Filter, typename Params>
@@ -373,8 +374,8 @@ void expect_filter_agrees(const std::string& name, const Params& params, float t
 TEST(Isa, FiltersAgreeAtEveryLevel) {
   if (levels_here().size() < 2) GTEST_SKIP() << "one kernel copy runs on this machine: nothing to compare";
   // Outputs in [0, 1]; phlm's debug.traceP and state reach 3e3 (hence the relative measure). v2 rounds a * b + c
-  // twice where v3 rounds once. taa's output is a short chain of such operations per frame: measured 7.7e-7 at
-  // most on this sequence (an ulp or a few), bound 1e-5. phlm's RLS update divides by the a-priori variance and
+  // twice where v3 rounds once. taa's and ema's outputs are short chains of such operations per frame: measured
+  // 7.7e-7 (taa) and 1.2e-7 (ema) at most on this sequence (an ulp or a few), bound 1e-5. phlm's RLS update divides by the a-priori variance and
   // carries P and beta from frame to frame, which amplifies the last-bit differences: measured 7.4e-5 (bilinear
   // fetch) and 4.5e-5 (Catmull-Rom) at most, relative, bound 5e-4 - below the 1e-3 at which the tools print values
   // and far below the filters' differences from each other.
@@ -387,6 +388,7 @@ TEST(Isa, FiltersAgreeAtEveryLevel) {
   minmax.clip = "minmax";
   minmax.velocity = "centre";
   expect_filter_agrees<phlm::TaaFilter>("taa minmax", minmax, 1e-5f);
+  expect_filter_agrees<phlm::EmaFilter>("ema", phlm::EmaParams{}, 1e-5f);
 }
 
 // morph-120hz's dispatched methods (didyk: pyramid, reconstruction, compensation, grid rasteriser; warp: splat and
