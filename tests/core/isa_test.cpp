@@ -353,8 +353,10 @@ Difference compare_runs(const std::vector<float>& a, const std::vector<float>& b
   return d;
 }
 
+// v3_is_v4: the two copies run the same operations (bit-identical); phlm's v4 copy is built for 256-bit vectors and
+// contracts differently (phlm.cpp), so it is held to `tolerance` against v3 like v2.
 template <typename Filter, typename Params>
-void expect_filter_agrees(const std::string& name, const Params& params, float tolerance) {
+void expect_filter_agrees(const std::string& name, const Params& params, float tolerance, bool v3_is_v4 = true) {
   const std::vector<Level> here = levels_here();
   std::vector<std::vector<float>> runs;
   for (Level l : here) runs.push_back(run_filter<Filter>(l, params));
@@ -365,25 +367,28 @@ void expect_filter_agrees(const std::string& name, const Params& params, float t
     EXPECT_LE(d.worst, tolerance) << name << ": v2 against " << isa::name(here[k]) << " (" << d.count << " of "
                                   << runs[0].size() << " values differ)";
   }
-  if (here.size() == 3) {
+  if (here.size() == 3 && v3_is_v4) {
     EXPECT_EQ(0, std::memcmp(runs[1].data(), runs[2].data(), runs[1].size() * sizeof(float)))
         << name << ": v3 and v4 differ";
+  } else if (here.size() == 3) {
+    const Difference d = compare_runs(runs[1], runs[2]);
+    EXPECT_LE(d.worst, tolerance) << name << ": v3 against v4 (" << d.count << " values differ)";
   }
 }
 
 TEST(Isa, FiltersAgreeAtEveryLevel) {
   if (levels_here().size() < 2) GTEST_SKIP() << "one kernel copy runs on this machine: nothing to compare";
-  // phlm runs its v3 copy at level v4 (phlm.cpp says why), so for phlm the v3 = v4 check below is by
-  // construction. Outputs in [0, 1]; phlm's debug.traceP and state reach 3e3 (hence the relative measure). v2 rounds a * b + c
+  // Outputs in [0, 1]; phlm's debug.traceP and state reach 3e3 (hence the relative measure). v2 rounds a * b + c
   // twice where v3 rounds once. taa's and ema's outputs are short chains of such operations per frame: measured
   // 7.7e-7 (taa) and 1.2e-7 (ema) at most on this sequence (an ulp or a few), bound 1e-5. phlm's RLS update divides by the a-priori variance and
-  // carries P and beta from frame to frame, which amplifies the last-bit differences: measured 7.4e-5 (bilinear
-  // fetch) and 4.5e-5 (Catmull-Rom) at most, relative, bound 5e-4 - below the 1e-3 at which the tools print values
-  // and far below the filters' differences from each other.
+  // carries P and beta from frame to frame, which amplifies the last-bit differences: measured 7.1e-5 (bilinear
+  // fetch) and 5.1e-5 (Catmull-Rom) at most, relative, v2 against v3 and v4, and 1.1e-5 / 1.4e-5 v3 against v4
+  // (phlm's v4 copy contracts differently, phlm.cpp); bound 5e-4 - below the 1e-3 at which the tools print
+  // values and far below the filters' differences from each other.
   phlm::PhlmParams catmull;
   catmull.model_fetch = "catmull-rom";
-  expect_filter_agrees<phlm::PhlmFilter>("phlm", phlm::PhlmParams{}, 5e-4f);
-  expect_filter_agrees<phlm::PhlmFilter>("phlm catmull-rom", catmull, 5e-4f);
+  expect_filter_agrees<phlm::PhlmFilter>("phlm", phlm::PhlmParams{}, 5e-4f, false);
+  expect_filter_agrees<phlm::PhlmFilter>("phlm catmull-rom", catmull, 5e-4f, false);
   expect_filter_agrees<phlm::TaaFilter>("taa", phlm::TaaParams{}, 1e-5f);
   phlm::TaaParams minmax;
   minmax.clip = "minmax";

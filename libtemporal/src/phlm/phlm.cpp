@@ -49,13 +49,11 @@ struct FrameScratch {
 };
 
 
-// The kernel copies, one per instruction set (temporal/core/isa.h). v3 contracts the multiply-adds of the bilinear
-// model fetch, the RLS update and the predictions into FMAs (v2 has none): v2's outputs and states differ from
-// v3's in the last bits, amplified by the RLS over frames (tests/core/isa_test.cpp bounds that). Level v4 runs the
-// v3 copy (the v4 one is never instantiated): this kernel is scalar arithmetic per pixel with short vector loops
-// (the 26-float record blend, the neighbourhood rows), and with isa.h's 512-bit vectors the same work took 1.2x
-// as long as at v3 on the AVX-512 AMD EPYC of docs/building.md (245-267 against 205-225 ms per 1080p frame, one
-// thread, best of 5 in each of 4 alternating runs).
+// The kernel copies, one per instruction set (temporal/core/isa.h). v3 and v4 contract the multiply-adds of the
+// bilinear model fetch, the RLS update and the predictions into FMAs (v2 has none): v2's outputs and states
+// differ from theirs in the last bits, amplified by the RLS over frames. v4 is compiled for 256-bit vectors
+// (phlm_kernels.inc says why) and with AVX-512's 32 registers GCC groups and contracts some operations
+// differently from v3: v3 and v4 differ like v2 and v3 (tests/core/isa_test.cpp bounds both).
 #define TEMPORAL_ISA_FILE "phlm_kernels.inc"
 #include "temporal/core/isa_copies.inc"
 
@@ -64,13 +62,8 @@ void run_phlm_copy(const FilterInput& in, const PhlmParams& params, const Varian
                    const float* prev, float* next, const FrameScratch& fs, float* const out[C],
                    float* const dbg[3 + C], std::atomic<std::size_t>& resets, std::atomic<std::size_t>& clamps,
                    float& max_trace) {
-#if TEMPORAL_ISA_DISPATCH
-  if (isa::active() == isa::Level::V2)
-    return v2::run_phlm<C>(in, params, variant, have_prev, prev, next, fs, out, dbg, resets, clamps, max_trace);
-  return v3::run_phlm<C>(in, params, variant, have_prev, prev, next, fs, out, dbg, resets, clamps, max_trace);
-#else
-  return native::run_phlm<C>(in, params, variant, have_prev, prev, next, fs, out, dbg, resets, clamps, max_trace);
-#endif
+  TEMPORAL_ISA_CALL(copy, return copy::run_phlm<C>(in, params, variant, have_prev, prev, next, fs, out, dbg, resets,
+                                                     clamps, max_trace))
 }
 
 }  // namespace
