@@ -284,9 +284,9 @@ TEST(Isa, UpsamplingAgreesAtEveryLevel) {
   }
 }
 
-// filter-phlm's dispatched filters (phlm, taa, ema) on a 61 x 37 sequence (odd sizes: the vector loops' remainders run), 10 frames:
-// a fractional camera pan, a square moving against it (disocclusions, box-test resets), noise, and a column of
-// NaN samples (invalid pixels). Returns every output value and the final state of every frame.
+// filter-phlm's dispatched filters (phlm, taa, ema) on a 61 x 37 sequence (odd sizes: the vector loops' remainders
+// run), 10 frames: a fractional camera pan, a square moving against it (disocclusions, box-test resets), noise, and a
+// column of NaN samples (invalid pixels). Returns every output value of every frame and the final state.
 template <typename Filter, typename Params>
 std::vector<float> run_filter(Level level, const Params& params) {
   isa::ScopedLevel scope(level);  // each process() call runs the copy of the active level
@@ -305,7 +305,8 @@ std::vector<float> run_filter(Level level, const Params& params) {
       for (int x = 0; x < w; ++x) {
         const std::size_t i = std::size_t(y) * w + std::size_t(x);
         const float sx = float(x) + 0.37f * float(t), sy = float(y) - 0.21f * float(t);
-        const bool square = std::abs(float(x) - 20.0f - 1.5f * float(t)) < 7.0f && std::abs(float(y) - 18.0f) < 6.0f;
+        const bool square =
+            std::abs(float(x) - 20.0f - 1.5f * float(t)) < 7.0f && std::abs(float(y) - 18.0f) < 6.0f;
         for (int c = 0; c < 3; ++c)
           rgb[c][i] = square ? 0.9f - 0.2f * float(c) + noise(rng)
                              : 0.45f + 0.3f * std::sin(0.3f * sx + float(c)) * std::cos(0.25f * sy) + noise(rng);
@@ -331,7 +332,8 @@ std::vector<float> run_filter(Level level, const Params& params) {
     }
   }
   const Image state = filter.state();
-  for (const auto& ch : state.channel_names()) out.insert(out.end(), state.plane(ch), state.plane(ch) + state.pixel_count());
+  for (const auto& ch : state.channel_names())
+    out.insert(out.end(), state.plane(ch), state.plane(ch) + state.pixel_count());
   return out;
 }
 
@@ -381,11 +383,11 @@ TEST(Isa, FiltersAgreeAtEveryLevel) {
   if (levels_here().size() < 2) GTEST_SKIP() << "one kernel copy runs on this machine: nothing to compare";
   // Outputs in [0, 1]; phlm's debug.traceP and state reach 3e3 (hence the relative measure). v2 rounds a * b + c
   // twice where v3 rounds once. taa's and ema's outputs are short chains of such operations per frame: measured
-  // 7.7e-7 (taa) and 1.2e-7 (ema) at most on this sequence (an ulp or a few), bound 1e-5. phlm's RLS update divides by the a-priori variance and
-  // carries P and beta from frame to frame, which amplifies the last-bit differences: measured 7.1e-5 (bilinear
-  // fetch) and 5.1e-5 (Catmull-Rom) at most, relative, v2 against v3 and v4, and 1.1e-5 / 1.4e-5 v3 against v4
-  // (phlm's v4 copy contracts differently, phlm.cpp); bound 5e-4 - below the 1e-3 at which the tools print
-  // values and far below the filters' differences from each other.
+  // 7.7e-7 (taa) and 1.2e-7 (ema) at most on this sequence (an ulp or a few), bound 1e-5. phlm's RLS update divides
+  // by the a-priori variance and carries P and beta from frame to frame, which amplifies the last-bit differences:
+  // measured 7.1e-5 (bilinear fetch) and 5.1e-5 (Catmull-Rom) at most, relative, v2 against v3 and v4, and 1.1e-5 /
+  // 1.4e-5 v3 against v4 (phlm's v4 copy contracts differently, phlm.cpp); bound 5e-4 - below the 1e-3 at which the
+  // tools print values and far below the filters' differences from each other.
   phlm::PhlmParams catmull;
   catmull.model_fetch = "catmull-rom";
   expect_filter_agrees<phlm::PhlmFilter>("phlm", phlm::PhlmParams{}, 5e-4f, false);
@@ -414,7 +416,9 @@ MorphScene morph_scene() {
   for (int y = 0; y < h; ++y)
     for (int x = 0; x < w; ++x) {
       const std::size_t i = std::size_t(y) * w + std::size_t(x);
-      const int occluder = (std::abs(x - 30) < 12 && std::abs(y - 25) < 9) ? 1 : (std::abs(x - 66) < 10 && std::abs(y - 55) < 12) ? 2 : 0;
+      const int occluder = (std::abs(x - 30) < 12 && std::abs(y - 25) < 9)    ? 1
+                           : (std::abs(x - 66) < 10 && std::abs(y - 55) < 12) ? 2
+                                                                              : 0;
       for (int c = 0; c < 3; ++c)
         rgb[c][i] = occluder ? 0.85f - 0.3f * float(occluder) + 0.05f * float(c)
                              : 0.4f + 0.25f * std::sin(0.45f * float(x) + 0.7f * float(c)) * std::cos(0.6f * float(y));
@@ -440,7 +444,8 @@ std::vector<float> run_morph(Level level, const std::string& method) {
   EXPECT_TRUE(st.is_ok()) << method << ": " << st.error().message;
   std::vector<float> values;
   for (const Image& img : out)
-    for (const auto& ch : img.channel_names()) values.insert(values.end(), img.plane(ch), img.plane(ch) + img.pixel_count());
+    for (const auto& ch : img.channel_names())
+      values.insert(values.end(), img.plane(ch), img.plane(ch) + img.pixel_count());
   return values;
 }
 

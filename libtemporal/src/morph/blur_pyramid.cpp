@@ -111,7 +111,8 @@ void BlurPyramid::reconstruct_level(int level, float* const* out, float weight, 
   const int width = widths_[0], height = heights_[0];
   const int lw = widths_[level], lh = heights_[level];
   if (level == 0) {
-    for (int c = 0; c < channels_; ++c) scale_plane_copy(base_[std::size_t(c)], out[c], width, height, weight, accumulate);
+    for (int c = 0; c < channels_; ++c)
+      scale_plane_copy(base_[std::size_t(c)], out[c], width, height, weight, accumulate);
     return;
   }
   const Taps tx = make_taps(width, lw, level);

@@ -123,9 +123,11 @@ Status PhlmFilter::process(const FilterInput& in, Image& output, FilterStats* st
   std::atomic<std::size_t> resets{0}, clamps{0};
   float max_trace = 0.0f;
   if (channels == 3) {
-    run_phlm_copy<3>(in, params_, *variant, have_prev, state_.data(), next_.data(), fs, out, dbg, resets, clamps, max_trace);
+    run_phlm_copy<3>(in, params_, *variant, have_prev, state_.data(), next_.data(), fs, out, dbg, resets, clamps,
+                     max_trace);
   } else {
-    run_phlm_copy<1>(in, params_, *variant, have_prev, state_.data(), next_.data(), fs, out, dbg, resets, clamps, max_trace);
+    run_phlm_copy<1>(in, params_, *variant, have_prev, state_.data(), next_.data(), fs, out, dbg, resets, clamps,
+                     max_trace);
   }
   std::swap(state_, next_);
   have_state_ = true;

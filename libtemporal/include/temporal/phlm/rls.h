@@ -144,8 +144,8 @@ inline constexpr float kMinD = 1e-20f;
 // One RLS step (eq. 5-7) for sample y (C values) with predictor x, forgetting factor lambda, and the
 // bounds of the header comment (D entries <= d_max, trace(P) <= trace_max). Returns trace(P) after the step.
 template <int N, int C>
-[[gnu::always_inline]] inline float update(Model<N, C>& m, const float x[N], const float y[C], float lambda, float d_max,
-                    float trace_max) {
+[[gnu::always_inline]] inline float update(Model<N, C>& m, const float x[N], const float y[C], float lambda,
+                                           float d_max, float trace_max) {
   float e[C];
   for (int c = 0; c < C; ++c) e[c] = y[c] - predict(m, c, x);  // eq. 5, a-priori error
   float gain[N];
