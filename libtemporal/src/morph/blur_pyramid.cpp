@@ -4,12 +4,14 @@
 // then a horizontal 4-tap pass), so the cost per output pixel does not depend on the level.
 #include "temporal/morph/blur_pyramid.h"
 
+#include "temporal/core/isa.h"
 #include "temporal/core/parallel.h"
 
 #include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstring>
+#include <vector>
 
 namespace temporal::morph {
 
@@ -33,6 +35,24 @@ Taps make_taps(int full, int n, int level) {
   Taps t;
   blur_pyramid_taps(full, n, level, t.index, t.weight);
   return t;
+}
+
+// The filter copies, one per instruction set (temporal/core/isa.h). v3 and v4 contract the weighted sums into FMAs
+// (v2 has none): v2's pyramid and reconstruction differ from theirs in the last bits (tests/core/isa_test.cpp);
+// v3 and v4 are bit-identical.
+#define TEMPORAL_ISA_FILE "blur_pyramid_kernels.inc"
+#include "temporal/core/isa_copies.inc"
+
+void downsample_copy(const float* src, float* dst, float* tmp, int pw, int ph, int lw, int lh) {
+  TEMPORAL_ISA_CALL(copy, return copy::downsample(src, dst, tmp, pw, ph, lw, lh))
+}
+void scale_plane_copy(const float* base, float* out, int width, int height, float weight, bool accumulate) {
+  TEMPORAL_ISA_CALL(copy, return copy::scale_plane(base, out, width, height, weight, accumulate))
+}
+void reconstruct_planes_copy(const float* const* src_planes, int channels, int lw, int width, int height,
+                             const Taps& tx, const Taps& ty, float* const* out, float weight, bool accumulate) {
+  TEMPORAL_ISA_CALL(copy, return copy::reconstruct_planes(src_planes, channels, lw, width, height, tx, ty, out, weight,
+                                                          accumulate))
 }
 
 }  // namespace
@@ -76,29 +96,7 @@ void BlurPyramid::build(std::span<const float* const> planes, int width, int hei
       const float* src = l == 1 ? base_[std::size_t(c)] : level_plane(l - 1, c);
       float* dst = level.data() + std::size_t(c) * std::size_t(lw) * std::size_t(lh);
       float* tmp = scratch_.data();
-      // Horizontal [1 2 1]/4 at the even samples, edges clamped.
-      parallel_rows(ph, [&](int y0, int y1) {
-        for (int y = y0; y < y1; ++y) {
-          const float* s = src + std::size_t(y) * std::size_t(pw);
-          float* d = tmp + std::size_t(y) * std::size_t(lw);
-          for (int i = 0; i < lw; ++i) {
-            const int x = 2 * i;
-            const float a = s[std::max(x - 1, 0)], b = s[x], cc = s[std::min(x + 1, pw - 1)];
-            d[i] = 0.25f * a + 0.5f * b + 0.25f * cc;
-          }
-        }
-      });
-      // Vertical [1 2 1]/4 at the even rows.
-      parallel_rows(lh, [&](int y0, int y1) {
-        for (int j = y0; j < y1; ++j) {
-          const int y = 2 * j;
-          const float* a = tmp + std::size_t(std::max(y - 1, 0)) * std::size_t(lw);
-          const float* b = tmp + std::size_t(y) * std::size_t(lw);
-          const float* cc = tmp + std::size_t(std::min(y + 1, ph - 1)) * std::size_t(lw);
-          float* d = dst + std::size_t(j) * std::size_t(lw);
-          for (int i = 0; i < lw; ++i) d[i] = 0.25f * a[i] + 0.5f * b[i] + 0.25f * cc[i];
-        }
-      });
+      downsample_copy(src, dst, tmp, pw, ph, lw, lh);
     }
   }
 }
@@ -113,43 +111,15 @@ void BlurPyramid::reconstruct_level(int level, float* const* out, float weight, 
   const int width = widths_[0], height = heights_[0];
   const int lw = widths_[level], lh = heights_[level];
   if (level == 0) {
-    for (int c = 0; c < channels_; ++c) {
-      parallel_rows(height, [&](int y0, int y1) {
-        for (int y = y0; y < y1; ++y) {
-          const float* s = base_[std::size_t(c)] + std::size_t(y) * std::size_t(width);
-          float* d = out[c] + std::size_t(y) * std::size_t(width);
-          for (int x = 0; x < width; ++x) d[x] = (accumulate ? d[x] : 0.0f) + weight * s[x];
-        }
-      });
-    }
+    for (int c = 0; c < channels_; ++c)
+      scale_plane_copy(base_[std::size_t(c)], out[c], width, height, weight, accumulate);
     return;
   }
   const Taps tx = make_taps(width, lw, level);
   const Taps ty = make_taps(height, lh, level);
-  parallel_rows(height, [&](int y0, int y1) {
-    std::vector<float> row(static_cast<std::size_t>(lw));  // one per band of rows, never per pixel
-    for (int c = 0; c < channels_; ++c) {
-      const float* src = level_plane(level, c);
-      for (int y = y0; y < y1; ++y) {
-        const int* yi = &ty.index[std::size_t(y) * 4];
-        const float* yw = &ty.weight[std::size_t(y) * 4];
-        const float* r0 = src + std::size_t(yi[0]) * std::size_t(lw);
-        const float* r1 = src + std::size_t(yi[1]) * std::size_t(lw);
-        const float* r2 = src + std::size_t(yi[2]) * std::size_t(lw);
-        const float* r3 = src + std::size_t(yi[3]) * std::size_t(lw);
-        for (int i = 0; i < lw; ++i) row[std::size_t(i)] = yw[0] * r0[i] + yw[1] * r1[i] + yw[2] * r2[i] + yw[3] * r3[i];
-        float* d = out[c] + std::size_t(y) * std::size_t(width);
-        const int* xi = tx.index.data();
-        const float* xw = tx.weight.data();
-        for (int x = 0; x < width; ++x) {
-          const std::size_t k = std::size_t(x) * 4;
-          const float v = xw[k] * row[std::size_t(xi[k])] + xw[k + 1] * row[std::size_t(xi[k + 1])] +
-                          xw[k + 2] * row[std::size_t(xi[k + 2])] + xw[k + 3] * row[std::size_t(xi[k + 3])];
-          d[x] = (accumulate ? d[x] : 0.0f) + weight * v;
-        }
-      }
-    }
-  }, 8);
+  std::vector<const float*> planes(static_cast<std::size_t>(channels_));
+  for (int c = 0; c < channels_; ++c) planes[std::size_t(c)] = level_plane(level, c);
+  reconstruct_planes_copy(planes.data(), channels_, lw, width, height, tx, ty, out, weight, accumulate);
 }
 
 void BlurPyramid::reconstruct(float level, std::span<float* const> out) const {

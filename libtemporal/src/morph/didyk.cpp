@@ -18,6 +18,7 @@
 #include "method_common.h"
 #include "temporal/core/color.h"
 #include "temporal/core/fast_math.h"
+#include "temporal/core/isa.h"
 #include "temporal/core/parallel.h"
 #include "temporal/morph/blur_pyramid.h"
 #include "temporal/morph/gpu_methods.h"
@@ -33,37 +34,18 @@ namespace {
 
 using namespace detail;
 
-// Section 5.1 on pixels [i0, i1) of one channel, in linear light: o = original (= v^g), v and l = display
-// values of the original and its low-pass, bs = blur sum B. Writes the rendered frame's value (L + H')^g and the
-// low-frequency layer of the in-between frames, both linear. A free function with local pointers so that GCC
-// vectorises it (inside the lambda the stores might alias the captures).
-void compensate_span(const float* o, const float* v, const float* l, const float* bs, float* top, float* lowlin,
-                     float gamma, bool compensate, std::size_t i0, std::size_t i1) {
-  if (!compensate) {
-    for (std::size_t i = i0; i < i1; ++i) {
-      top[i] = o[i];
-      lowlin[i] = fast_math::pow(l[i], gamma);
-    }
-    return;
-  }
-  // Selects only (no short-circuit logic): the loop vectorises.
-  for (std::size_t i = i0; i < i1; ++i) {
-    const float oi = o[i], B = bs[i];
-    const float lg = fast_math::pow(l[i], gamma);
-    const float top_g = (1.0f + B) * oi - B * lg;  // N_eff (H + L)^g - (N_eff - 1) L^g, N_eff = 1 + B
-    const float excess_low = ((1.0f + B) * oi - 1.0f) / (B > 0.0f ? B : 1.0f);
-    // Rule 2: the enhanced original would exceed the display: show 1, the excess goes to the low layer.
-    float t = top_g > 1.0f ? 1.0f : top_g;
-    float lo = top_g > 1.0f ? excess_low : lg;
-    // No in-between frame is blurred here: nothing to compensate.
-    t = B > 0.0f ? t : oi;
-    lo = B > 0.0f ? lo : lg;
-    // Rule 1: an original darker than its low-pass is kept in every frame; values outside [0, 1] (not
-    // display-referred) pass through.
-    const bool keep = (v[i] < l[i]) | (oi < 0.0f) | (oi > 1.0f);
-    top[i] = keep ? oi : t;
-    lowlin[i] = keep ? oi : lo;
-  }
+// The per-pixel passes, one copy per instruction set (temporal/core/isa.h). v3 and v4 contract the polynomial of
+// fast_math::pow and the compensation's products into FMAs (v2 has none): v2 differs from them in the last bits
+// (tests/core/isa_test.cpp); v3 and v4 are bit-identical.
+#define TEMPORAL_ISA_FILE "didyk_kernels.inc"
+#include "temporal/core/isa_copies.inc"
+
+void display_span_copy(const float* l, float* v, float inv_gamma, std::size_t i0, std::size_t i1) {
+  TEMPORAL_ISA_CALL(copy, return copy::display_span(l, v, inv_gamma, i0, i1))
+}
+void compensate_span_copy(const float* o, const float* v, const float* l, const float* bs, float* top, float* lowlin,
+                          float gamma, bool compensate, std::size_t i0, std::size_t i1) {
+  TEMPORAL_ISA_CALL(copy, return copy::compensate_span(o, v, l, bs, top, lowlin, gamma, compensate, i0, i1))
 }
 
 class Didyk final : public MorphMethod {
@@ -136,9 +118,7 @@ class Didyk final : public MorphMethod {
     for (int c = 0; c < 3; ++c) {
       float* v = P(kV + c);
       const float* l = color.plane(kRGB[c]);
-      parallel_chunks(np, [&](std::size_t i0, std::size_t i1) {
-        for (std::size_t i = i0; i < i1; ++i) v[i] = fast_math::pow(std::clamp(l[i], 0.0f, 1.0f), inv_gamma);
-      });
+      parallel_chunks(np, [&](std::size_t i0, std::size_t i1) { display_span_copy(l, v, inv_gamma, i0, i1); });
     }
     const float* vplanes[3] = {P(kV), P(kV + 1), P(kV + 2)};
     float* lplanes[3] = {P(kL), P(kL + 1), P(kL + 2)};
@@ -162,7 +142,9 @@ class Didyk final : public MorphMethod {
       const float* bs = P(kBSum);
       float* top = o0.plane(kRGB[c]);
       float* lowlin = P(kLowLin + c);
-      parallel_chunks(np, [&](std::size_t i0, std::size_t i1) { compensate_span(o, v, l, bs, top, lowlin, gamma, comp, i0, i1); });
+      parallel_chunks(np, [&](std::size_t i0, std::size_t i1) {
+        compensate_span_copy(o, v, l, bs, top, lowlin, gamma, comp, i0, i1);
+      });
     }
     if (!options_.debug_layers) return;
     float* dbgH = o0.plane("debug.H");

@@ -4,6 +4,7 @@
 // covered by exactly one of two triangles sharing an edge.
 #include "temporal/morph/grid_warp.h"
 
+#include "temporal/core/isa.h"
 #include "temporal/core/parallel.h"
 #include "temporal/core/reproject.h"
 
@@ -204,10 +205,6 @@ namespace {
 constexpr int kBand = 16;  // rows per raster band (the unit of parallel work)
 constexpr std::size_t kMaxAttributes = 8;
 
-// Top-left rule: an edge a->b owns the pixel centres lying exactly on it when it goes down, or goes left
-// along a row. The two triangles that share an edge traverse it in opposite directions, so exactly one owns it.
-inline bool owns(double dx, double dy) { return dy > 0.0 || (dy == 0.0 && dx < 0.0); }
-
 // The three vertices of triangle t: each cell is split along its top-left to bottom-right diagonal.
 inline void corners(const SnappedGrid& grid, int t, int out[3]) {
   const int cells_x = grid.nx - 1;
@@ -220,169 +217,17 @@ inline void corners(const SnappedGrid& grid, int t, int out[3]) {
   }
 }
 
-// One GridRasterizer::draw call: what every band reads, and the work of one band (its triangles, then the
-// pixels none of them covered). Bands own disjoint rows of the targets and of the z-buffer.
-class BandRaster {
- public:
-  BandRaster(const SnappedGrid& grid, std::span<const float> tx, std::span<const float> ty, const GridRaster& raster,
-             float* zbuffer)
-      : grid_(grid), tx_(tx), ty_(ty), r_(raster), zbuffer_(zbuffer), w_(grid.width), h_(grid.height),
-        ns_(raster.source.size()), na_(raster.attributes.size()), blend_(raster.blend_attribute),
-        nt_(blend_ >= 0 ? ns_ / 2 : ns_), cull_(raster.cull_zero_attributes && ns_ == 0 && na_ > 0) {}
+// The band kernel copies, one per instruction set (temporal/core/isa.h). v3 and v4 may contract the edge
+// functions' and the interpolations' multiply-adds into FMAs (v2 has none): a pixel centre within rounding of a
+// shared edge can fall to the other triangle, and interpolated values differ in the last bits
+// (tests/core/isa_test.cpp bounds both); v3 and v4 are bit-identical.
+#define TEMPORAL_ISA_FILE "grid_warp_kernels.inc"
+#include "temporal/core/isa_copies.inc"
 
-  void band(int band, const std::vector<std::int32_t>& triangles) {
-    const int y0 = band * kBand, y1 = std::min(h_, y0 + kBand);
-    std::fill(zbuffer_ + std::ptrdiff_t(y0) * w_, zbuffer_ + std::ptrdiff_t(y1) * w_,
-              std::numeric_limits<float>::infinity());
-    for (const int t : triangles) triangle(t, y0, y1);
-    uncovered(y0, y1);
-  }
-
- private:
-  bool all_attributes_zero(const int v[3]) const {
-    for (std::size_t c = 0; c < na_; ++c)
-      if (r_.attributes[c][v[0]] != 0.0f || r_.attributes[c][v[1]] != 0.0f || r_.attributes[c][v[2]] != 0.0f)
-        return false;
-    return true;
-  }
-
-  // Scan-converts triangle t over rows [band_y0, band_y1).
-  void triangle(int t, int band_y0, int band_y1) {
-    int v[3];
-    corners(grid_, t, v);
-    if (cull_ && all_attributes_zero(v)) return;
-    double px[3] = {tx_[v[0]], tx_[v[1]], tx_[v[2]]};
-    double py[3] = {ty_[v[0]], ty_[v[1]], ty_[v[2]]};
-    double area = cross(px[1] - px[0], py[1] - py[0], px[2] - px[0], py[2] - py[0]);
-    if (std::abs(area) < 1e-12) return;
-    if (area < 0.0) {  // a folded-over triangle: draw it too, with its vertices reordered
-      std::swap(px[1], px[2]);
-      std::swap(py[1], py[2]);
-      std::swap(v[1], v[2]);
-      area = -area;
-    }
-    const double inv_area = 1.0 / area;
-    const int xa = std::max(0, int(std::ceil(std::min({px[0], px[1], px[2]}) - 0.5)));
-    const int xb = std::min(w_ - 1, int(std::floor(std::max({px[0], px[1], px[2]}) - 0.5)));
-    const int ya = std::max(band_y0, int(std::ceil(std::min({py[0], py[1], py[2]}) - 0.5)));
-    const int yb = std::min(band_y1 - 1, int(std::floor(std::max({py[0], py[1], py[2]}) - 0.5)));
-    if (xa > xb || ya > yb) return;
-    // Edge k goes from vertex k+1 to vertex k+2 (opposite vertex k); its edge function, divided by the
-    // area, is vertex k's barycentric weight. Evaluated exactly in double at the row start, then stepped.
-    double ex[3], ey[3];
-    bool own[3];
-    for (int k = 0; k < 3; ++k) {
-      const int p = (k + 1) % 3, q = (k + 2) % 3;
-      ex[k] = px[q] - px[p];
-      ey[k] = py[q] - py[p];
-      own[k] = owns(ex[k], ey[k]);
-    }
-    const float su[3] = {grid_.x[v[0]], grid_.x[v[1]], grid_.x[v[2]]};
-    const float sv[3] = {grid_.y[v[0]], grid_.y[v[1]], grid_.y[v[2]]};
-    // Attribute values at the three vertices, loaded once per triangle (at most kMaxAttributes).
-    float av[kMaxAttributes][3];
-    for (std::size_t c = 0; c < na_; ++c)
-      for (int k = 0; k < 3; ++k) av[c][k] = r_.attributes[c][v[k]];
-    for (int y = ya; y <= yb; ++y) {
-      const double cy = y + 0.5, cx0 = xa + 0.5;
-      double e0[3];
-      for (int k = 0; k < 3; ++k) {
-        const int p = (k + 1) % 3;
-        e0[k] = cross(ex[k], ey[k], cx0 - px[p], cy - py[p]);
-      }
-      // The row's span: e_k(x) = e_k(xa) - ey_k (x - xa) >= 0 for every edge. Widened by one pixel on each
-      // side; the exact test (with the fill rule) runs inside.
-      int xs = xa, xe = xb;
-      bool empty = false;
-      for (int k = 0; k < 3; ++k) {
-        if (ey[k] > 0.0) {
-          xe = std::min(xe, xa + int(std::floor(e0[k] / ey[k])) + 1);
-        } else if (ey[k] < 0.0) {
-          xs = std::max(xs, xa + int(std::ceil(e0[k] / ey[k])) - 1);
-        } else if (e0[k] < 0.0) {
-          empty = true;
-        }
-      }
-      if (empty || xs > xe) continue;
-      double e[3];
-      for (int k = 0; k < 3; ++k) e[k] = e0[k] - ey[k] * double(xs - xa);
-      for (int x = xs; x <= xe; ++x, e[0] -= ey[0], e[1] -= ey[1], e[2] -= ey[2]) {
-        if (e[0] < 0.0 || e[1] < 0.0 || e[2] < 0.0) continue;
-        if ((e[0] == 0.0 && !own[0]) || (e[1] == 0.0 && !own[1]) || (e[2] == 0.0 && !own[2])) continue;
-        const float w0 = float(e[0] * inv_area), w1 = float(e[1] * inv_area), w2 = 1.0f - w0 - w1;
-        const float u = w0 * su[0] + w1 * su[1] + w2 * su[2];
-        const float vv = w0 * sv[0] + w1 * sv[1] + w2 * sv[2];
-        fragment(x, y, u, vv, w0, w1, w2, av);
-      }
-    }
-  }
-
-  // Pixel (x, y) covered at barycentric (w0, w1, w2), texture coordinate (u, vv): depth test, attributes, and
-  // the source planes fetched at (u, vv) through the reprojection module's bilinear fetch.
-  void fragment(int x, int y, float u, float vv, float w0, float w1, float w2, const float (*av)[3]) {
-    const std::size_t pix = std::size_t(y) * std::size_t(w_) + std::size_t(x);
-    float& z_here = zbuffer_[pix];
-    // Texture coordinates are continuous pixel coordinates (pixel centres at +0.5); the reprojection module's
-    // fetches take positions with the centres at integers.
-    const float fu = u - 0.5f, fv = vv - 0.5f;
-    if (r_.source_depth) {
-      // Section 6: "we enable the depth test and pass depth from the original frame": the depth of the source
-      // pixel that contains (u, vv), its nearest pixel centre.
-      const float z = r_.source_depth[reproject::nearest(fu, fv, w_, h_)];
-      if (!(z < z_here)) return;
-      z_here = z;
-    } else {
-      z_here = 0.0f;  // covered
-    }
-    float blend_weight = 0.0f;
-    for (std::size_t c = 0; c < na_; ++c) {
-      const float val = w0 * av[c][0] + w1 * av[c][1] + w2 * av[c][2];
-      r_.attr_target[c][pix] = val;
-      if (int(c) == blend_) blend_weight = val;
-    }
-    if (ns_ == 0) return;
-    const reproject::Bilinear f = reproject::bilinear(fu, fv, w_, h_);
-    if (blend_ < 0) {
-      for (std::size_t c = 0; c < ns_; ++c) r_.target[c][pix] = f(r_.source[c]);
-    } else if (blend_weight > 0.0f) {
-      for (std::size_t c = 0; c < nt_; ++c) {
-        const float sharp = f(r_.source[c]);
-        r_.target[c][pix] = sharp + blend_weight * (f(r_.source[nt_ + c]) - sharp);
-      }
-    } else {
-      for (std::size_t c = 0; c < nt_; ++c) r_.target[c][pix] = f(r_.source[c]);
-    }
-  }
-
-  // Pixels no fragment reached (only possible where degenerate triangles meet): the source pixel itself and the
-  // attributes' `uncovered` value.
-  void uncovered(int y0, int y1) {
-    for (int y = y0; y < y1; ++y)
-      for (int x = 0; x < w_; ++x) {
-        const std::size_t pix = std::size_t(y) * std::size_t(w_) + std::size_t(x);
-        if (zbuffer_[pix] != std::numeric_limits<float>::infinity()) continue;
-        for (std::size_t c = 0; c < na_; ++c)
-          r_.attr_target[c][pix] = c < r_.attr_uncovered.size() ? r_.attr_uncovered[c] : 0.0f;
-        if (blend_ < 0) {
-          for (std::size_t c = 0; c < ns_; ++c) r_.target[c][pix] = r_.source[c][pix];
-        } else {
-          const float a = r_.attr_target[std::size_t(blend_)][pix];
-          for (std::size_t c = 0; c < nt_; ++c)
-            r_.target[c][pix] = r_.source[c][pix] + a * (r_.source[nt_ + c][pix] - r_.source[c][pix]);
-        }
-      }
-  }
-
-  const SnappedGrid& grid_;
-  std::span<const float> tx_, ty_;
-  const GridRaster& r_;
-  float* zbuffer_;
-  const int w_, h_;
-  const std::size_t ns_, na_;  // source planes, attributes
-  const int blend_;
-  const std::size_t nt_;       // target planes
-  const bool cull_;
-};
+void draw_bands_copy(const SnappedGrid& grid, std::span<const float> tx, std::span<const float> ty,
+                     const GridRaster& raster, float* zbuffer, const std::vector<std::vector<std::int32_t>>& bins) {
+  TEMPORAL_ISA_CALL(copy, return copy::draw_bands(grid, tx, ty, raster, zbuffer, bins))
+}
 
 }  // namespace
 
@@ -408,10 +253,7 @@ void GridRasterizer::draw(const SnappedGrid& grid, std::span<const float> tx, st
     if (r1 < r0) continue;
     for (int b = r0 / kBand; b <= r1 / kBand; ++b) bins_[std::size_t(b)].push_back(t);
   }
-  BandRaster raster_bands(grid, tx, ty, raster, zbuffer_.data());
-  tbb::parallel_for(tbb::blocked_range<int>(0, bands, 1), [&](const tbb::blocked_range<int>& range) {
-    for (int band = range.begin(); band < range.end(); ++band) raster_bands.band(band, bins_[std::size_t(band)]);
-  });
+  draw_bands_copy(grid, tx, ty, raster, zbuffer_.data(), bins_);
 }
 
 void draw_grid_lines(const SnappedGrid& grid, std::span<const float> tx, std::span<const float> ty, float* plane) {

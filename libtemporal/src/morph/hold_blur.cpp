@@ -2,13 +2,29 @@
 // frame is held, so a point of the retina integrates the held frame along the motion path.
 #include "temporal/morph/hold_blur.h"
 
+#include "temporal/core/isa.h"
 #include "temporal/core/parallel.h"
 #include "temporal/core/reproject.h"
 
 #include <algorithm>
 #include <cmath>
+#include <vector>
 
 namespace temporal::morph {
+namespace {
+
+// The integration copies, one per instruction set (temporal/core/isa.h). v3 and v4 contract the eye position
+// c + t v and the bilinear sums into FMAs (v2 has none): v2 differs from them in the last bits
+// (tests/core/isa_test.cpp); v3 and v4 are bit-identical.
+#define TEMPORAL_ISA_FILE "hold_blur_kernels.inc"
+#include "temporal/core/isa_copies.inc"
+
+void perceive_rows_copy(const float* const* src, float* const* dst, std::size_t count, std::size_t nc,
+                        const float* motion_x, const float* motion_y, int w, int h, float spp, int max_samples) {
+  TEMPORAL_ISA_CALL(copy, return copy::perceive_rows(src, dst, count, nc, motion_x, motion_y, w, h, spp, max_samples))
+}
+
+}  // namespace
 
 Expected<Image> perceive_hold(std::span<const Image* const> frames, const std::vector<std::string>& channels,
                               const float* motion_x, const float* motion_y, const HoldBlurOptions& options) {
@@ -35,33 +51,7 @@ Expected<Image> perceive_hold(std::span<const Image* const> frames, const std::v
     dst[c] = out.plane(channels[c]);
     for (std::size_t f = 0; f < count; ++f) src[f * nc + c] = frames[f]->plane(channels[c]);
   }
-  parallel_rows(h, [&](int y0, int y1) {
-    std::vector<double> sum(nc);  // one per band of rows, never per pixel
-    for (int y = y0; y < y1; ++y) {
-      for (int x = 0; x < w; ++x) {
-        const std::size_t i = std::size_t(y) * std::size_t(w) + std::size_t(x);
-        float vx = -motion_x[i], vy = -motion_y[i];  // screen velocity, pixels per displayed frame
-        if (!std::isfinite(vx) || !std::isfinite(vy)) vx = vy = 0.0f;
-        const float speed = std::sqrt(vx * vx + vy * vy);
-        const int samples = std::clamp(int(std::ceil(speed * spp)), 1, options.max_samples);
-        const float cx = float(x) + 0.5f, cy = float(y) + 0.5f;
-        std::fill(sum.begin(), sum.end(), 0.0);
-        for (std::size_t f = 0; f < count; ++f) {
-          // Midpoint rule over the hold time of frame f: the eye is at (f + s) * v, s in [0, 1). One bilinear
-          // fetch of the reprojection module (pixel centres at integers there, edge taps repeated) serves every
-          // channel.
-          for (int s = 0; s < samples; ++s) {
-            const float tt = float(f) + (float(s) + 0.5f) / float(samples);
-            const float fx = cx + tt * vx - 0.5f, fy = cy + tt * vy - 0.5f;
-            const reproject::Bilinear b = reproject::bilinear(fx, fy, w, h);
-            for (std::size_t c = 0; c < nc; ++c) sum[c] += b(src[f * nc + c]);
-          }
-        }
-        const double norm = 1.0 / (double(samples) * double(count));
-        for (std::size_t c = 0; c < nc; ++c) dst[c][i] = float(sum[c] * norm);
-      }
-    }
-  });
+  perceive_rows_copy(src.data(), dst.data(), count, nc, motion_x, motion_y, w, h, spp, options.max_samples);
   out.metadata() = frames[0]->metadata();
   return out;
 }

@@ -3,6 +3,7 @@
 // index): positive floats order like their bit patterns, and the index makes the winner among equal depths
 // independent of the thread schedule.
 #include "method_common.h"
+#include "temporal/core/isa.h"
 #include "temporal/core/parallel.h"
 #include "temporal/morph/gpu_methods.h"
 #include "temporal/morph/methods.h"
@@ -17,6 +18,15 @@ namespace temporal::morph {
 namespace {
 
 using namespace detail;
+
+constexpr std::uint64_t kWarpEmpty = std::numeric_limits<std::uint64_t>::max();  // no source pixel landed here
+
+// The splat and resolve copies, one per instruction set (temporal/core/isa.h). v3 and v4 may contract
+// x + 0.5 - t * motion into a fused multiply-add (v2 rounds the product first): a target position within rounding
+// of a pixel edge can land in the neighbouring pixel (tests/core/isa_test.cpp counts them); v3 and v4 are
+// bit-identical.
+#define TEMPORAL_ISA_FILE "warp_kernels.inc"
+#include "temporal/core/isa_copies.inc"
 
 class Warp final : public MorphMethod {
  public:
@@ -38,46 +48,21 @@ class Warp final : public MorphMethod {
   }
 
  private:
-  static constexpr std::uint64_t kEmpty = std::numeric_limits<std::uint64_t>::max();
-
   // Forward splat of each source pixel centre to p - t * motion, keeping the nearest depth per target pixel.
   void splat(const Image& color, const Image& gbuffer, float t) {
-    const int w = color.width(), h = color.height();
+    std::fill(buffer_.begin(), buffer_.end(), kWarpEmpty);
     const float* mx = gbuffer.plane("motion.X");
     const float* my = gbuffer.plane("motion.Y");
     const float* depth = gbuffer.plane("depth.Z");
-    std::fill(buffer_.begin(), buffer_.end(), kEmpty);
-    parallel_rows(h, [&](int y0, int y1) {
-      for (int y = y0; y < y1; ++y) {
-        for (int x = 0; x < w; ++x) {
-          const std::size_t i = std::size_t(y) * std::size_t(w) + std::size_t(x);
-          const float fx = float(x) + 0.5f - t * mx[i], fy = float(y) + 0.5f - t * my[i];
-          if (!(fx >= 0.0f && fy >= 0.0f && fx < float(w) && fy < float(h))) continue;
-          float z = depth[i];
-          if (!(z >= 0.0f)) z = std::numeric_limits<float>::max();
-          const std::uint64_t key = (std::uint64_t(std::bit_cast<std::uint32_t>(z)) << 32) | std::uint64_t(i);
-          const std::size_t q = std::size_t(int(fy)) * std::size_t(w) + std::size_t(int(fx));
-          std::atomic_ref<std::uint64_t> slot(buffer_[q]);
-          std::uint64_t cur = slot.load(std::memory_order_relaxed);
-          while (key < cur && !slot.compare_exchange_weak(cur, key, std::memory_order_relaxed)) {
-          }
-        }
-      }
-    });
+    const int w = color.width(), h = color.height();
+    TEMPORAL_ISA_CALL(copy, return copy::splat(mx, my, depth, w, h, t, buffer_.data()))
   }
 
   // The winning source pixel of every target pixel; holes stay black.
   void resolve(const Image& color, Image& o) const {
     const float* src[3] = {color.plane("R"), color.plane("G"), color.plane("B")};
     float* dst[3] = {o.plane("R"), o.plane("G"), o.plane("B")};
-    parallel_chunks(color.pixel_count(), [&](std::size_t i0, std::size_t i1) {
-      for (std::size_t i = i0; i < i1; ++i) {
-        const std::uint64_t key = buffer_[i];
-        const bool hole = key == kEmpty;
-        const std::size_t s = std::size_t(key & 0xffffffffu);
-        for (int c = 0; c < 3; ++c) dst[c][i] = hole ? 0.0f : src[c][s];
-      }
-    });
+    TEMPORAL_ISA_CALL(copy, return copy::resolve(buffer_.data(), src, dst, color.pixel_count()))
   }
 
   bool debug_layers_;

@@ -4,6 +4,7 @@
 #include "filter_common.h"
 #include "temporal/phlm/filters.h"
 #include "temporal/phlm/gpu_filters.h"
+#include "temporal/core/isa.h"
 #include "temporal/core/parallel.h"
 #include "temporal/core/reproject.h"
 
@@ -12,6 +13,33 @@
 #include <cmath>
 
 namespace temporal::phlm {
+namespace {
+
+// What ema's rows read and write in one frame.
+struct EmaFrame {
+  const FilterInput* in;
+  const reproject::Frames* frames;
+  bool same;  // a history of this shape exists
+  int w, channels;
+  float alpha;
+  const float* const* hist;
+  const float* const* y;
+  float* const* out;
+  float* const* next;
+  const std::uint8_t* valid;
+  float* next_depth;
+  std::uint32_t* next_id;
+  float* dbg;
+};
+
+// The row copies, one per instruction set (temporal/core/isa.h); v3 and v4 contract eq. 1's alpha h + (1 - alpha) y
+// into an FMA (v2 has none): v2 differs in the last bit (tests/core/isa_test.cpp); v3 and v4 are bit-identical.
+#define TEMPORAL_ISA_FILE "ema_kernels.inc"
+#include "temporal/core/isa_copies.inc"
+
+std::size_t ema_rows_copy(const EmaFrame& e) { TEMPORAL_ISA_CALL(copy, return copy::ema_rows(e)) }
+
+}  // namespace
 
 EmaFilter::EmaFilter(EmaParams params) : params_(params) {}
 
@@ -67,43 +95,14 @@ Status EmaFilter::process(const FilterInput& in, Image& output, FilterStats* sta
   frames.test = {tol, use_id};
   // The expected previous depth: the warped depth when the G-buffer has it, else the current depth.
   if (use_depth) reproject::expect_depth(frames, in.depth, in.prev_depth, params_.warped_depth_tolerance);
-  std::atomic<std::size_t> rejects{0};
-  parallel_rows(h, [&](int y0, int y1) {
-    thread_local reproject::HistoryRow taps;
-    thread_local std::vector<float> fetched;
-    fetched.resize(std::size_t(3) * w);
-    float* rows[3] = {fetched.data(), fetched.data() + w, fetched.data() + 2 * w};
-    std::size_t local = 0;
-    for (int yy = y0; yy < y1; ++yy) {
-      reproject::reproject_row(frames, yy, taps);
-      if (same) reproject::gather_row(taps, hist, rows, channels, w);
-      for (int xx = 0; xx < w; ++xx) {
-        const std::size_t i = std::size_t(yy) * std::size_t(w) + std::size_t(xx);
-        const bool reject = in.reset || !same || taps.hit[xx] == 0.0f;
-        local += reject ? 1 : 0;
-        for (int c = 0; c < channels; ++c) {
-          const float hv = reject ? 0.0f : rows[c][xx];
-          float v;
-          if (valid[i])
-            v = reject ? y[c][i] : alpha * hv + (1.0f - alpha) * y[c][i];  // eq. 1
-          else
-            v = hv;  // no valid sample: keep the history (0 when there is none)
-          out[c][i] = v;
-          next[c][i] = v;
-        }
-        if (next_depth) next_depth[i] = in.depth[i];
-        if (next_id) next_id[i] = in.id[i];
-        if (dbg) dbg[i] = reject ? 1.0f : 0.0f;
-      }
-    }
-    rejects += local;
-  });
+  const EmaFrame frame{&in, &frames, same, w, channels, alpha, hist, y, out, next, valid, next_depth, next_id, dbg};
+  const std::size_t rejected = ema_rows_copy(frame);
   std::swap(history_, next_);
   have_state_ = true;
   if (stats) {
     *stats = {};
     stats->non_finite = non_finite;
-    stats->history_resets = rejects.load();
+    stats->history_resets = rejected;
   }
   return Status::ok();
 }

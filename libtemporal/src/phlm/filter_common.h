@@ -3,6 +3,7 @@
 
 #include "temporal/phlm/frame_filter.h"
 #include "temporal/phlm/taa.h"
+#include "temporal/core/color.h"
 
 #include <cstdint>
 #include <string>
@@ -44,4 +45,23 @@ struct TaaConfig {
 Expected<TaaConfig> resolve_taa(const TaaParams& p);
 // The frame-dependent check: `nearest` velocity needs depth when there is motion (a usage error naming the fix).
 Status check_taa_input(const TaaConfig& cfg, const FilterInput& in);
+// to_ycgco_box / from_ycgco_box (temporal/core/color.h) for C = 1 or 3 channels, always inlined: phlm's and taa's
+// pixel kernels are compiled once per instruction set (temporal/core/isa.h), and with three callers GCC stopped
+// inlining the generic functions (an out-of-line call per pixel, compiled for the baseline, in every copy). The
+// same operations in the same order.
+template <int C>
+[[gnu::always_inline]] inline void to_box(const float* in, float* out) {
+  if constexpr (C == 3)
+    rgb_to_ycgco(in[0], in[1], in[2], out[0], out[1], out[2]);
+  else
+    out[0] = in[0];
+}
+template <int C>
+[[gnu::always_inline]] inline void from_box(const float* in, float* out) {
+  if constexpr (C == 3)
+    ycgco_to_rgb(in[0], in[1], in[2], out[0], out[1], out[2]);
+  else
+    out[0] = in[0];
+}
+
 }  // namespace temporal::phlm::detail

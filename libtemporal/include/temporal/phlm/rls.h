@@ -28,6 +28,10 @@
 
 namespace temporal::phlm::rls {
 
+// The per-pixel steps (reset, predict, trace, bierman_update, update) are always inlined: phlm's kernel is compiled
+// once per instruction set (temporal/core/isa.h), and with three callers GCC's inliner left bierman_update out of
+// line, compiled for the baseline (SSE, no FMA), in every copy. Their operations are unchanged.
+
 // Number of strictly-upper entries of an N x N unit upper triangular U.
 template <int N>
 inline constexpr int kOffDiagonal = N * (N - 1) / 2;
@@ -57,7 +61,7 @@ struct Model {
 // Seed 003 section 6, "Initialization": the intercept coefficients take `value`, the slopes are cleared,
 // P = p0 * I (U = I, D = p0).
 template <int N, int C>
-inline void reset(Model<N, C>& m, const float value[C], float p0) {
+[[gnu::always_inline]] inline void reset(Model<N, C>& m, const float value[C], float p0) {
   for (int c = 0; c < C; ++c) {
     m.beta[c][0] = value[c];
     for (int k = 1; k < N; ++k) m.beta[c][k] = 0.0f;
@@ -68,7 +72,7 @@ inline void reset(Model<N, C>& m, const float value[C], float p0) {
 
 // Prediction of output c: beta_c^T x (eq. 4 / 8).
 template <int N, int C>
-inline float predict(const Model<N, C>& m, int c, const float x[N]) {
+[[gnu::always_inline]] inline float predict(const Model<N, C>& m, int c, const float x[N]) {
   float s = 0.0f;
   for (int k = 0; k < N; ++k) s += m.beta[c][k] * x[k];
   return s;
@@ -76,7 +80,7 @@ inline float predict(const Model<N, C>& m, int c, const float x[N]) {
 
 // trace(P) = sum_j D_j (1 + sum_{i<j} U_ij^2).
 template <int N>
-inline float trace(const float* u, const float* d) {
+[[gnu::always_inline]] inline float trace(const float* u, const float* d) {
   float t = 0.0f;
   for (int j = 0; j < N; ++j) {
     float col = 1.0f;
@@ -102,7 +106,7 @@ inline void covariance(const float* u, const float* d, float* p) {
 // P - P x x^T P / (r + x^T P x), `gain` holds P x / (r + x^T P x) (computed from the old P), and the
 // return value is r + x^T P x. With r = lambda this is eq. 6-7 before the division by lambda.
 template <int N>
-inline float bierman_update(float* u, float* d, const float x[N], float r, float gain[N]) {
+[[gnu::always_inline]] inline float bierman_update(float* u, float* d, const float x[N], float r, float gain[N]) {
   float f[N], v[N];
   for (int j = 0; j < N; ++j) {
     float s = x[j];
@@ -140,8 +144,8 @@ inline constexpr float kMinD = 1e-20f;
 // One RLS step (eq. 5-7) for sample y (C values) with predictor x, forgetting factor lambda, and the
 // bounds of the header comment (D entries <= d_max, trace(P) <= trace_max). Returns trace(P) after the step.
 template <int N, int C>
-inline float update(Model<N, C>& m, const float x[N], const float y[C], float lambda, float d_max,
-                    float trace_max) {
+[[gnu::always_inline]] inline float update(Model<N, C>& m, const float x[N], const float y[C], float lambda,
+                                           float d_max, float trace_max) {
   float e[C];
   for (int c = 0; c < C; ++c) e[c] = y[c] - predict(m, c, x);  // eq. 5, a-priori error
   float gain[N];
