@@ -398,14 +398,7 @@ class DrobotStateGpu final : public MethodState, public gpu::TimedKernel {
       for (int c = 0; c < C; ++c)
         if (out_[cur_].download(c, plane.data()))
           put_plane(state, "history." + g_.channels[std::size_t(c)], plane.data(), g_.W, g_.H);
-      PreviousGeometry prev;
-      prev.z.resize(plane.size());
-      if (!prevg_.download(0, prev.z.data())) return;
-      if (has_prev_id_) {
-        prev.id.resize(plane.size());
-        if (!prevg_.download(1, prev.id.data())) prev.id.clear();
-      }
-      put_previous(state, prev, g_.W, g_.H);
+      save_previous_geometry(prevg_, has_prev_id_, g_, state);
       return;
     }
     std::vector<float> plane(std::size_t(g_.lw) * g_.lh);

@@ -65,6 +65,9 @@ void set_joint_bilateral_uniforms(const gpu::Program& program, const FrameContex
 // A state file's previous depth (and ids, when it has them) into planes 0 and 1 of `prevg` (the C++ states'
 // PreviousGeometry, read by get_previous); `has_prev_id` says whether the ids were there.
 Status upload_previous_geometry(const Image& state, const Geometry& g, gpu::ImageBuffer& prevg, bool& has_prev_id);
+// Its inverse for save(): planes 0 (and 1 when `has_prev_id`) of `prevg` into the state as the C++ states write
+// them (put_previous). save() cannot report an error: a failed download leaves the planes out, and load() names them.
+void save_previous_geometry(const gpu::ImageBuffer& prevg, bool has_prev_id, const Geometry& g, Image& state);
 
 // One frame's inputs on the GPU: `gb` (binding 0) the full-resolution planes depth.Z, N.X, N.Y, N.Z, motion.X,
 // motion.Y, prevDepth.Z, id (planes 0-7; motion, warped depth and id uploaded only when `history_layers` and

@@ -359,14 +359,7 @@ class HerzogStateGpu final : public MethodState, public gpu::TimedKernel {
       if (grid_.download(4 * cur_ + t, cell.data()))
         put_plane(state, "gradient.t" + std::to_string(t + 1), cell.data(), GW_, GH_);
     if (grid_.download(4 * cur_ + 3, cell.data())) put_plane(state, "gradient.wf", cell.data(), GW_, GH_);
-    PreviousGeometry prev;
-    prev.z.resize(plane.size());
-    if (!prevg_.download(0, prev.z.data())) return;
-    if (has_prev_id_) {
-      prev.id.resize(plane.size());
-      if (!prevg_.download(1, prev.id.data())) prev.id.clear();
-    }
-    put_previous(state, prev, g_.W, g_.H);
+    save_previous_geometry(prevg_, has_prev_id_, g_, state);
   }
 
   Status load(const Image& state) override {

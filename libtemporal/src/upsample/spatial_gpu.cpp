@@ -134,6 +134,17 @@ Status upload_previous_geometry(const Image& state, const Geometry& g, gpu::Imag
   return Status::ok();
 }
 
+void save_previous_geometry(const gpu::ImageBuffer& prevg, bool has_prev_id, const Geometry& g, Image& state) {
+  PreviousGeometry prev;
+  prev.z.resize(std::size_t(g.W) * g.H);
+  if (!prevg.download(0, prev.z.data())) return;  // left out: load() names the missing plane
+  if (has_prev_id) {
+    prev.id.resize(prev.z.size());
+    if (!prevg.download(1, prev.id.data())) prev.id.clear();
+  }
+  put_previous(state, prev, g.W, g.H);
+}
+
 Status GpuFrame::upload(const std::shared_ptr<gpu::Context>& context, const FrameContext& f, bool history_layers) {
   if (gb.width() != f.W || gb.height() != f.H) {
     auto b = gpu::ImageBuffer::create(context, f.W, f.H, 8);

@@ -346,14 +346,7 @@ class TaauStateGpu final : public MethodState, public gpu::TimedKernel {
     const char* names[3] = {"history.weight", "lock.lifetime", "lock.luma"};
     for (int q = 0; q < 3; ++q)
       if (st_.download(3 * cur_ + q, plane.data())) put_plane(state, names[q], plane.data(), g_.W, g_.H);
-    PreviousGeometry prev;
-    prev.z.resize(plane.size());
-    if (!prevg_.download(0, prev.z.data())) return;
-    if (has_prev_id_) {
-      prev.id.resize(plane.size());
-      if (!prevg_.download(1, prev.id.data())) prev.id.clear();
-    }
-    put_previous(state, prev, g_.W, g_.H);
+    save_previous_geometry(prevg_, has_prev_id_, g_, state);
   }
 
   Status load(const Image& state) override {
