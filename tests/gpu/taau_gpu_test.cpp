@@ -38,6 +38,8 @@ std::vector<test::SyntheticFrame> sequence(int n, int width = 76, int height = 5
     frames.push_back(test::make_frame(scene, t));
     // A non-finite sample now and then: it must carry weight 0 and never enter the history.
     frames.back().low.plane("G")[std::size_t((5 * t) % 200)] = std::numeric_limits<float>::quiet_NaN();
+    // ... and one past kMaxSampleMagnitude (temporal/core/image.h), which is no sample either (issue 26 item 12).
+    frames.back().low.plane("R")[std::size_t((7 * t + 101) % 200)] = 1e20f;
     // Thin features (step 5's locks): isolated bright samples, ridges no similar 2x2 quad explains, at fixed
     // low-resolution pixels, some dimming over the frames so that a lock's luminance change ends it.
     test::SyntheticFrame& fr = frames.back();

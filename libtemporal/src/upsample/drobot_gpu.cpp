@@ -45,13 +45,14 @@ float floor_vec(float x) {  // reproject::floor_vec
   const float t = float(int(x));
   return t > x ? t - 1.0 : t;
 }
-// gather_low_geometry's validity of this frame's low-resolution sample q.
+// gather_low_geometry's validity of low-resolution sample q: finite geometry at its full-resolution pixel and a
+// payload that is a sample (is_sample: finite and at most kMaxSampleMagnitude, as usable_sample in frame.cpp).
 bool low_valid(uint q) {
   const uint lx = q % uint(u_low.x), ly = q / uint(u_low.x);
   const uint g = (uint(u_k) * ly + uint(u_sy)) * uint(u_full.x) + uint(u_sx) + uint(u_k) * lx;
   bool ok = is_finite_bits(gb[g]) && is_finite_bits(gb[u_n + g]) && is_finite_bits(gb[2u * u_n + g]) &&
             is_finite_bits(gb[3u * u_n + g]);
-  for (int c = 0; c < u_C; ++c) ok = ok && is_finite_bits(lowb[uint(c) * u_ln + q]);
+  for (int c = 0; c < u_C; ++c) ok = ok && is_sample(lowb[uint(c) * u_ln + q]);
   return ok;
 }
 )";
