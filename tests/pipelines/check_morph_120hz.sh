@@ -41,4 +41,14 @@ awk -v t="$total" 'BEGIN { exit !(t > 99.8 && t < 100.2) }' || fail "region shar
 grep -qE '^\| fan \| moving \| [+-][0-9.]+ \[' "$summary" || fail "no per-region paired differences"
 grep -qE '^\| scene \| region \| didyk - repeat \| didyk - blend \| didyk - warp \|$' "$summary" ||
   fail "the per-region paired differences are not didyk against repeat, blend and warp"
+# The lag column: the mean of the perceived frames' temporal:lagMs headers (one iinfo over all of them), a number
+# for every method; repeat holds each frame for the whole 40 Hz interval, so it lags.
+csv="$out/summary.csv"
+col="$(head -1 "$csv" | tr ',' '\n' | grep -nx lag_ms | cut -d: -f1)"
+[[ -n "$col" ]] || fail "summary.csv has no lag_ms column"
+for m in didyk repeat blend warp; do
+  lag="$(awk -F, -v m="$m" -v c="$col" '$2 == m { print $c }' "$csv")"
+  [[ "$lag" =~ ^-?[0-9]+(\.[0-9]+)?$ ]] || fail "$m: lag_ms is '$lag', not a number"
+done
+awk -F, -v c="$col" '$2 == "repeat" { exit !($c > 1) }' "$csv" || fail "repeat's lag is not above 1 ms"
 echo "check_morph_120hz.sh: ok"
