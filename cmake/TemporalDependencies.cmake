@@ -21,9 +21,10 @@ find_package(CLI11 CONFIG REQUIRED)
 # The renderer (OSMesa) and the plots (VTK, which links libGL) live in separate targets: both libraries
 # export every gl* symbol, and an executable that loads libGL first silently breaks OSMesa.
 pkg_check_modules(OSMESA REQUIRED IMPORTED_TARGET osmesa)
-# The renderer's second context: EGL's device platform through glvnd's libEGL (libegl-dev; Mesa's software device
-# comes from libegl-mesa0, a GPU's from its driver). Only libEGL is linked: GL entry points come from eglGetProcAddress.
-# (The gpu stage opens libEGL at run time and needs only its headers.)
+# EGL's device platform (the renderer's second context and the compute kernels' context, one module:
+# temporal/gpu/egl.h) through glvnd's libEGL (libegl-dev; Mesa's software device comes from libegl-mesa0, a GPU's
+# from its driver). Nothing links it: the gpu stage opens libEGL.so.1 at run time and needs only its headers; GL
+# entry points come from eglGetProcAddress.
 pkg_check_modules(EGL REQUIRED IMPORTED_TARGET egl)
 find_package(TinyGLTF CONFIG REQUIRED)
 # stb_image (libstb, the library tinygltf decodes glTF images with) decodes USD textures too.

@@ -1,77 +1,24 @@
-// EGL device platform -> OpenGL 4.5 core context, surfaceless (the recipe of shared/tools/egl-probe.c, verified on
-// llvmpipe and on an NVIDIA H200 driver-only machine).
+// The gpu stage's compute context: a surfaceless OpenGL 4.5 core context on an EGL device (temporal/gpu/egl.h, which
+// the renderer's EGL context uses too), with the GL function table every kernel calls through.
 //
-// libEGL is opened at run time (dlopen), not linked: the method stages link this stage, and their CPU kernel
+// libEGL is opened at run time (egl.cpp), not linked: the method stages link this stage, and their CPU kernel
 // benchmarks must stay free of display libraries (kernel_dependencies.*, tests/benchmarks/CMakeLists.txt); a
 // program that never asks for the GPU never loads libEGL, and one that does on a machine without it gets an error.
 #include "temporal/gpu/context.h"
 
-#define EGL_NO_PROTOTYPES
-#include <EGL/egl.h>
-#include <EGL/eglext.h>
+#include "temporal/gpu/egl.h"
 
-#include <dlfcn.h>
-
-#include <chrono>
 #include <cstdio>
-#include <cstring>
-#include <type_traits>
-#include <string_view>
+#include <string>
 #include <vector>
 
 namespace temporal::gpu {
 namespace {
 
-// The EGL 1.5 entry points this file calls, from libEGL.so.1 (glvnd's dispatcher, or a vendor's libEGL).
-struct Egl {
-  PFNEGLGETPROCADDRESSPROC GetProcAddress = nullptr;
-  PFNEGLINITIALIZEPROC Initialize = nullptr;
-  PFNEGLBINDAPIPROC BindAPI = nullptr;
-  PFNEGLCREATECONTEXTPROC CreateContext = nullptr;
-  PFNEGLDESTROYCONTEXTPROC DestroyContext = nullptr;
-  PFNEGLMAKECURRENTPROC MakeCurrent = nullptr;
-  PFNEGLGETCURRENTCONTEXTPROC GetCurrentContext = nullptr;
-  PFNEGLGETERRORPROC GetError = nullptr;
-  std::string error;  // why loading failed; empty when loaded
-};
-
-// Loaded once per process (the handle is never closed: contexts may live until exit).
-const Egl& egl() {
-  static const Egl loaded = [] {
-    Egl e;
-    void* lib = dlopen("libEGL.so.1", RTLD_NOW | RTLD_LOCAL);
-    if (!lib) {
-      const char* why = dlerror();
-      e.error = std::string("cannot load libEGL.so.1 (") + (why ? why : "?") +
-                "): install libegl1 and a driver (libegl-mesa0 for llvmpipe)";
-      return e;
-    }
-    auto load = [&](auto& fn, const char* name) {
-      fn = reinterpret_cast<std::remove_reference_t<decltype(fn)>>(dlsym(lib, name));
-      if (!fn && e.error.empty()) e.error = std::string("libEGL.so.1 has no ") + name;
-    };
-    load(e.GetProcAddress, "eglGetProcAddress");
-    load(e.Initialize, "eglInitialize");
-    load(e.BindAPI, "eglBindAPI");
-    load(e.CreateContext, "eglCreateContext");
-    load(e.DestroyContext, "eglDestroyContext");
-    load(e.MakeCurrent, "eglMakeCurrent");
-    load(e.GetCurrentContext, "eglGetCurrentContext");
-    load(e.GetError, "eglGetError");
-    return e;
-  }();
-  return loaded;
-}
-
 std::string hex(unsigned v) {
   char buf[16];
   std::snprintf(buf, sizeof buf, "0x%04x", v);
   return buf;
-}
-
-Error egl_error(const std::string& step) {
-  return Error::usage("--device gpu: " + step + " failed (EGL error " + hex(unsigned(egl().GetError())) +
-                      "); this machine has no usable EGL device (install libegl-mesa0 for llvmpipe)");
 }
 
 // Whether GL_TIME_ELAPSED reports a dispatch's time: a small kernel that does measurable work, timed once.
@@ -129,49 +76,31 @@ Status Context::ensure(std::shared_ptr<Context>& context) {
 }
 
 Expected<std::shared_ptr<Context>> Context::create(const ContextOptions& options) {
-  if (!egl().error.empty()) return Error::usage("--device gpu: " + egl().error);
-  auto query_devices = reinterpret_cast<PFNEGLQUERYDEVICESEXTPROC>(egl().GetProcAddress("eglQueryDevicesEXT"));
-  auto query_string =
-      reinterpret_cast<PFNEGLQUERYDEVICESTRINGEXTPROC>(egl().GetProcAddress("eglQueryDeviceStringEXT"));
-  auto platform_display =
-      reinterpret_cast<PFNEGLGETPLATFORMDISPLAYEXTPROC>(egl().GetProcAddress("eglGetPlatformDisplayEXT"));
-  if (!query_devices || !platform_display)
-    return Error::usage("--device gpu: EGL has no device enumeration (EGL_EXT_device_enumeration, "
-                        "EGL_EXT_platform_device); install libegl1 and a driver (libegl-mesa0 for llvmpipe)");
-  EGLDeviceEXT devices[16];
-  EGLint count = 0;
-  if (!query_devices(16, devices, &count) || count == 0) return egl_error("eglQueryDevicesEXT (no EGL device)");
-  std::vector<bool> software(std::size_t(count), false);
-  for (EGLint i = 0; i < count; ++i) {
-    const char* ext = query_string ? query_string(devices[i], EGL_EXTENSIONS) : nullptr;
-    software[std::size_t(i)] = ext && std::strstr(ext, "EGL_MESA_device_software") != nullptr;
-  }
-  int pick = options.device;
-  if (pick >= count) return Error::usage("--gpu-device " + std::to_string(pick) + ": EGL lists " +
-                                         std::to_string(count) + " device(s) (0-" + std::to_string(count - 1) + ")");
-  if (pick < 0) {
-    for (EGLint i = 0; i < count && pick < 0; ++i)
-      if (!software[std::size_t(i)]) pick = i;
-    if (pick < 0) pick = 0;
-  }
+  // Errors of this step are usage errors: the machine cannot run `--device gpu` (no libEGL, no device, no 4.5 core
+  // context), whatever EGL step failed.
+  // (egl.h's own usage errors already say what to install; its failed steps get the hint here.)
+  auto unusable = [](const Error& e) {
+    return Error::usage("--device gpu: " + e.message +
+                        (e.kind == ErrorKind::Usage ? ""
+                                                    : "; this machine has no usable EGL device (install libegl1 and a "
+                                                      "driver: libegl-mesa0 for llvmpipe)"));
+  };
+  auto devices = egl::devices();
+  if (!devices) return unusable(devices.error());
+  if (devices->empty()) return unusable(Error::internal("eglQueryDevicesEXT lists no EGL device"));
+  const int count = int(devices->size());
+  if (options.device >= count)
+    return Error::usage("--gpu-device " + std::to_string(options.device) + ": EGL lists " + std::to_string(count) +
+                        " device(s) (0-" + std::to_string(count - 1) + ")");
+  const int pick = options.device >= 0 ? options.device : egl::default_device(*devices);
+  auto surfaceless = egl::SurfacelessContext::create(pick);
+  if (!surfaceless) return unusable(surfaceless.error());
   std::shared_ptr<Context> ctx(new Context());
   ctx->device_index_ = pick;
-  ctx->software_ = software[std::size_t(pick)];
-  EGLDisplay display = platform_display(EGL_PLATFORM_DEVICE_EXT, devices[pick], nullptr);
-  if (display == EGL_NO_DISPLAY) return egl_error("eglGetPlatformDisplayEXT");
-  EGLint major = 0, minor = 0;
-  if (!egl().Initialize(display, &major, &minor)) return egl_error("eglInitialize");
-  if (!egl().BindAPI(EGL_OPENGL_API)) return egl_error("eglBindAPI(EGL_OPENGL_API)");
-  const EGLint attributes[] = {EGL_CONTEXT_MAJOR_VERSION, 4, EGL_CONTEXT_MINOR_VERSION, 5,
-                               EGL_CONTEXT_OPENGL_PROFILE_MASK, EGL_CONTEXT_OPENGL_CORE_PROFILE_BIT, EGL_NONE};
-  EGLContext context = egl().CreateContext(display, EGL_NO_CONFIG_KHR, EGL_NO_CONTEXT, attributes);
-  if (context == EGL_NO_CONTEXT) return egl_error("eglCreateContext (OpenGL 4.5 core, no config)");
-  ctx->display_ = display;
-  ctx->context_ = context;
-  if (!egl().MakeCurrent(display, EGL_NO_SURFACE, EGL_NO_SURFACE, context))
-    return egl_error("eglMakeCurrent (surfaceless)");
+  ctx->software_ = (*devices)[std::size_t(pick)].software;
+  ctx->egl_ = std::move(*surfaceless);
 #define TEMPORAL_GPU_GL_LOAD(type, name)                                                                  \
-  ctx->gl_.name = reinterpret_cast<type>(egl().GetProcAddress("gl" #name));                                 \
+  ctx->gl_.name = reinterpret_cast<type>(egl::SurfacelessContext::proc_address("gl" #name));                                 \
   if (!ctx->gl_.name) return Error::usage("--device gpu: the EGL device has no entry point gl" #name);
   TEMPORAL_GPU_GL_FUNCTIONS(TEMPORAL_GPU_GL_LOAD)
 #undef TEMPORAL_GPU_GL_LOAD
@@ -194,20 +123,11 @@ Expected<std::shared_ptr<Context>> Context::create(const ContextOptions& options
   return ctx;
 }
 
-Context::~Context() {
-  // The display is not terminated: EGL returns the same EGLDisplay for a device to every caller in the process, so
-  // eglTerminate would end the other contexts on it too. Its resources go with the process.
-  if (display_ && context_) {
-    if (egl().GetCurrentContext() == context_)
-      egl().MakeCurrent(display_, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
-    egl().DestroyContext(display_, context_);
-  }
-}
+Context::~Context() = default;  // egl::SurfacelessContext releases the EGL context
 
 Status Context::make_current() const {
-  if (egl().GetCurrentContext() == context_) return Status::ok();
-  if (!egl().MakeCurrent(display_, EGL_NO_SURFACE, EGL_NO_SURFACE, context_))
-    return Error::internal("gpu: eglMakeCurrent failed (EGL error " + hex(unsigned(egl().GetError())) + ")");
+  if (egl_->is_current()) return Status::ok();
+  if (Status s = egl_->make_current(); !s) return Error::internal("gpu: " + s.error().message);
   return Status::ok();
 }
 

@@ -38,20 +38,24 @@ avx512cd,avx512dq,avx512vl,prefer-vector-width=512\")")
 
 // Runs `...` (a statement, usually a return) with the namespace alias NS naming the kernel copy of the active
 // level (temporal/core/isa_copies.inc): TEMPORAL_ISA_CALL(copy, return std::make_unique<copy::HerzogState>(o, g)).
+// Exactly one copy runs: a statement that does not return (fxaa's `edges = copy::run_fxaa(...)`) leaves the switch.
 #if TEMPORAL_ISA_DISPATCH
 #define TEMPORAL_ISA_CALL(NS, ...)                \
   switch (::temporal::isa::active()) {            \
     case ::temporal::isa::Level::V4: {            \
       namespace NS = v4;                          \
       __VA_ARGS__;                                \
+      break;                                      \
     }                                             \
     case ::temporal::isa::Level::V3: {            \
       namespace NS = v3;                          \
       __VA_ARGS__;                                \
+      break;                                      \
     }                                             \
     default: {                                    \
       namespace NS = v2;                          \
       __VA_ARGS__;                                \
+      break;                                      \
     }                                             \
   }
 #else

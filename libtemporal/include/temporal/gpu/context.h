@@ -5,7 +5,7 @@
 // Why a function table: libOSMesa (the renderer) and libGL (VTK) both export every gl* symbol, and a process that
 // loads one of them first would send direct gl* calls to a library without a current context. Every entry point
 // used here is loaded through eglGetProcAddress, and libEGL itself (glvnd's dispatcher) is opened at run time on
-// the first Context::create: the stage links no display library (the method stages link it, and their CPU kernel
+// the first Context::create (temporal/gpu/egl.h, shared with the renderer's EGL context): the stage links no display library (the method stages link it, and their CPU kernel
 // benchmarks must run where no display library is installed), and works whatever else the program links.
 //
 // Threading: an EGL context is current on one thread at a time. Every object of this stage calls
@@ -21,6 +21,10 @@
 #include <string>
 
 namespace temporal::gpu {
+
+namespace egl {
+class SurfacelessContext;  // temporal/gpu/egl.h
+}
 
 // X(PFN type, member name): the OpenGL 4.5 core entry points of the compute kernels.
 #define TEMPORAL_GPU_GL_FUNCTIONS(X)                   \
@@ -119,8 +123,7 @@ class Context {
 
  private:
   Context() = default;
-  void* display_ = nullptr;  // EGLDisplay
-  void* context_ = nullptr;  // EGLContext
+  std::unique_ptr<egl::SurfacelessContext> egl_;
   int device_index_ = -1;
   bool software_ = false;
   bool timer_queries_ = false;
