@@ -18,6 +18,7 @@ PACKAGES=(
   snakemake slurm-wlm munge python3
   clang-14 libclang-rt-14-dev
   ffmpeg fonts-dejavu-core chromium
+  qemu-user
 )
 
 say() { printf 'setup.sh: %s\n' "$*" >&2; }

@@ -54,11 +54,20 @@ std::string cpu_flags() {
 
 bool has_flag(const std::string& flags, const std::string& f) { return flags.find(" " + f + " ") != std::string::npos; }
 
+// TEMPORAL_ISA_EXPECTED, set by tests/emulated/run_emulated.sh: the level the emulated CPU must give, or empty.
+std::string expected_level() {
+  const char* env = std::getenv("TEMPORAL_ISA_EXPECTED");
+  return env ? env : "";
+}
+
 TEST(Isa, LevelsFollowTheCpuFlags) {
   if (!isa::dispatching()) {
     EXPECT_EQ(isa::active(), Level::Native);
     GTEST_SKIP() << "a build with one kernel copy (TEMPORAL_NATIVE=ON or not x86-64 with GCC)";
   }
+  if (!expected_level().empty())
+    GTEST_SKIP() << "on a CPU emulated by qemu-user /proc/cpuinfo lists the host's flags, not the emulated CPU's; "
+                    "Isa.EmulatedCpuRunsItsLevel checks the level instead";
   EXPECT_TRUE(isa::supported(Level::V2));
   EXPECT_FALSE(isa::supported(Level::Native));
   const std::string flags = cpu_flags();
@@ -94,6 +103,20 @@ TEST(Isa, EnvironmentChoosesTheLevel) {
     }
   EXPECT_EQ(isa::active(), here.back());
   EXPECT_NE(isa::environment_note().find("not v2, v3 or v4"), std::string_view::npos) << isa::environment_note();
+}
+
+// The unit tests run again on CPUs emulated by qemu-user (tests/emulated): an AVX2 + FMA CPU without AVX-512 must
+// run v3, an SSE4.2 CPU without AVX v2, with no TEMPORAL_ISA forcing either (run_emulated.sh unsets it).
+TEST(Isa, EmulatedCpuRunsItsLevel) {
+  const std::string want = expected_level();
+  if (want.empty())
+    GTEST_SKIP() << "TEMPORAL_ISA_EXPECTED is unset: set only for the runs on an emulated CPU (ctest -L emulated)";
+  if (!isa::dispatching()) GTEST_SKIP() << "a build with one kernel copy";
+  ASSERT_EQ(std::getenv("TEMPORAL_ISA"), nullptr) << "the level must come from the CPU, not be forced";
+  EXPECT_EQ(isa::name(isa::active()), want);
+  EXPECT_TRUE(isa::environment_note().empty()) << isa::environment_note();
+  EXPECT_EQ(isa::supported(Level::V3), want == "v3" || want == "v4");
+  EXPECT_EQ(isa::supported(Level::V4), want == "v4");
 }
 
 TEST(Isa, ScopedLevelForcesAndRestores) {

@@ -1,7 +1,7 @@
 // upsample-st's `drobot` GLSL kernels (drobot_gpu.cpp) against its C++ state (drobot.cpp, the reference of record)
 // on the synthetic G-buffer sequence of the upsampling tests (a panning textured background, a foreground square
-// moving over it with its own depth and id: disocclusions every frame; k = 4 regular jitter; a NaN low-resolution
-// sample now and then; a cut at frame 6), for both modes and every option that changes the kernels' arithmetic,
+// moving over it with its own depth and id: disocclusions every frame; k = 4 regular jitter; a NaN and a 1e20
+// low-resolution sample every frame; a cut at frame 6), for both modes and every option that changes the kernels' arithmetic,
 // and the state round trips GPU -> CPU and CPU -> GPU. The FrameContext is built as Upsampler::build_context builds it.
 #include "gpu_methods.h"
 #include "gpu_support.h"
@@ -37,6 +37,8 @@ std::vector<test::SyntheticFrame> sequence(int n, int width = 76, int height = 5
     frames.push_back(test::make_frame(scene, t));
     // A non-finite sample now and then: it must carry weight 0 and never enter the history.
     frames.back().low.plane("G")[std::size_t((5 * t) % 200)] = std::numeric_limits<float>::quiet_NaN();
+    // ... and one past kMaxSampleMagnitude (temporal/core/image.h), which is no sample either (usable_sample).
+    frames.back().low.plane("R")[std::size_t((7 * t + 101) % 200)] = 1e20f;
     // Listing 7.1's normal weight needs normals that differ (the synthetic surfaces face the camera): the right half
     // of the image tilted, a crease across which --normal-power and --depth-only change the result.
     Image& gbuf = frames.back().gbuffer;
@@ -67,8 +69,10 @@ std::unique_ptr<MethodState> cpu_state(const Options& o, const Geometry& g) {
 // What can differ (drobot_gpu.cpp's file comment): multiply-adds contracted into FMAs differently by the driver and
 // GCC (and the fast_exp2 / fast_log2 polynomials for a --normal-power other than 32): float roundings; every decision
 // (cache hit, a block's validity) is the same. Measured on llvmpipe (Mesa 22.3.6, 2026-11-26): max |GPU - CPU|
-// 6.0e-7 (PSNR >= 137.1 dB) over both modes and every option, round trips 4.2e-7; the debug planes within 4.3e-7
-// (relative weight sum) and 1.9e-6 (frame count).
+// 6.6e-7 (PSNR >= 137.3 dB) over both modes and every option, round trips 4.2e-7 (before the 1e20 sample); the
+// debug planes within 4.3e-7 (relative weight sum) and 1.9e-6 (frame count). Before refresh mode's fallback read 0
+// at a tap that is no sample, the 1e20 sample made refresh mode differ by 1.1e12: the sample reached the output on
+// both devices, and a float rounding of 1e20 is ~1e13.
 constexpr double kDrobotMaxAbs = 2e-6, kDrobotPsnr = 125.0;
 // The debug planes: the Listing 7.1 weight sum relative, Listing 7.2's confidence / the convergence and the frame
 // count absolute.

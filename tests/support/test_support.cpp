@@ -19,7 +19,10 @@ std::filesystem::path binary_dir() { return TEMPORAL_BINARY_DIR; }
 std::filesystem::path tool_path(const std::string& tool) { return binary_dir() / "apps" / tool / tool; }
 
 std::filesystem::path scratch_dir(const std::string& name) {
-  auto dir = binary_dir() / "test-scratch" / name;
+  // TEMPORAL_TEST_SCRATCH: another root, for a second run of the same executable that CTest may start beside the
+  // first (the runs on emulated CPUs, tests/emulated): each run removes and refills its folders.
+  const char* root = std::getenv("TEMPORAL_TEST_SCRATCH");
+  auto dir = (root && *root ? std::filesystem::path(root) : binary_dir() / "test-scratch") / name;
   std::error_code ec;
   std::filesystem::remove_all(dir, ec);
   std::filesystem::create_directories(dir);

@@ -13,7 +13,8 @@
 
 namespace temporal::test {
 
-// A fresh, empty folder under the build tree for one test (removed and recreated on each call).
+// A fresh, empty folder under the build tree (or $TEMPORAL_TEST_SCRATCH) for one test (removed and recreated on
+// each call).
 std::filesystem::path scratch_dir(const std::string& name);
 
 // ../shared/assets beside the project (or $TEMPORAL_SHARED_ASSETS), when present. Tests that need it call

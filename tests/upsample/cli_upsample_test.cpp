@@ -236,12 +236,22 @@ std::size_t non_finite_values(const temporal::Image& img) {
       for (std::size_t i = 0; i < img.pixel_count(); ++i) n += std::isfinite(p[i]) ? 0 : 1;
   return n;
 }
+// Payload values (R, G, B) that are no sample: non-finite or past kMaxSampleMagnitude (temporal/core/image.h).
+std::size_t unusable_payload_values(const temporal::Image& img) {
+  std::size_t n = 0;
+  for (const char* c : {"R", "G", "B"})
+    if (const float* p = img.plane(c))
+      for (std::size_t i = 0; i < img.pixel_count(); ++i) n += temporal::usable_sample(p[i]) ? 0 : 1;
+  return n;
+}
 }  // namespace
 
-// Issue 26 items 11 and 12: a G-buffer frame with NaN depth (64 pixels) and a shade frame with a finite FLT_MAX
-// sample are warned about and treated as missing by every method: no non-finite value in any output, debug
-// layers included, in that frame or the ones after it. drobot once wrote thousands (its Listing 7.2 confidence of a
-// NaN cached depth was NaN and entered the frame count of the cache).
+// Issue 26 items 11 and 12: a G-buffer frame with NaN depth (64 pixels), a shade frame with a finite FLT_MAX
+// sample and one with a 1e20 sample are warned about and treated as missing by every method: no non-finite value
+// in any output, debug layers included, and no payload value past kMaxSampleMagnitude, in that frame or the ones
+// after it. drobot once wrote thousands (its Listing 7.2 confidence of a NaN cached depth was NaN and entered the
+// frame count of the cache); drobot --mode refresh wrote the 1e20 sample's neighbourhood (Listing 7.1's fallback
+// read it) and carried it in its history.
 TEST(UpsampleCli, NonFiniteDepthAndHugeSamplesNeverReachTheOutputs) {
   const fs::path dir = write_sequence("upsample_cli_hostile_values", 5);
   {
@@ -255,6 +265,10 @@ TEST(UpsampleCli, NonFiniteDepthAndHugeSamplesNeverReachTheOutputs) {
     ASSERT_TRUE(s.has_value());
     for (const char* c : {"R", "G", "B"}) s->plane(c)[5] = 3.4e38f;
     ASSERT_TRUE(temporal::write_exr((dir / "shade.0002.exr").string(), *s));
+    auto s3 = temporal::read_exr((dir / "shade.0003.exr").string());
+    ASSERT_TRUE(s3.has_value());
+    s3->plane("R")[std::size_t(s3->width()) * 3 + 7] = 1e20f;
+    ASSERT_TRUE(temporal::write_exr((dir / "shade.0003.exr").string(), *s3));
   }
   for (const std::string method : {"spatial", "temporal", "herzog", "drobot", "drobot --mode refresh", "taau"}) {
     std::string output;
@@ -264,15 +278,17 @@ TEST(UpsampleCli, NonFiniteDepthAndHugeSamplesNeverReachTheOutputs) {
                             ".####.exr --debug-layers --method " + method;
     ASSERT_EQ(temporal::test::run_command(cmd, &output), 0) << output;
     EXPECT_NE(output.find("gbuffer.0001.exr: warning: 64 pixels hold NaN or Inf"), std::string::npos) << output;
-    EXPECT_NE(output.find("shade.0002.exr: warning: 1 pixels hold NaN, Inf or a magnitude above 1e10"),
-              std::string::npos)
-        << output;
+    for (const char* frame : {"shade.0002.exr", "shade.0003.exr"})
+      EXPECT_NE(output.find(std::string(frame) + ": warning: 1 pixels hold NaN, Inf or a magnitude above 1e10"),
+                std::string::npos)
+          << output;
     for (int t = 0; t < 5; ++t) {
       char num[16];
       std::snprintf(num, sizeof num, "%04d", t);
       auto img = temporal::read_exr((dir / (name + "." + num + ".exr")).string());
       ASSERT_TRUE(img.has_value()) << img.error().message;
       EXPECT_EQ(non_finite_values(*img), 0u) << method << " frame " << t;
+      EXPECT_EQ(unusable_payload_values(*img), 0u) << method << " frame " << t;
     }
   }
 }

@@ -140,7 +140,8 @@ Image PlainUpsampler::process(const Image& g, const Image& low, const std::vecto
     for (int x = 0; x < f.lw; ++x) {
       const std::size_t s = f.sample_pixel(x, y);
       bool ok = std::isfinite(f.z[s]) && std::isfinite(f.nx[s]) && std::isfinite(f.ny[s]) && std::isfinite(f.nz[s]);
-      for (int c = 0; c < f.C; ++c) ok = ok && std::isfinite(f.low[c][std::size_t(y) * f.lw + x]);
+      // a payload past kMaxSampleMagnitude is no sample either (temporal/core/image.h, docs/conventions.md)
+      for (int c = 0; c < f.C; ++c) ok = ok && usable_sample(f.low[c][std::size_t(y) * f.lw + x]);
       f.valid[std::size_t(y) * f.lw + x] = ok;
     }
   if (cut || prev_out_.width() != f.W || prev_out_.height() != f.H) have_history_ = false;
@@ -553,7 +554,7 @@ void PlainUpsampler::drobot_refresh(const Frame& f, Image& out) {
                     up::drobot_depth_weight((f.z[i] - lz[s]) / f.depth_range) * avail[s] * t;
           if (!(w >= 0)) w = 0;
           tsum += t;
-          fb += t * f.low[c][s];
+          fb += t * (avail[s] > 0 ? f.low[c][s] : 0.0f);  // a tap that is no sample holds 0 for the fallback
           if (w > 0) {
             wsum += w;
             sum += w * f.low[c][s];

@@ -28,7 +28,7 @@ struct Frame {
 // A random sequence of `count` frames at W x H, factor k. Three rectangles (ids 2-4, depth ~10) move over a sloped
 // background (id 1, depth 20-26); the top half of the background moves by an integer pixel per frame (aligned
 // history taps), the bottom half by random fractional amounts per pixel (gathered taps); normals and payload are
-// random. Frame 4 has NaN payload samples and NaN motion, frame `count` / 2 is a camera cut.
+// random. Frame 4 has NaN and 1e20 payload samples and NaN motion, frame `count` / 2 is a camera cut.
 std::vector<Frame> random_sequence(int W, int H, int k, int count, unsigned seed) {
   std::mt19937 rng(seed);
   std::uniform_real_distribution<float> u01(0.0f, 1.0f), jitter(-0.15f, 0.15f), frac(-1.5f, 1.5f);
@@ -86,8 +86,11 @@ std::vector<Frame> random_sequence(int W, int H, int k, int count, unsigned seed
       float* p = f.low.add_channel(c);
       for (int j = 0; j < lw * lh; ++j) p[j] = u01(rng);
     }
-    if (t == 4)
+    if (t == 4) {
       for (int j = 0; j < 3; ++j) f.low.plane("G")[std::size_t(7 * j + 2)] = nan;
+      // and samples past kMaxSampleMagnitude (temporal/core/image.h), which are no samples either
+      for (int j = 0; j < 3; ++j) f.low.plane("R")[std::size_t(11 * j + 4)] = 1e20f;
+    }
     auto& lm = f.low.metadata();
     lm = gm;
     lm.camera_cut.reset();

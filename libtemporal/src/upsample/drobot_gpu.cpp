@@ -318,7 +318,8 @@ uniform float u_tol, u_warped_tol, u_threshold, u_convergence_time;
   ((uint(u_k) * ((q) / uint(u_low.x)) + uint(u_sy)) * uint(u_full.x) + uint(u_sx) + uint(u_k) * ((q) % uint(u_low.x)))
 #define COARSE(q, plane) gb[uint(plane) * u_n + SAMPLE_PIXEL(q)]
 #define COARSE_AVAIL(q) (low_valid(q) ? 1.0 : 0.0)
-#define COARSE_VALUE(c, q) lowb[uint(c) * u_ln + (q)]
+// A tap that is no sample holds 0 for listing71's fallback (run_refresh's refresh_low).
+#define COARSE_VALUE(c, q) (low_valid(q) ? lowb[uint(c) * u_ln + (q)] : 0.0)
 #define REPROJECT_PREV_Z(q) prevg[uint(q)]
 #define REPROJECT_PREV_ID(q) prevg_u[u_n + uint(q)]
 )";
