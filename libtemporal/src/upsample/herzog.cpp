@@ -32,9 +32,13 @@
 #include "temporal/core/isa.h"
 #include "temporal/core/parallel.h"
 
+#include <immintrin.h>
+
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 #include <limits>
 
 namespace temporal::upsample {
