@@ -63,9 +63,8 @@ struct FrameScratch {
 
 // The kernel copies, one per instruction set (temporal/core/isa.h). v3 and v4 contract the multiply-adds of the
 // bilinear model fetch, the RLS update and the predictions into FMAs (v2 has none): v2's outputs and states
-// differ from theirs in the last bits, amplified by the RLS over frames. v4 is compiled for 256-bit vectors
-// (phlm_kernels.inc says why) and with AVX-512's 32 registers GCC groups and contracts some operations
-// differently from v3: v3 and v4 differ like v2 and v3 (tests/core/isa_test.cpp bounds both).
+// differ from theirs in the last bits, amplified by the RLS over frames (tests/core/isa_test.cpp bounds it). v3 and
+// v4 run the same 8-lane vector code and give the same bits.
 // phlm_kernels.inc runs Algorithm 1 for kLanes pixels at once, one per vector lane: one SSE vector in the v2
 // copy, one AVX vector in v3 and v4 (v4 stays at 256 bits: phlm_kernels.inc says why). The kernel reads its copy's
 // value by unqualified lookup (a `#pragma GCC target` region does not define __AVX__ for the code in it).
