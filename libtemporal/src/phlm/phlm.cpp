@@ -1,5 +1,10 @@
 // Pixel History Linear Models, seed 003 sections 4-6 and Algorithm 1. The terms the paper leaves loose and
 // how they are read here are listed in docs/filter-phlm.md ("Reading the paper").
+// rls.h's steps are instantiated below for phlm_kernels.inc's vectors; the templates are compiled for the baseline
+// target, where GCC notes that a 32-byte vector is returned under another ABI than with AVX. They are always inlined
+// into the v3 / v4 kernels (no call, so no ABI), so the note does not apply.
+#pragma GCC diagnostic ignored "-Wpsabi"
+
 #include "temporal/phlm/phlm.h"
 
 #include "filter_common.h"
@@ -15,8 +20,11 @@
 #include <algorithm>
 #include <array>
 #include <atomic>
+#include <cfloat>
+#include <cstdint>
 #include <cmath>
 #include <cstring>
+#include <type_traits>
 #include <vector>
 
 namespace temporal::phlm {
@@ -55,9 +63,27 @@ struct FrameScratch {
 
 // The kernel copies, one per instruction set (temporal/core/isa.h). v3 and v4 contract the multiply-adds of the
 // bilinear model fetch, the RLS update and the predictions into FMAs (v2 has none): v2's outputs and states
-// differ from theirs in the last bits, amplified by the RLS over frames. v4 is compiled for 256-bit vectors
-// (phlm_kernels.inc says why) and with AVX-512's 32 registers GCC groups and contracts some operations
-// differently from v3: v3 and v4 differ like v2 and v3 (tests/core/isa_test.cpp bounds both).
+// differ from theirs in the last bits, amplified by the RLS over frames (tests/core/isa_test.cpp bounds it). v3 and
+// v4 run the same 8-lane vector code and give the same bits.
+// phlm_kernels.inc runs Algorithm 1 for kLanes pixels at once, one per vector lane: one SSE vector in the v2
+// copy, one AVX vector in v3 and v4 (v4 stays at 256 bits: phlm_kernels.inc says why). The kernel reads its copy's
+// value by unqualified lookup (a `#pragma GCC target` region does not define __AVX__ for the code in it).
+namespace v2 {
+[[maybe_unused]] constexpr int kLanes = 4;
+}
+namespace v3 {
+[[maybe_unused]] constexpr int kLanes = 8;
+}
+namespace v4 {
+[[maybe_unused]] constexpr int kLanes = 8;
+}
+namespace native {
+#ifdef __AVX__
+[[maybe_unused]] constexpr int kLanes = 8;
+#else
+[[maybe_unused]] constexpr int kLanes = 4;
+#endif
+}  // namespace native
 #define TEMPORAL_ISA_FILE "phlm_kernels.inc"
 #include "temporal/core/isa_copies.inc"
 

@@ -31,6 +31,11 @@ namespace temporal::phlm::rls {
 // The per-pixel steps (reset, predict, trace, bierman_update, update) are always inlined: phlm's kernel is compiled
 // once per instruction set (temporal/core/isa.h), and with three callers GCC's inliner left bierman_update out of
 // line, compiled for the baseline (SSE, no FMA), in every copy. Their operations are unchanged.
+//
+// Model, reset, predict, trace and bierman_update take the value type T: float for one model, or a GCC vector of
+// floats for one model per lane (phlm_kernels.inc runs Algorithm 1 for 4 to 8 pixels at once, one per lane). The
+// operations are the same in the same order for either; they have no branches, so every lane computes exactly
+// what the float version computes for its pixel.
 
 // Number of strictly-upper entries of an N x N unit upper triangular U.
 template <int N>
@@ -51,39 +56,39 @@ constexpr int packed_index(int i, int j) {
 }
 
 // One linear model: C outputs, N predictors.
-template <int N, int C>
+template <int N, int C, typename T = float>
 struct Model {
-  float beta[C][N];
-  float u[kOffDiagonal<N> > 0 ? kOffDiagonal<N> : 1];
-  float d[N];
+  T beta[C][N];
+  T u[kOffDiagonal<N> > 0 ? kOffDiagonal<N> : 1];
+  T d[N];
 };
 
 // Seed 003 section 6, "Initialization": the intercept coefficients take `value`, the slopes are cleared,
 // P = p0 * I (U = I, D = p0).
-template <int N, int C>
-[[gnu::always_inline]] inline void reset(Model<N, C>& m, const float value[C], float p0) {
+template <int N, int C, typename T>
+[[gnu::always_inline]] inline void reset(Model<N, C, T>& m, const T value[C], float p0) {
   for (int c = 0; c < C; ++c) {
     m.beta[c][0] = value[c];
-    for (int k = 1; k < N; ++k) m.beta[c][k] = 0.0f;
+    for (int k = 1; k < N; ++k) m.beta[c][k] = T{};
   }
-  for (int k = 0; k < kOffDiagonal<N>; ++k) m.u[k] = 0.0f;
-  for (int k = 0; k < N; ++k) m.d[k] = p0;
+  for (int k = 0; k < kOffDiagonal<N>; ++k) m.u[k] = T{};
+  for (int k = 0; k < N; ++k) m.d[k] = T{} + p0;
 }
 
 // Prediction of output c: beta_c^T x (eq. 4 / 8).
-template <int N, int C>
-[[gnu::always_inline]] inline float predict(const Model<N, C>& m, int c, const float x[N]) {
-  float s = 0.0f;
+template <int N, int C, typename T>
+[[gnu::always_inline]] inline T predict(const Model<N, C, T>& m, int c, const T x[N]) {
+  T s = T{};
   for (int k = 0; k < N; ++k) s += m.beta[c][k] * x[k];
   return s;
 }
 
 // trace(P) = sum_j D_j (1 + sum_{i<j} U_ij^2).
-template <int N>
-[[gnu::always_inline]] inline float trace(const float* u, const float* d) {
-  float t = 0.0f;
+template <int N, typename T>
+[[gnu::always_inline]] inline T trace(const T* u, const T* d) {
+  T t = T{};
   for (int j = 0; j < N; ++j) {
-    float col = 1.0f;
+    T col = T{} + 1.0f;
     for (int i = 0; i < j; ++i) col += u[off_index<N>(i, j)] * u[off_index<N>(i, j)];
     t += d[j] * col;
   }
@@ -105,29 +110,29 @@ inline void covariance(const float* u, const float* d, float* p) {
 // Bierman's UD measurement update with measurement variance `r`: on return U D U^T holds
 // P - P x x^T P / (r + x^T P x), `gain` holds P x / (r + x^T P x) (computed from the old P), and the
 // return value is r + x^T P x. With r = lambda this is eq. 6-7 before the division by lambda.
-template <int N>
-[[gnu::always_inline]] inline float bierman_update(float* u, float* d, const float x[N], float r, float gain[N]) {
-  float f[N], v[N];
+template <int N, typename T>
+[[gnu::always_inline]] inline T bierman_update(T* u, T* d, const T x[N], float r, T gain[N]) {
+  T f[N], v[N];
   for (int j = 0; j < N; ++j) {
-    float s = x[j];
+    T s = x[j];
     for (int i = 0; i < j; ++i) s += u[off_index<N>(i, j)] * x[i];
     f[j] = s;
     v[j] = d[j] * s;
   }
   // The running sums alpha_j = r + sum_{k<=j} f_k v_k come first so that their N reciprocals are
   // independent divisions (pipelined) instead of a chain of 2N dependent ones.
-  float alpha[N], inv[N];
+  T alpha[N], inv[N];
   alpha[0] = r + v[0] * f[0];
   for (int j = 1; j < N; ++j) alpha[j] = alpha[j - 1] + v[j] * f[j];
   for (int j = 0; j < N; ++j) inv[j] = 1.0f / alpha[j];
   d[0] *= r * inv[0];
   gain[0] = v[0];
   for (int j = 1; j < N; ++j) {
-    const float p = -f[j] * inv[j - 1];
+    const T p = -f[j] * inv[j - 1];
     d[j] *= alpha[j - 1] * inv[j];
     for (int i = 0; i < j; ++i) {
-      float& uij = u[off_index<N>(i, j)];
-      const float old = uij;
+      T& uij = u[off_index<N>(i, j)];
+      const T old = uij;
       uij = old + gain[i] * p;
       gain[i] += old * v[j];
     }
