@@ -13,6 +13,7 @@
 
 #include <benchmark/benchmark.h>
 
+#include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <memory>
@@ -117,10 +118,10 @@ void BM_PerPixel(benchmark::State& state) {
 //   non-temporal threshold and stores through the cache, so every destination line is first read (a third
 //   stream the method's byte count does not contain) and the writes evict the source from L3.
 // - Sources that come from DRAM: the copy rotates over enough buffer pairs that the sources read between two
-//   uses of one pair exceed twice the L3 (64 MB on the build machine's 32 MB L3). Copying one pair again and
-//   again read part of its source from L3, a share that depended on what else ran on the host: the bound of
-//   the same 41.6 MB moved between 0.7 and 1.95 ms in runs of the same binary (docs/upsample-st.md,
-//   "Performance").
+//   uses of one pair exceed twice the L3 (64 MB on the build machine's 32 MB L3: 5 pairs for drobot). Copying
+//   one pair again and again read part of its source from L3, a share that depended on what else ran on the
+//   host: drobot's bound (42.6 MB) moved between 0.7 and 1.95 ms in runs of the same binary
+//   (docs/upsample-st.md, "Issue 27, third pass").
 // - Every buffer is written before the timed loop (no page faults inside it); the chunks are 64 KiB of whole
 //   cache lines, shared dynamically by the threads (a thread held up by another process does not leave half
 //   the copy waiting).
@@ -141,6 +142,24 @@ void stream_copy(char* dst, const char* src, std::size_t n) {
 #endif
 }
 
+// The L3 size: Linux's cache description (what lscpu shows), else glibc's, else the build machine's 32 MB. glibc's
+// sysconf(_SC_LEVEL3_CACHE_SIZE) says 320 MB on the build machine's VM (lscpu and sysfs: 32 MB), which would
+// allocate ten times the buffers needed.
+std::size_t l3_bytes() {
+  if (std::FILE* f = std::fopen("/sys/devices/system/cpu/cpu0/cache/index3/size", "r")) {
+    unsigned long v = 0;
+    char unit = 0;
+    const int got = std::fscanf(f, "%lu%c", &v, &unit);
+    std::fclose(f);
+    const std::size_t scale = got == 2 && unit == 'K' ? 1024 : got == 2 && unit == 'M' ? std::size_t(1) << 20 : 1;
+    if (got >= 1 && v > 0) return std::size_t(v) * scale;
+  }
+#if defined(_SC_LEVEL3_CACHE_SIZE)
+  if (const long s = sysconf(_SC_LEVEL3_CACHE_SIZE); s > 0) return std::size_t(s);
+#endif
+  return std::size_t(32) << 20;
+}
+
 struct AlignedFree {
   void operator()(char* p) const { std::free(p); }
 };
@@ -151,11 +170,7 @@ void BM_Stream(benchmark::State& state) {
   constexpr std::size_t kLine = 64, kChunkLines = 1024;          // 64 KiB chunks
   const std::size_t lines = (bytes / 2 + kLine - 1) / kLine;     // memcpy reads n bytes and writes n bytes
   const std::size_t n = lines * kLine;
-  std::size_t l3 = 32u << 20;
-#if defined(_SC_LEVEL3_CACHE_SIZE)
-  if (const long s = sysconf(_SC_LEVEL3_CACHE_SIZE); s > 0) l3 = std::size_t(s);
-#endif
-  const std::size_t pairs = 1 + (2 * l3 + n - 1) / n;
+  const std::size_t pairs = 1 + (2 * l3_bytes() + n - 1) / n;
   std::vector<std::unique_ptr<char, AlignedFree>> src, dst;
   for (std::size_t p = 0; p < pairs; ++p) {
     src.emplace_back(static_cast<char*>(std::aligned_alloc(4096, (n + 4095) / 4096 * 4096)));
