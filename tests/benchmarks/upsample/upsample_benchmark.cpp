@@ -1,9 +1,10 @@
 // ms per frame of each upsampling method and named variant of the method table (temporal/upsample/methods.h) at
 // 1280x1024 (factor 4, R,G,B payload) and, in the same run, the
 // time to stream the bytes the method must read and write (Upsampler::streamed_bytes: G-buffer planes,
-// payload in and out, full-resolution histories read and written once), measured as a parallel memcpy
-// moving that many bytes (half read, half written). Targets (issue 4): herzog <= 1.5x spatial, and within
-// 2.5x of its streaming bound.
+// payload in and out, full-resolution histories read and written once), measured as a parallel copy
+// moving that many bytes (half read, half written) from DRAM to DRAM with non-temporal stores (BM_Stream;
+// BM_StreamL3: the same copy of one buffer pair, part of it from L3). Targets (issue 4): herzog <= 1.5x
+// spatial, and within 2.5x of its streaming bound.
 #include "synthetic.h"
 #include "upsample_variants.h"
 
@@ -13,10 +14,16 @@
 
 #include <benchmark/benchmark.h>
 
+#include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <memory>
 #include <vector>
+
+#include <unistd.h>
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 
 namespace up = temporal::upsample;
 using temporal::Image;
@@ -107,21 +114,94 @@ void BM_PerPixel(benchmark::State& state) {
       benchmark::Counter(pixels * double(state.iterations()), benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
 }
 
-void BM_Stream(benchmark::State& state) {
+// The bound: the fastest copy of the method's bytes from DRAM to DRAM, half of them read, half written.
+// - Non-temporal stores (SSE2, every x86-64): a memcpy in 64 KiB chunks (the bound until 2026-11-26) is below
+//   glibc's non-temporal threshold and stores through the cache, so every destination line is first read (a
+//   third stream the method's byte count does not contain) and the writes evict the source from L3.
+// - Sources from DRAM (BM_Stream): the copy rotates over enough buffer pairs that the sources read between two
+//   uses of one pair exceed twice the L3 (64 MB on the build machine's 32 MB L3: 5 pairs for drobot). One pair
+//   copied again and again (BM_StreamL3, the old bound's way) reads part of its source from L3, a share that
+//   depends on what else runs on the host: drobot's old bound (42.6 MB) moved between 0.7 and 1.95 ms in runs
+//   of the same binary, BM_StreamL3 between 0.44 and 0.81 ms (docs/upsample-st.md, "Issue 27, third pass").
+// - Every buffer is written before the timed loop (no page faults inside it); the chunks are 64 KiB of whole
+//   cache lines, shared dynamically by the threads (a thread held up by another process does not leave half
+//   the copy waiting).
+void stream_copy(char* dst, const char* src, std::size_t n) {
+#if defined(__SSE2__)
+  for (std::size_t i = 0; i < n; i += 64) {
+    const __m128i a = _mm_load_si128(reinterpret_cast<const __m128i*>(src + i));
+    const __m128i b = _mm_load_si128(reinterpret_cast<const __m128i*>(src + i + 16));
+    const __m128i c = _mm_load_si128(reinterpret_cast<const __m128i*>(src + i + 32));
+    const __m128i d = _mm_load_si128(reinterpret_cast<const __m128i*>(src + i + 48));
+    _mm_stream_si128(reinterpret_cast<__m128i*>(dst + i), a);
+    _mm_stream_si128(reinterpret_cast<__m128i*>(dst + i + 16), b);
+    _mm_stream_si128(reinterpret_cast<__m128i*>(dst + i + 32), c);
+    _mm_stream_si128(reinterpret_cast<__m128i*>(dst + i + 48), d);
+  }
+#else
+  std::memcpy(dst, src, n);
+#endif
+}
+
+// The L3 size: Linux's cache description (what lscpu shows), else glibc's, else the build machine's 32 MB. glibc's
+// sysconf(_SC_LEVEL3_CACHE_SIZE) says 320 MB on the build machine's VM (lscpu and sysfs: 32 MB), which would
+// allocate ten times the buffers needed.
+std::size_t l3_bytes() {
+  if (std::FILE* f = std::fopen("/sys/devices/system/cpu/cpu0/cache/index3/size", "r")) {
+    unsigned long v = 0;
+    char unit = 0;
+    const int got = std::fscanf(f, "%lu%c", &v, &unit);
+    std::fclose(f);
+    const std::size_t scale = got == 2 && unit == 'K' ? 1024 : got == 2 && unit == 'M' ? std::size_t(1) << 20 : 1;
+    if (got >= 1 && v > 0) return std::size_t(v) * scale;
+  }
+#if defined(_SC_LEVEL3_CACHE_SIZE)
+  if (const long s = sysconf(_SC_LEVEL3_CACHE_SIZE); s > 0) return std::size_t(s);
+#endif
+  return std::size_t(32) << 20;
+}
+
+struct AlignedFree {
+  void operator()(char* p) const { std::free(p); }
+};
+
+void stream(benchmark::State& state, bool from_dram) {
   const int m = int(state.range(0));
   const std::size_t bytes = up::Upsampler::streamed_bytes(options(m), kW, kH, kK, 3);
-  const std::size_t n = bytes / 2;  // memcpy reads n bytes and writes n bytes
-  std::unique_ptr<char[]> src(new char[n]), dst(new char[n]);
-  std::memset(src.get(), 1, n);
-  std::memset(dst.get(), 2, n);
+  constexpr std::size_t kLine = 64, kChunkLines = 1024;          // 64 KiB chunks
+  const std::size_t lines = (bytes / 2 + kLine - 1) / kLine;     // memcpy reads n bytes and writes n bytes
+  const std::size_t n = lines * kLine;
+  const std::size_t pairs = from_dram ? 1 + (2 * l3_bytes() + n - 1) / n : 1;
+  std::vector<std::unique_ptr<char, AlignedFree>> src, dst;
+  for (std::size_t p = 0; p < pairs; ++p) {
+    src.emplace_back(static_cast<char*>(std::aligned_alloc(4096, (n + 4095) / 4096 * 4096)));
+    dst.emplace_back(static_cast<char*>(std::aligned_alloc(4096, (n + 4095) / 4096 * 4096)));
+    if (!src.back() || !dst.back()) {
+      state.SkipWithError("out of memory for the stream buffers");
+      return;
+    }
+    std::memset(src.back().get(), 1, n);
+    std::memset(dst.back().get(), 2, n);
+  }
+  std::size_t p = 0;
   for (auto _ : state) {
-    temporal::parallel_chunks(n, [&](std::size_t b, std::size_t e) { std::memcpy(dst.get() + b, src.get() + b, e - b); },
-                              1 << 16);
+    const char* s = src[p].get();
+    char* d = dst[p].get();
+    p = (p + 1) % pairs;
+    temporal::parallel_chunks(
+        lines, [&](std::size_t b, std::size_t e) { stream_copy(d + b * kLine, s + b * kLine, (e - b) * kLine); },
+        kChunkLines);
+#if defined(__SSE2__)
+    _mm_sfence();  // the streamed stores are globally visible before the clock stops
+#endif
     benchmark::ClobberMemory();
   }
-  state.SetLabel(std::string("stream bound of ") + name(m));
+  state.SetLabel(std::string(from_dram ? "stream bound of " : "L3-assisted copy for ") + name(m));
   state.counters["MB"] = double(bytes) / 1e6;
 }
+
+void BM_Stream(benchmark::State& state) { stream(state, true); }
+void BM_StreamL3(benchmark::State& state) { stream(state, false); }
 
 }  // namespace
 
@@ -133,6 +213,10 @@ int main(int argc, char** argv) {
   const int last = int(up::method_variants().size()) - 1;
   auto* u = benchmark::RegisterBenchmark("BM_Upsample", BM_Upsample)->DenseRange(0, last)->Unit(benchmark::kMillisecond)->UseRealTime();
   auto* m = benchmark::RegisterBenchmark("BM_Stream", BM_Stream)->DenseRange(0, last)->Unit(benchmark::kMillisecond)->UseRealTime();
+  auto* d = benchmark::RegisterBenchmark("BM_StreamL3", BM_StreamL3)
+                ->DenseRange(0, last)
+                ->Unit(benchmark::kMillisecond)
+                ->UseRealTime();
   // One thread's time per pixel of spatial, temporal, herzog, drobot and taau.
   const std::vector<int64_t> per_pixel = {variant_index("spatial"), variant_index("temporal"), variant_index("herzog"),
                                           variant_index("drobot"), variant_index("taau")};
@@ -143,6 +227,7 @@ int main(int argc, char** argv) {
   if (n > 0) {
     u->Iterations(n);
     m->Iterations(n);
+    d->Iterations(n);
     p->Iterations(n);
   }
   benchmark::Initialize(&argc, argv);

@@ -3,7 +3,8 @@
 // (the method table's, in the order of the file) on synthetic sequences (the benchmark's 1280x1024 pan; small
 // scenes with a moving object and per-frame G-buffers, debug layers on, k = 4, 3 (odd width) and 2 (gradient
 // scale 4)) and writes every output float to FILE (`write FILE`), or compares against FILE (`check FILE`), printing
-// the largest absolute and relative differences per variant ("max abs 0": bit-identical).
+// the largest absolute and relative differences per variant ("max abs 0": bit-identical) and, for a variant that
+// differs, per scene and output channel (payload or debug layer).
 #include "synthetic.h"
 #include "upsample_variants.h"
 
@@ -34,10 +35,21 @@ up::Options options(int m, std::vector<std::string> extra = {}) {
   return temporal::test::upsample_variant(kNames[m], std::move(extra));
 }
 
-void append(std::vector<float>& v, const Image& img) {
+// Where each plane lies in a variant's floats (the same for `write` and `check`): its scene and channel, so that
+// `check` can say which outputs moved (payload or debug layer, which scene).
+struct Segment {
+  int scene;
+  std::string channel;
+  std::size_t begin, end;
+};
+const char* const kScenes[] = {"pan 1280x1024", "small k=4", "k=3", "k=2"};
+
+void append(std::vector<float>& v, std::vector<Segment>& seg, int scene, const Image& img) {
   for (const auto& n : img.channel_names()) {
     const float* p = img.plane(n);
-    if (p) v.insert(v.end(), p, p + img.pixel_count());
+    if (!p) continue;
+    seg.push_back({scene, n, v.size(), v.size() + img.pixel_count()});
+    v.insert(v.end(), p, p + img.pixel_count());
   }
 }
 
@@ -90,13 +102,14 @@ int main(int argc, char** argv) {
   }
 
   std::vector<std::vector<float>> results(kVariants);
+  std::vector<std::vector<Segment>> segments(kVariants);
   for (int m = 0; m < kVariants; ++m) {
     {
       up::Upsampler u(options(m));
       for (int i = 0; i < 40; ++i) {
         auto r = u.process(fa[0].gbuffer, fa[i % 16].low, kRGB, false);
         if (!r) return 2;
-        if (i >= 36) append(results[m], **r);
+        if (i >= 36) append(results[m], segments[m], 0, **r);
       }
     }
     {
@@ -104,7 +117,7 @@ int main(int argc, char** argv) {
       for (int i = 0; i < 24; ++i) {
         auto r = u.process(fb[i].gbuffer, fb[i].low, kRGB, false);
         if (!r) return 2;
-        append(results[m], **r);
+        append(results[m], segments[m], 1, **r);
       }
     }
     for (int scene = 0; scene < 2; ++scene) {
@@ -115,7 +128,7 @@ int main(int argc, char** argv) {
       for (const auto& fr : frames) {
         auto r = u.process(fr.gbuffer, fr.low, kRGB, false);
         if (!r) return 2;
-        append(results[m], **r);
+        append(results[m], segments[m], 2 + scene, **r);
       }
     }
   }
@@ -160,6 +173,24 @@ int main(int argc, char** argv) {
                 ok ? "OK" : "DIFFERENT");
     if (differing) std::printf("  (%zu values differ, the first at float %zu of %zu)", differing, first, std::size_t(n));
     std::printf("\n");
+    if (!differing) continue;
+    // Per scene and channel: the largest difference (absolute; relative to max(1, |reference|)).
+    std::vector<std::pair<std::string, std::pair<double, double>>> per;
+    for (const Segment& sg : segments[m]) {
+      const std::string key = std::string(kScenes[sg.scene]) + " " + sg.channel;
+      auto it = std::find_if(per.begin(), per.end(), [&](const auto& e) { return e.first == key; });
+      if (it == per.end()) it = per.insert(per.end(), {key, {0.0, 0.0}});
+      for (std::size_t i = sg.begin; i < sg.end; ++i) {
+        const float x = results[m][i], y = ref[i];
+        if (std::isnan(x) || std::isnan(y)) continue;
+        const double d = std::abs(double(x) - double(y));
+        it->second.first = std::max(it->second.first, d);
+        it->second.second = std::max(it->second.second, d / std::max(1.0, std::abs(double(y))));
+      }
+    }
+    for (const auto& [key, d] : per)
+      if (d.first > 0)
+        std::printf("    %-36s max abs %.3g  max rel %.3g\n", key.c_str(), d.first, d.second);
   }
   return bad ? 4 : 0;
 }
