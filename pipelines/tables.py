@@ -110,19 +110,9 @@ def tuning(path):
     for r in rows:
         methods.setdefault(r["method"], OrderedDict()).setdefault(r["setting"], OrderedDict())[r["sequence"]] = r
     seqs = list(OrderedDict((r["sequence"], 1) for r in rows))
-    def key(setting):
-        parts = []
-        for item in setting.split("/"):
-            name, _, value = item.partition("=")
-            try:
-                parts.append((name, 0, float(value), ""))
-            except ValueError:
-                parts.append((name, 1, 0.0, value))
-        return parts
-
     out = []
     for method, settings in methods.items():
-        settings = OrderedDict(sorted(settings.items(), key=lambda kv: key(kv[0])))
+        settings = OrderedDict(sorted(settings.items(), key=lambda kv: _setting_key(kv[0])))
         out.append(f"### {method}\n")
         out.append("| setting | " + " | ".join(seqs) + " | mean PSNR | mean flicker |")
         out.append("|---|" + "---|" * (len(seqs) + 2))

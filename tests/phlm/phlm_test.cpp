@@ -59,25 +59,32 @@ TEST(Phlm, StateSizeFollowsTheData) {
 // Section 5.1's feature weight with hand-computed values: grey frames (YCgCo Y = the value), frame 0 all 0.5,
 // frame 1 with 0.3 at (1,1) and 0.9 at (3,3). At pixel (2,2): Delta(Y) = 0.9 - 0.3 = 0.6, the previous feature
 // is 0.5, l = min(|0.5 - 0.3|, |0.5 - 0.9|) = 0.2, the binomial low-pass is (8 - 1 + 1.2) / 16 = 0.5125.
+// The frames of the feature tests below, through a fresh filter with `params`: frame 0 uniform 0.5, frame 1 with
+// 0.3 at (1,1) and 0.9 at (3,3), motion (vx, vy) at every pixel; returns frame 1's output (debug layers on).
+Image feature_frames(const PhlmParams& params, int w, int h, float vx, float vy) {
+  Image m(w, h);
+  float* mx = m.add_channel("motion.X", vx);
+  float* my = m.add_channel("motion.Y", vy);
+  const Image f0 = make_frame(w, h, [](int, int, int) { return 0.5f; });
+  const Image f1 = make_frame(w, h, [](int x, int y, int) {
+    return (x == 1 && y == 1) ? 0.3f : ((x == 3 && y == 3) ? 0.9f : 0.5f);
+  });
+  PhlmFilter filter(params);
+  Image out;
+  FilterInput in = input_for(f0, true);
+  in.motion_x = mx;
+  in.motion_y = my;
+  in.debug = true;
+  EXPECT_TRUE(filter.process(in, out));
+  in.color = &f1;
+  in.reset = false;
+  EXPECT_TRUE(filter.process(in, out));
+  return out;
+}
+
 TEST(Phlm, FeatureWeightFollowsSection51) {
   for (const float v : {0.0f, 1.0f}) {  // |motion| in pixels
-    Image m(5, 5);
-    float* mx = m.add_channel("motion.X", v);
-    float* my = m.add_channel("motion.Y", 0.0f);
-    const Image f0 = make_frame(5, 5, [](int, int, int) { return 0.5f; });
-    const Image f1 = make_frame(5, 5, [](int x, int y, int) {
-      return (x == 1 && y == 1) ? 0.3f : ((x == 3 && y == 3) ? 0.9f : 0.5f);
-    });
-    PhlmFilter filter;
-    Image out;
-    FilterInput in = input_for(f0, true);
-    in.motion_x = mx;
-    in.motion_y = my;
-    in.debug = true;
-    ASSERT_TRUE(filter.process(in, out));
-    in.color = &f1;
-    in.reset = false;
-    ASSERT_TRUE(filter.process(in, out));
+    const Image out = feature_frames(PhlmParams{}, 5, 5, v, 0.0f);
     // alpha = (a l^2 + b v l^3) / (l + Delta), a = 0.125, b = 0.25.
     const double alpha = (0.125 * 0.04 + 0.25 * v * 0.008) / 0.8;
     EXPECT_NEAR(out.plane("debug.alpha")[12], alpha, 1e-6) << "v = " << v;
@@ -85,14 +92,8 @@ TEST(Phlm, FeatureWeightFollowsSection51) {
     // The literal eq. 1 reading (ablation --feature-alpha eq1): alpha weighs the history.
     PhlmParams eq1;
     eq1.alpha_reading = "eq1";
-    PhlmFilter literal(eq1);
-    in.color = &f0;
-    in.reset = true;
-    ASSERT_TRUE(literal.process(in, out));
-    in.color = &f1;
-    in.reset = false;
-    ASSERT_TRUE(literal.process(in, out));
-    EXPECT_NEAR(out.plane("debug.featureG")[12], alpha * 0.5 + (1.0 - alpha) * 0.5125, 1e-6);
+    const Image literal = feature_frames(eq1, 5, 5, v, 0.0f);
+    EXPECT_NEAR(literal.plane("debug.featureG")[12], alpha * 0.5 + (1.0 - alpha) * 0.5125, 1e-6);
   }
 }
 
@@ -107,25 +108,9 @@ TEST(Phlm, LinearFeatureWeightFollowsUe4HistoryFactor) {
   for (const auto& [v, expected] : {std::pair{0.0f, 0.03125}, std::pair{1.0f, 0.09375}, std::pair{5.0f, 0.34375}}) {
     // 5 x 9 pixels, the motion v pixels per frame along y: q = p + motion = (2, 2 + v) stays on screen, and frame 0
     // is uniform, so the fetched feature is 0.5 wherever it comes from.
-    Image m(5, 9);
-    float* mx = m.add_channel("motion.X", 0.0f);
-    float* my = m.add_channel("motion.Y", v);
-    const Image f0 = make_frame(5, 9, [](int, int, int) { return 0.5f; });
-    const Image f1 = make_frame(5, 9, [](int x, int y, int) {
-      return (x == 1 && y == 1) ? 0.3f : ((x == 3 && y == 3) ? 0.9f : 0.5f);
-    });
     PhlmParams linear;
     linear.feature_phi = "linear";
-    PhlmFilter filter(linear);
-    Image out;
-    FilterInput in = input_for(f0, true);
-    in.motion_x = mx;
-    in.motion_y = my;
-    in.debug = true;
-    ASSERT_TRUE(filter.process(in, out));
-    in.color = &f1;
-    in.reset = false;
-    ASSERT_TRUE(filter.process(in, out));
+    const Image out = feature_frames(linear, 5, 9, 0.0f, v);
     EXPECT_NEAR(out.plane("debug.alpha")[12], expected, 1e-6) << "v = " << v;
     EXPECT_NEAR(out.plane("debug.featureG")[12], 0.5 + expected * (0.5125 - 0.5), 1e-6) << "v = " << v;
     // Pixel (4, 0), whose whole neighbourhood is 0.5 (flat box, Delta = 0, l = 0; q = (4, v) on screen): nothing
