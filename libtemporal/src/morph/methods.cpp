@@ -34,8 +34,7 @@ ParamList params(MorphOptions& o) {
 }
 
 Expected<MorphOptions> make_options(const std::string& method, const std::vector<std::string>& args) {
-  return make_options_with<MorphOptions>(method, args, [](MorphOptions& o) { return params(o); },
-                               [](const MorphOptions& o) { return check(o); });
+  return make_options_with<MorphOptions>(method, args, params, check);
 }
 
 std::vector<std::string> morph_gbuffer_channels(const std::string& layer) {

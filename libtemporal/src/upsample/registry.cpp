@@ -71,17 +71,10 @@ ParamList params(Options& o) {
   return list;
 }
 
-Status check(const Options& options) {
-  if (Status s = check_method_name(registry(), options.method); !s) return s;
-  Options copy = options;  // params() points at the fields it is given
-  if (Status s = check_params(params(copy)); !s) return s;
-  if (Status s = check_method_device(*find_entry(options.method), options.device); !s) return s;
-  return check_method_options(registry(), options.per_method);
-}
+Status check(const Options& options) { return check_stage_options(registry(), options, params); }
 
 Expected<Options> make_options(const std::string& method, const std::vector<std::string>& args) {
-  return make_options_with<Options>(method, args, [](Options& o) { return params(o); },
-                               [](const Options& o) { return check(o); });
+  return make_options_with<Options>(method, args, params, check);
 }
 
 std::string method_parameters(const Options& o) {
