@@ -93,10 +93,7 @@ while read -r name scene opts; do
     echo
     cat "$dir/edges.md"
     echo
-    echo '```'
-    cat "$dir/table.txt"
-    echo '```'
-    echo
+    code_block "$dir/table.txt"
   } >> "$summary"
 done <<< "$CASES"
 cat "$summary"

@@ -151,10 +151,7 @@ for scene in "${scenes[@]}"; do
       python3 "$TABLES" noise-floor "$floor_json" "$dir/metrics.json" "$REFERENCE_SPP" "$(( 4 * REFERENCE_SPP ))"
       echo
     fi
-    echo '```'
-    cat "$dir/table.txt"
-    echo '```'
-    echo
+    code_block "$dir/table.txt"
   } >> "$summary"
 done
 

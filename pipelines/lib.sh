@@ -135,6 +135,14 @@ render_or_reuse() {
   "$(tool_path render-gbuffer)" "$scene" --out "$dir" "$@"
 }
 
+# code_block FILE: FILE's text as a Markdown code block (a table compare printed), then an empty line.
+code_block() {
+  echo '```'
+  cat "$1"
+  echo '```'
+  echo
+}
+
 # The reference's noise floor (issue 24; docs/pipelines.md, "Noise floor"): a pipeline renders the first few frames
 # of its reference again at 4x the samples and compare scores the reference against that render; tables.py
 # noise-floor prints the PSNR above the pipeline's table and says when the best score comes within 10 dB of it

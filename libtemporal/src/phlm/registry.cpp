@@ -23,10 +23,7 @@ ParamList params(FilterOptions& o) {
       Param::choice("--method", "Filter method (filter-phlm --list-methods describes each)", &o.method,
                     method_names(registry())),
       Param::text("--layer", "Layer to filter: rgb (R,G,B) or a layer name (ssao, shadow, direct, ...)", &o.layer),
-      Param::choice("--device",
-                    "Where the method runs: cpu (the C++ reference) or gpu (its GLSL compute kernel through EGL; "
-                    "--list-methods says which methods have one)",
-                    &o.device, device_names()),
+      device_param(&o.device),
       Param::flag_on("--debug-layers",
                      "Add debug.* layers (phlm: feature, alpha, reset, traceP; taa: clip, noHistory, velocity; ema: "
                      "reject; fxaa: edge)",

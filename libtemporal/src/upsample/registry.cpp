@@ -35,10 +35,7 @@ ParamList params(Options& o) {
       Param::choice("--method", "Upsampling method (upsample-st --list-methods describes each)", &o.method,
                     method_names(registry())),
       Param::text("--layer", "Payload layers to upsample: rgb (bare R,G,B) or layer names, comma-separated", &o.layer),
-      Param::choice("--device",
-                    "Where the method runs: cpu (the C++ reference) or gpu (its GLSL compute kernel through EGL; "
-                    "--list-methods says which methods have one)",
-                    &o.device, device_names()),
+      device_param(&o.device),
       Param::flag_on("--debug-layers",
                      "Add debug.* layers: confidence, disocclusion, gradient, wf, historyWeight, convergence",
                      &o.debug_layers),

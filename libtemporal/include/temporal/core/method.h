@@ -43,6 +43,14 @@ inline const std::vector<std::string>& device_names() {
   static const std::vector<std::string> names = {kCpuDevice, kGpuDevice};
   return names;
 }
+// The --device parameter of every method tool, bound to `device` (check_method_device says whether the chosen
+// method has an implementation there).
+inline Param device_param(std::string* device) {
+  return Param::choice("--device",
+                       "Where the method runs: cpu (the C++ reference) or gpu (its GLSL compute kernel through EGL; "
+                       "--list-methods says which methods have one)",
+                       device, device_names());
+}
 
 // A named way to run a method: the method and the arguments that select the variant, written as on the command
 // line ("herzog-lagged" = --method herzog --lagged-wf).
