@@ -9,8 +9,9 @@ target_compile_options(temporal_warnings INTERFACE
 
 # TEMPORAL_WERROR=ON turns the project's warnings into errors (the `ci` and `dev` presets set it, so
 # `./setup.sh test`, .ci/run and a development build stop on a warning: a -Wimplicit-fallthrough that GCC reported
-# in TEMPORAL_ISA_CALL went unnoticed while warnings only scrolled by). It is part of temporal::warnings, so it reaches only the targets that link that
-# (the project's own: stages, tools, tests, benchmarks, the scene generator), never the installed package's users.
+# in TEMPORAL_ISA_CALL went unnoticed while warnings only scrolled by). It is part of temporal::warnings, so it
+# reaches only the targets that link that (the project's own: stages, tools, tests, benchmarks, the scene
+# generator), never the installed package's users.
 # Third-party headers come through -isystem or /usr/include, where GCC and clang report nothing, so a Debian
 # header cannot fail the build. Off by default: a newer compiler's new warnings should not stop a user's build.
 option(TEMPORAL_WERROR "Treat warnings in the project's own code as errors (-Werror)" OFF)
