@@ -36,7 +36,6 @@ helmet-static $shared/FlightHelmet/FlightHelmet.gltf --camera-path fixed
 ivy-orbit $shared/SponzaIvy/sponza_ivy.gltf --camera-path orbit}"
 
 require_tools render-gbuffer filter-phlm compare tests/benchmarks/phlm/phlm_edge_split
-render="$(tool_path render-gbuffer)"
 filter="$(tool_path filter-phlm)"
 compare="$(tool_path compare)"
 split="$(tool_path tests/benchmarks/phlm/phlm_edge_split)"
@@ -70,14 +69,9 @@ while read -r name scene opts; do
   fi
   dir="$OUT/$name"
   r="$dir/render"
-  if [[ "$REUSE_RENDER" == 1 && -d "$r" ]]; then
-    echo "== $name: reusing $r" >&2
-  else
-    echo "== $name: rendering $scene $opts" >&2
-    # shellcheck disable=SC2086
-    "$render" "$scene" --out "$r" --size "$SIZE" --fps "$FPS" --frames "$FRAMES" --outputs gbuffer,color,reference \
-      --jitter random --reference-spp 16 --payload direct,shadow $opts
-  fi
+  # shellcheck disable=SC2086
+  render_or_reuse "$name" "$r" "$scene $opts" "$scene" --size "$SIZE" --fps "$FPS" --frames "$FRAMES" \
+    --outputs gbuffer,color,reference --jitter random --reference-spp 16 --payload direct,shadow $opts
   tests=("$r/color.####.exr")
   names="input"
   pairs=("input=$r/color.####.exr")
@@ -99,10 +93,7 @@ while read -r name scene opts; do
     echo
     cat "$dir/edges.md"
     echo
-    echo '```'
-    cat "$dir/table.txt"
-    echo '```'
-    echo
+    code_block "$dir/table.txt"
   } >> "$summary"
 done <<< "$CASES"
 cat "$summary"

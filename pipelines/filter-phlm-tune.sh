@@ -62,7 +62,6 @@ fan-dolly fan.glb 100-131 --camera-path dolly --seed 104
 morph_test-orbit morph_test.glb 100-131 --camera-path orbit --seed 105}"
 
 require_tools render-gbuffer filter-phlm compare
-render="$(tool_path render-gbuffer)"
 filter="$(tool_path filter-phlm)"
 compare="$(tool_path compare)"
 mkdir -p "$OUT"
@@ -90,14 +89,10 @@ while read -r name scene frames opts; do
   [[ -z "$name" ]] && continue
   dir="$OUT/$name"
   mkdir -p "$dir"
-  if [[ "$REUSE_RENDER" == 1 && -d "$dir/render" ]]; then
-    echo "== $name: reusing $dir/render" >&2
-  else
-    echo "== $name: rendering $scene $opts ($SIZE, frames $frames)" >&2
-    # shellcheck disable=SC2086
-    "$render" "$ROOT/assets/scenes/$scene" --out "$dir/render" --size "$SIZE" --fps "$FPS" --frames "$frames" \
-      --outputs gbuffer,color,reference --jitter random --reference-spp 16 --payload direct,shadow,ssao $opts
-  fi
+  # shellcheck disable=SC2086
+  render_or_reuse "$name" "$dir/render" "$scene $opts ($SIZE, frames $frames)" "$ROOT/assets/scenes/$scene" \
+    --size "$SIZE" --fps "$FPS" --frames "$frames" --outputs gbuffer,color,reference --jitter random \
+    --reference-spp 16 --payload direct,shadow,ssao $opts
   tests=()
   names=""
   i=0

@@ -60,33 +60,20 @@ STATIC_FRAMES="${STATIC_FRAMES:-10}"
 PAIRS="${PAIRS:-phlm:taa,phlm:taa-0.1,phlm:input,taa:input,taa:taa-0.1,phlm:fxaa,phlm:ema,phlm:ema-tuned-static,taa-0.1:taa-2014}"
 
 require_tools render-gbuffer filter-phlm compare
-render="$(tool_path render-gbuffer)"
 filter="$(tool_path filter-phlm)"
 compare="$(tool_path compare)"
 METHODS="${METHODS:-$(methods_of filter-phlm)}"
 
-scenes=("$@")
-if [[ ${#scenes[@]} -eq 0 ]]; then
-  for s in fence tower fan walkers; do
-    [[ -f "$ROOT/assets/scenes/$s.glb" ]] && scenes+=("$ROOT/assets/scenes/$s.glb")
-  done
-fi
-if [[ ${#scenes[@]} -eq 0 ]]; then
-  die "no scenes given and none in $ROOT/assets/scenes"
-fi
+use_scenes "fence tower fan walkers" "$@"
 
 mkdir -p "$OUT"
 summary="$OUT/summary.md"
 # Every run: "NAME ARGUMENTS" (the METHODS through the registry under their own names first, then the variants).
 runs=()
-for m in $METHODS; do
-  args="$(method_args filter-phlm "$m")" || die "unknown method '$m' in METHODS"
-  runs+=("$m $args")
-done
-while read -r n m args; do [[ -n "$n" ]] && runs+=("$n --method $m $args"); done <<< "$VARIANTS"
+add_runs filter-phlm runs
 if [[ -n "${TUNED:-}" ]]; then
   [[ -f "$TUNED" ]] || die "TUNED=$TUNED: no such file (pipelines/filter-phlm-tune.sh writes OUT_DIR/tuned-variants.txt)"
-  while read -r n m args; do [[ -n "$n" ]] && runs+=("$n --method $m $args"); done < "$TUNED"
+  add_variant_runs runs < "$TUNED"
 fi
 compare_args=()
 compare_help="$("$compare" --help 2>/dev/null || true)"
@@ -118,14 +105,9 @@ for scene in "${scenes[@]}"; do
   dir="$OUT/$name"
   render_dir="$RENDERS/$name/render"
   mkdir -p "$dir"
-  if [[ "$REUSE_RENDER" == 1 && -d "$render_dir" ]]; then
-    echo "== $name: reusing $render_dir" >&2
-  else
-    echo "== $name: rendering ($SIZE, frames $FRAMES)" >&2
-    # shellcheck disable=SC2086
-    "$render" "$scene" --out "$render_dir" --size "$SIZE" --fps "$FPS" --frames "$FRAMES" \
-      --outputs gbuffer,color,reference --jitter random --reference-spp "$REFERENCE_SPP" $RENDER_ARGS
-  fi
+  # shellcheck disable=SC2086
+  render_or_reuse "$name" "$render_dir" "($SIZE, frames $FRAMES)" "$scene" --size "$SIZE" --fps "$FPS" \
+    --frames "$FRAMES" --outputs gbuffer,color,reference --jitter random --reference-spp "$REFERENCE_SPP" $RENDER_ARGS
 
   tests=("$render_dir/color.####.exr")
   last_frame="$(ls "$render_dir"/color.*.exr | tail -1)"
@@ -169,10 +151,7 @@ for scene in "${scenes[@]}"; do
       python3 "$TABLES" noise-floor "$floor_json" "$dir/metrics.json" "$REFERENCE_SPP" "$(( 4 * REFERENCE_SPP ))"
       echo
     fi
-    echo '```'
-    cat "$dir/table.txt"
-    echo '```'
-    echo
+    code_block "$dir/table.txt"
   } >> "$summary"
 done
 

@@ -83,6 +83,66 @@ method_args() {
   echo "${out#*$'\t'}"
 }
 
+# add_runs TOOL ARRAY: appends to the array named ARRAY one "NAME ARGUMENTS" per run: each name of METHODS under
+# its own name with the arguments the tool's registry gives it (method_args; exit 2 on an unknown name), then the
+# VARIANTS lines (add_variant_runs).
+add_runs() {
+  local -n runs_ref="$2"
+  local m args
+  for m in $METHODS; do
+    args="$(method_args "$1" "$m")" || die "unknown method '$m' in METHODS ($1 --list-methods lists the names)"
+    runs_ref+=("$m $args")
+  done
+  add_variant_runs "$2" <<< "${VARIANTS:-}"
+}
+
+# add_variant_runs ARRAY: appends each line "NAME METHOD OPTIONS" of stdin (a VARIANTS or TUNED line) to the array
+# named ARRAY as "NAME --method METHOD OPTIONS"; empty lines are skipped.
+add_variant_runs() {
+  local -n variants_ref="$1"
+  local n m args
+  while read -r n m args; do
+    [[ -n "$n" ]] && variants_ref+=("$n --method $m $args")
+  done
+  return 0
+}
+
+# use_scenes "NAME..." SCENE...: sets the array `scenes` to the SCENE arguments, else to the built-in scenes
+# assets/scenes/NAME.glb that exist; exits 2 when that leaves none.
+use_scenes() {
+  local defaults="$1" s
+  shift
+  scenes=("$@")
+  if [[ ${#scenes[@]} -eq 0 ]]; then
+    for s in $defaults; do
+      if [[ -f "$ROOT/assets/scenes/$s.glb" ]]; then scenes+=("$ROOT/assets/scenes/$s.glb"); fi
+    done
+  fi
+  [[ ${#scenes[@]} -gt 0 ]] || die "no scenes given and none in $ROOT/assets/scenes"
+}
+
+# render_or_reuse LABEL DIR WHAT SCENE RENDER_ARG...: `render-gbuffer SCENE --out DIR RENDER_ARG...`, announced on
+# stderr as "== LABEL: rendering WHAT"; when REUSE_RENDER=1 and DIR exists, DIR is kept instead ("== LABEL:
+# reusing DIR").
+render_or_reuse() {
+  local label="$1" dir="$2" what="$3" scene="$4"
+  shift 4
+  if [[ "${REUSE_RENDER:-0}" == 1 && -d "$dir" ]]; then
+    echo "== $label: reusing $dir" >&2
+    return 0
+  fi
+  echo "== $label: rendering $what" >&2
+  "$(tool_path render-gbuffer)" "$scene" --out "$dir" "$@"
+}
+
+# code_block FILE: FILE's text as a Markdown code block (a table compare printed), then an empty line.
+code_block() {
+  echo '```'
+  cat "$1"
+  echo '```'
+  echo
+}
+
 # The reference's noise floor (issue 24; docs/pipelines.md, "Noise floor"): a pipeline renders the first few frames
 # of its reference again at 4x the samples and compare scores the reference against that render; tables.py
 # noise-floor prints the PSNR above the pipeline's table and says when the best score comes within 10 dB of it

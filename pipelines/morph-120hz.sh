@@ -67,11 +67,7 @@ if [[ "$REGIONS" != none ]]; then region_args=(--regions "$REGIONS" --static-fra
 METHODS=${METHODS:-$(methods_of morph-120hz)}
 # Every run: "NAME ARGUMENTS" (the METHODS through the registry, then the VARIANTS lines).
 RUNS=()
-for m in $METHODS; do
-  args="$(method_args morph-120hz "$m")" || die "unknown method '$m' in METHODS"
-  RUNS+=("$m $args")
-done
-while read -r n m args; do [[ -n "$n" ]] && RUNS+=("$n --method $m $args"); done <<< "${VARIANTS:-}"
+add_runs morph-120hz RUNS
 
 if (( $# > 0 )); then SCENES=("$@"); else SCENES=("$ROOT"/assets/scenes/*.glb); fi
 if [[ ! -e "${SCENES[0]}" ]]; then

@@ -75,7 +75,6 @@ if [[ "$REFERENCE_SPP" -gt 0 && "$NOISE_AVERAGED_SPP" -gt 0 ]]; then
 fi
 
 require_tools render-gbuffer upsample-st compare
-render="$(tool_path render-gbuffer)"
 upsample="$(tool_path upsample-st)"
 compare="$(tool_path compare)"
 # Every metric also per region (static / moving / disoccluded, from the G-buffer; docs/compare.md "Regions").
@@ -87,27 +86,14 @@ fi
 
 # Every run: "NAME ARGUMENTS" (METHODS through the method table, then the VARIANTS lines as given).
 runs=()
-for m in $METHODS; do
-  args="$(method_args upsample-st "$m")" || die "unknown method '$m' in METHODS (upsample-st --list-methods lists the names)"
-  runs+=("$m $args")
-done
+add_runs upsample-st runs
 raster=0
-while read -r n m args; do
-  [[ -z "$n" ]] && continue
-  runs+=("$n --method $m $args")
-  [[ "$n" == *-raster ]] && raster=1
-done <<< "$VARIANTS"
+for run in "${runs[@]}"; do
+  if [[ "${run%% *}" == *-raster ]]; then raster=1; fi
+done
 IFS=, read -r -a pairs <<< "$PAIRS"
 
-scenes=("$@")
-if [[ ${#scenes[@]} -eq 0 ]]; then
-  for s in walkers tower fan; do
-    [[ -f "$ROOT/assets/scenes/$s.glb" ]] && scenes+=("$ROOT/assets/scenes/$s.glb")
-  done
-fi
-if [[ ${#scenes[@]} -eq 0 ]]; then
-  die "no scenes given and none in $ROOT/assets/scenes"
-fi
+use_scenes "walkers tower fan" "$@"
 
 mkdir -p "$OUT"
 summary="$OUT/summary.md"
@@ -140,19 +126,14 @@ for scene in "${scenes[@]}"; do
   dir="$OUT/$name"
   render_dir="${RENDERS:-$OUT}/$name/render"
   mkdir -p "$dir"
-  if [[ "$REUSE_RENDER" == 1 && -d "$render_dir" ]]; then
-    echo "== $name: reusing $render_dir" >&2
-  else
-    echo "== $name: rendering ($SIZE, factor $FACTOR, frames $FRAMES)" >&2
+  # shellcheck disable=SC2086
+  render_or_reuse "$name" "$render_dir" "($SIZE, factor $FACTOR, frames $FRAMES)" "$scene" --size "$SIZE" \
+    --fps "$FPS" --frames "$FRAMES" --factor "$FACTOR" --outputs "$outputs" --jitter none "${reference_args[@]}" \
+    $RENDER_ARGS
+  if [[ "$raster" == 1 ]]; then
     # shellcheck disable=SC2086
-    "$render" "$scene" --out "$render_dir" --size "$SIZE" --fps "$FPS" --frames "$FRAMES" --factor "$FACTOR" \
-      --outputs "$outputs" --jitter none "${reference_args[@]}" $RENDER_ARGS
-  fi
-  if [[ "$raster" == 1 && ! ( "$REUSE_RENDER" == 1 && -d "$render_dir-raster" ) ]]; then
-    echo "== $name: rendering the payload in the raster pattern order" >&2
-    # shellcheck disable=SC2086
-    "$render" "$scene" --out "$render_dir-raster" --size "$SIZE" --fps "$FPS" --frames "$FRAMES" --factor "$FACTOR" \
-      --outputs shade --shade-jitter regular-raster $RENDER_ARGS
+    render_or_reuse "$name" "$render_dir-raster" "the payload in the raster pattern order" "$scene" --size "$SIZE" \
+      --fps "$FPS" --frames "$FRAMES" --factor "$FACTOR" --outputs shade --shade-jitter regular-raster $RENDER_ARGS
   fi
 
   tests=()

@@ -28,6 +28,19 @@ std::vector<float> key_times(int n, float duration) {
   return t;
 }
 
+// One CUBICSPLINE key of a translation (glTF Appendix C): in-tangent, value, out-tangent, for a point p moving at v.
+void push_hermite_key(std::vector<float>& values, const glm::vec3& p, const glm::vec3& v) {
+  values.insert(values.end(), {v.x, v.y, v.z, p.x, p.y, p.z, v.x, v.y, v.z});
+}
+
+// The rotation keys of a flying camera at `times`: looking from position(t) at target(t).
+template <typename Position, typename Target>
+void animate_look_at(GltfBuilder& b, int cam, const std::vector<float>& times, Position&& position, Target&& target) {
+  std::vector<float> values;
+  for (float t : times) push_quat(values, look_rotation(target(t) - position(t)));
+  b.animate(cam, "rotation", times, values);
+}
+
 void scale_uv(MeshData& m, float su, float sv) {
   for (auto& uv : m.texcoords) uv *= glm::vec2(su, sv);
 }
@@ -294,16 +307,11 @@ void build_tower(GltfBuilder& b) {
   auto target = [&](float t) { return glm::vec3(0.0f, 3.5f + 1.5f * std::sin(kTwoPi * t / clip), 0.0f); };
   const int cam = b.add_node("flyaround_camera", -1, position(0.0f), look_rotation(target(0.0f) - position(0.0f)));
   b.set_camera(cam, "flyaround", 0.9f, 0.3f, 120.0f);
-  std::vector<float> times = key_times(12, clip), values;
-  for (float t : times) {
-    const glm::vec3 p = position(t), v = velocity(t);
-    values.insert(values.end(), {v.x, v.y, v.z, p.x, p.y, p.z, v.x, v.y, v.z});  // in-tangent, value, out-tangent
-  }
+  const std::vector<float> times = key_times(12, clip);
+  std::vector<float> values;
+  for (float t : times) push_hermite_key(values, position(t), velocity(t));
   b.animate(cam, "translation", times, values, "CUBICSPLINE");
-  times = key_times(120, clip);
-  values.clear();
-  for (float t : times) push_quat(values, look_rotation(target(t) - position(t)));
-  b.animate(cam, "rotation", times, values);
+  animate_look_at(b, cam, key_times(120, clip), position, target);
 
   add_sun(b, {0.45f, -0.8f, -0.4f}, 3.0f, {1.0f, 0.95f, 0.85f});
   add_point(b, "lantern", {0.0f, 4.2f, 3.6f}, 6.0f, {1.0f, 0.7f, 0.4f}, 20.0f);
@@ -458,16 +466,10 @@ void build_fence(GltfBuilder& b) {
   auto target = [&](float t) { return glm::vec3(3.0f * std::sin(kTwoPi * t / clip), 0.7f, -3.0f); };
   const int cam = b.add_node("drift_camera", -1, position(0.0f), look_rotation(target(0.0f) - position(0.0f)));
   b.set_camera(cam, "drift", 0.8f, 0.1f, 80.0f);
-  std::vector<float> times = key_times(n, clip), values;
-  for (int k = 0; k <= n; ++k) {
-    const glm::vec3 p = point(k), v = tangent(k);
-    values.insert(values.end(), {v.x, v.y, v.z, p.x, p.y, p.z, v.x, v.y, v.z});
-  }
-  b.animate(cam, "translation", times, values, "CUBICSPLINE");
-  times = key_times(160, clip);
-  values.clear();
-  for (float t : times) push_quat(values, look_rotation(target(t) - position(t)));
-  b.animate(cam, "rotation", times, values);
+  std::vector<float> values;
+  for (int k = 0; k <= n; ++k) push_hermite_key(values, point(k), tangent(k));
+  b.animate(cam, "translation", key_times(n, clip), values, "CUBICSPLINE");
+  animate_look_at(b, cam, key_times(160, clip), position, target);
 
   add_sun(b, {0.7f, -0.45f, -0.55f}, 3.0f, {1.0f, 0.92f, 0.8f});
   add_point(b, "sky_fill", {0.0f, 6.0f, 8.0f}, 50.0f, {0.6f, 0.7f, 1.0f});

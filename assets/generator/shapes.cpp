@@ -22,6 +22,25 @@ void push_quad(MeshData& m, glm::vec3 p0, glm::vec3 p1, glm::vec3 p2, glm::vec3 
 
 std::uint8_t to8(float v) { return static_cast<std::uint8_t>(std::clamp(v, 0.0f, 1.0f) * 255.0f + 0.5f); }
 
+// Texel (x, y) of t, opaque, colour c.
+void set_texel(TextureDesc& t, int x, int y, glm::vec3 c) {
+  std::uint8_t* p = &t.rgba[static_cast<std::size_t>((y * t.width + x) * 4)];
+  p[0] = to8(c.r);
+  p[1] = to8(c.g);
+  p[2] = to8(c.b);
+  p[3] = 255;
+}
+
+// A size x size texture, every texel opaque with colour(x, y).
+template <typename Colour>
+TextureDesc painted(const std::string& name, int size, Colour&& colour) {
+  TextureDesc t{name, size, size, {}, true, false};
+  t.rgba.resize(static_cast<std::size_t>(size * size * 4));
+  for (int y = 0; y < size; ++y)
+    for (int x = 0; x < size; ++x) set_texel(t, x, y, colour(x, y));
+  return t;
+}
+
 }  // namespace
 
 MeshData box(const glm::vec3& size, int segments_y) {
@@ -139,42 +158,22 @@ float hash01(std::uint32_t a, std::uint32_t b) {
 }
 
 TextureDesc checker(const std::string& name, int size, int squares, glm::vec3 a, glm::vec3 b) {
-  TextureDesc t{name, size, size, {}, true, false};
-  t.rgba.resize(static_cast<std::size_t>(size * size * 4));
-  for (int y = 0; y < size; ++y) {
-    for (int x = 0; x < size; ++x) {
-      const bool odd = ((x * squares / size) + (y * squares / size)) % 2 != 0;
-      const glm::vec3 c = odd ? a : b;
-      std::uint8_t* p = &t.rgba[static_cast<std::size_t>((y * size + x) * 4)];
-      p[0] = to8(c.r);
-      p[1] = to8(c.g);
-      p[2] = to8(c.b);
-      p[3] = 255;
-    }
-  }
-  return t;
+  return painted(name, size, [&](int x, int y) {
+    const bool odd = ((x * squares / size) + (y * squares / size)) % 2 != 0;
+    return odd ? a : b;
+  });
 }
 
 TextureDesc bricks(const std::string& name, int size, int rows, glm::vec3 brick, glm::vec3 mortar) {
-  TextureDesc t{name, size, size, {}, true, false};
-  t.rgba.resize(static_cast<std::size_t>(size * size * 4));
   const int bh = size / rows, bw = 2 * bh;
-  for (int y = 0; y < size; ++y) {
+  return painted(name, size, [&](int x, int y) {
     const int row = y / bh;
-    for (int x = 0; x < size; ++x) {
-      const int xs = x + (row % 2) * (bw / 2);
-      const int col = (xs / bw) % (size / bw);
-      const bool line = (y % bh) < 2 || (xs % bw) < 2;
-      const float tint = 0.8f + 0.35f * hash01(static_cast<std::uint32_t>(row), static_cast<std::uint32_t>(col));
-      const glm::vec3 c = line ? mortar : brick * tint;
-      std::uint8_t* p = &t.rgba[static_cast<std::size_t>((y * size + x) * 4)];
-      p[0] = to8(c.r);
-      p[1] = to8(c.g);
-      p[2] = to8(c.b);
-      p[3] = 255;
-    }
-  }
-  return t;
+    const int xs = x + (row % 2) * (bw / 2);
+    const int col = (xs / bw) % (size / bw);
+    const bool line = (y % bh) < 2 || (xs % bw) < 2;
+    const float tint = 0.8f + 0.35f * hash01(static_cast<std::uint32_t>(row), static_cast<std::uint32_t>(col));
+    return line ? mortar : brick * tint;
+  });
 }
 
 TextureDesc leaves(const std::string& name, int size, int count) {
@@ -201,11 +200,7 @@ TextureDesc leaves(const std::string& name, int size, int count) {
         const float u = (ca * dx + sa * dy) / len, v = (-sa * dx + ca * dy) / wid;
         if (u * u + v * v > 1.0f) continue;
         const float vein = std::fabs(v) < 0.08f ? 0.75f : 1.0f;
-        std::uint8_t* p = &t.rgba[static_cast<std::size_t>((y * size + x) * 4)];
-        p[0] = to8(0.18f * shade * vein);
-        p[1] = to8(0.45f * shade * vein);
-        p[2] = to8(0.12f * shade * vein);
-        p[3] = 255;
+        set_texel(t, x, y, glm::vec3(0.18f * shade * vein, 0.45f * shade * vein, 0.12f * shade * vein));
       }
     }
   }

@@ -27,6 +27,7 @@
 #include <cstring>
 #include <fstream>
 #include <random>
+#include <type_traits>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -41,6 +42,14 @@ std::vector<Level> levels_here() {
   for (Level l : {Level::V2, Level::V3, Level::V4})
     if (isa::supported(l)) out.push_back(l);
   return out;
+}
+
+// run(level) at each of `levels` in order (levels_here(): v2 first), one result per kernel copy.
+template <typename Run>
+auto run_at(const std::vector<Level>& levels, Run&& run) {
+  std::vector<std::decay_t<decltype(run(levels.front()))>> runs;
+  for (Level l : levels) runs.push_back(run(l));
+  return runs;
 }
 
 // The CPU flags the kernel reports in /proc/cpuinfo, or empty where there is none.
@@ -191,8 +200,7 @@ float max_difference(const std::vector<float>& a, const std::vector<float>& b) {
 TEST(Isa, FlipAgreesAtEveryLevel) {
   const std::vector<Level> here = levels_here();
   if (here.size() < 2) GTEST_SKIP() << "one kernel copy runs on this machine: nothing to compare";
-  std::vector<FlipRun> runs;
-  for (Level l : here) runs.push_back(run_flip(l));
+  const std::vector<FlipRun> runs = run_at(here, run_flip);
   const FlipRun& v2 = runs[0];
   float mean = 0.0f;
   for (float v : v2.ldr) mean += v;
@@ -237,8 +245,7 @@ SsimRun run_ssim(Level level) {
 TEST(Isa, SsimAgreesAtEveryLevel) {
   const std::vector<Level> here = levels_here();
   if (here.size() < 2) GTEST_SKIP() << "one kernel copy runs on this machine: nothing to compare";
-  std::vector<SsimRun> runs;
-  for (Level l : here) runs.push_back(run_ssim(l));
+  const std::vector<SsimRun> runs = run_at(here, run_ssim);
   EXPECT_LT(runs[0].plain.mean, 0.99) << "the pair must differ for the comparison to mean anything";
   for (std::size_t k = 1; k < runs.size(); ++k) {
     // Double-precision window sums: FMA contraction moves them by about 1e-16 relative; SSIM's E[x^2] - E[x]^2
@@ -285,8 +292,7 @@ TEST(Isa, UpsamplingAgreesAtEveryLevel) {
   const std::vector<Level> here = levels_here();
   if (here.size() < 2) GTEST_SKIP() << "one kernel copy runs on this machine: nothing to compare";
   for (const upsample::MethodVariant& v : upsample::method_variants()) {
-    std::vector<std::vector<float>> runs;
-    for (Level l : here) runs.push_back(run_upsample(l, v));
+    const auto runs = run_at(here, [&](Level l) { return run_upsample(l, v); });
     ASSERT_FALSE(runs[0].empty()) << v.name;
     for (std::size_t k = 1; k < runs.size(); ++k) {
       ASSERT_EQ(runs[0].size(), runs[k].size());
@@ -388,8 +394,7 @@ Difference compare_runs(const std::vector<float>& a, const std::vector<float>& b
 template <typename Filter, typename Params>
 void expect_filter_agrees(const std::string& name, const Params& params, float tolerance, bool v3_is_v4 = true) {
   const std::vector<Level> here = levels_here();
-  std::vector<std::vector<float>> runs;
-  for (Level l : here) runs.push_back(run_filter<Filter>(l, params));
+  const auto runs = run_at(here, [&](Level l) { return run_filter<Filter>(l, params); });
   ASSERT_FALSE(runs[0].empty()) << name;
   for (std::size_t k = 1; k < runs.size(); ++k) {
     ASSERT_EQ(runs[0].size(), runs[k].size()) << name;
@@ -437,8 +442,7 @@ TEST(Isa, FiltersAgreeAtEveryLevel) {
 TEST(Isa, FxaaAgreesAtEveryLevel) {
   const std::vector<Level> here = levels_here();
   if (here.size() < 2) GTEST_SKIP() << "one kernel copy runs on this machine: nothing to compare";
-  std::vector<std::vector<float>> runs;
-  for (Level l : here) runs.push_back(run_filter<phlm::FxaaFilter>(l, phlm::FxaaParams{}));
+  const auto runs = run_at(here, [](Level l) { return run_filter<phlm::FxaaFilter>(l, phlm::FxaaParams{}); });
   for (std::size_t k = 1; k < runs.size(); ++k) {
     ASSERT_EQ(runs[0].size(), runs[k].size());
     double squared = 0.0;
@@ -514,8 +518,7 @@ TEST(Isa, MorphAgreesAtEveryLevel) {
   const std::vector<Level> here = levels_here();
   if (here.size() < 2) GTEST_SKIP() << "one kernel copy runs on this machine: nothing to compare";
   for (const std::string method : {"didyk", "warp"}) {
-    std::vector<std::vector<float>> runs;
-    for (Level l : here) runs.push_back(run_morph(l, method));
+    const auto runs = run_at(here, [&](Level l) { return run_morph(l, method); });
     ASSERT_FALSE(runs[0].empty()) << method;
     for (std::size_t k = 1; k < runs.size(); ++k) {
       ASSERT_EQ(runs[0].size(), runs[k].size()) << method;

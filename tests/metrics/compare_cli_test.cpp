@@ -39,17 +39,10 @@ Image noisy(int w, int h, unsigned seed, float amount, const Image* base) {
   return img;
 }
 
-std::string read_text(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
 // True for a PNG file with a valid signature and an IHDR of the expected size.
 ::testing::AssertionResult is_png(const fs::path& path, int width, int height) {
   if (!fs::exists(path)) return ::testing::AssertionFailure() << path << " does not exist";
-  const auto bytes = read_text(path);
+  const auto bytes = test::read_file(path);
   static const std::string sig("\x89PNG\r\n\x1a\n", 8);
   if (bytes.size() < 33 || bytes.compare(0, 8, sig) != 0 || bytes.compare(12, 4, "IHDR") != 0)
     return ::testing::AssertionFailure() << path << " is not a PNG (" << bytes.size() << " bytes)";
@@ -110,7 +103,7 @@ TEST_F(CompareCli, WritesCsvJsonAndPngWithoutDisplay) {
     EXPECT_NE(out.find("Xvfb"), std::string::npos) << out;
   }
   // CSV: header + 3 frames x 2 sequences.
-  const auto csv = read_text(dir_ / "m.csv");
+  const auto csv = test::read_file(dir_ / "m.csv");
   std::istringstream lines(csv);
   std::string line;
   std::vector<std::string> rows;
@@ -120,7 +113,7 @@ TEST_F(CompareCli, WritesCsvJsonAndPngWithoutDisplay) {
   EXPECT_EQ(rows[1].rfind("1,good,", 0), 0u);
   EXPECT_EQ(rows[6].rfind("3,noisy,", 0), 0u);
   // JSON summary.
-  const auto j = nlohmann::json::parse(read_text(dir_ / "m.json"));
+  const auto j = nlohmann::json::parse(test::read_file(dir_ / "m.json"));
   for (const char* key : {"tool", "reference", "frames", "peak", "thresholds", "passed", "sequences"})
     EXPECT_TRUE(j.contains(key)) << key;
   ASSERT_EQ(j["sequences"].size(), 2u);
@@ -155,7 +148,7 @@ TEST_F(CompareCli, ThresholdsGiveExitThree) {
   EXPECT_EQ(run("--reference ref.####.exr a.####.exr --fail-psnr 30", &out), 0) << out;
   EXPECT_EQ(run("--reference ref.####.exr a.####.exr b.####.exr --fail-psnr 30 --json t.json", &out), 3) << out;
   EXPECT_NE(out.find("b: psnr_rgb"), std::string::npos) << out;
-  const auto j = nlohmann::json::parse(read_text(dir_ / "t.json"));
+  const auto j = nlohmann::json::parse(test::read_file(dir_ / "t.json"));
   EXPECT_EQ(j["passed"], false);
   EXPECT_EQ(j["failures"][0]["sequence"], "b");
   EXPECT_EQ(run("--reference ref.####.exr a.####.exr --fail-ssim 0.9999", &out), 3) << out;
@@ -228,7 +221,7 @@ TEST_F(CompareCli, HelpListsEveryOptionAndEachIsAccepted) {
   EXPECT_EQ(run(args + " a.####.exr", &out), 0) << args << "\n" << out;
   EXPECT_TRUE(fs::exists(dir_ / "maps" / "one.0002.exr"));
   EXPECT_FALSE(fs::exists(dir_ / "maps" / "one.0003.exr"));  // --frames 1-2
-  const auto csv = read_text(dir_ / "all.csv");
+  const auto csv = test::read_file(dir_ / "all.csv");
   EXPECT_NE(csv.find("psnr_rgb_in_db"), std::string::npos);  // --mask columns
   EXPECT_NE(csv.find("flip_in"), std::string::npos);         // FLIP's, with --flip and --mask
   auto maps = read_exr((dir_ / "maps" / "one.0002.exr").string());
@@ -241,7 +234,8 @@ TEST_F(CompareCli, HelpListsEveryOptionAndEachIsAccepted) {
 TEST_F(CompareCli, BadRunsLoseNothingAndOverflowIsReported) {
   auto checksum = [&] {
     std::string all;
-    for (const char* f : {"ref.0001.exr", "a.0001.exr", "a.0002.exr", "b.0003.exr", "g.0001.exr"}) all += read_text(dir_ / f);
+    for (const char* f : {"ref.0001.exr", "a.0001.exr", "a.0002.exr", "b.0003.exr", "g.0001.exr"})
+      all += test::read_file(dir_ / f);
     return std::hash<std::string>{}(all);
   };
   const auto before = checksum();
@@ -269,7 +263,7 @@ TEST_F(CompareCli, BadRunsLoseNothingAndOverflowIsReported) {
   EXPECT_NE(out.find("3 frames"), std::string::npos) << out;
   // Intervals and paired differences in the JSON.
   ASSERT_EQ(run("--reference ref.####.exr a.####.exr b.####.exr --warmup 1 --json s.json", &out), 0) << out;
-  const auto j = nlohmann::json::parse(read_text(dir_ / "s.json"));
+  const auto j = nlohmann::json::parse(test::read_file(dir_ / "s.json"));
   const auto& psnr = j["sequences"][0]["psnr_rgb"];
   ASSERT_TRUE(psnr["ci95"].is_array());
   EXPECT_LE(psnr["ci95"][0].get<double>(), psnr["mean"].get<double>());
@@ -293,10 +287,10 @@ TEST_F(CompareCli, ShardsMergeIntoTheSingleRunExactly) {
   ASSERT_EQ(run(common + " --json whole.json --csv whole.csv", &out), 0) << out;
   ASSERT_EQ(run(common + " --frames 1-1 --csv s1.csv", &out), 0) << out;
   ASSERT_EQ(run(common + " --frames 2-3 --csv s2.csv", &out), 0) << out;
-  const auto s2 = read_text(dir_ / "s2.csv");  // shown when a mean differs
+  const auto s2 = test::read_file(dir_ / "s2.csv");  // shown when a mean differs
   ASSERT_EQ(run("--merge s2.csv s1.csv --warmup 1 --json merged.json --csv merged.csv", &out), 0) << out;
-  const auto whole = nlohmann::json::parse(read_text(dir_ / "whole.json"));
-  const auto merged = nlohmann::json::parse(read_text(dir_ / "merged.json"));
+  const auto whole = nlohmann::json::parse(test::read_file(dir_ / "whole.json"));
+  const auto merged = nlohmann::json::parse(test::read_file(dir_ / "merged.json"));
   ASSERT_EQ(whole["sequences"].size(), merged["sequences"].size());
   for (std::size_t s = 0; s < whole["sequences"].size(); ++s)
     for (const char* m : {"psnr_rgb", "psnr_y", "ssim", "flicker"}) {
@@ -359,7 +353,7 @@ TEST_F(CompareCli, RegionsFromTheGbuffer) {
   ASSERT_EQ(run(common + " --csv r.csv --json r.json", &out), 0) << out;
   EXPECT_NE(out.find("psnr_rgb_pooled"), std::string::npos) << out;
   EXPECT_NE(out.find("static"), std::string::npos) << out;
-  const auto csv = read_text(dir_ / "r.csv");
+  const auto csv = test::read_file(dir_ / "r.csv");
   std::istringstream lines(csv);
   std::string line;
   std::vector<std::string> rows;
@@ -372,7 +366,7 @@ TEST_F(CompareCli, RegionsFromTheGbuffer) {
   // Frame 3: still for 2 frames on the left (40 of 64 columns) -> static; the right moves.
   EXPECT_EQ(rows[18].rfind("3,a,static,0.625,", 0), 0u) << rows[18];
   EXPECT_EQ(rows[19].rfind("3,a,moving,0.375,", 0), 0u) << rows[19];
-  const auto j = nlohmann::json::parse(read_text(dir_ / "r.json"));
+  const auto j = nlohmann::json::parse(test::read_file(dir_ / "r.json"));
   EXPECT_EQ(j["regions"]["kind"], "motion");
   EXPECT_EQ(j["regions"]["static_frames"], 2);
   const auto& regions = j["sequences"][0]["regions"];
@@ -390,7 +384,7 @@ TEST_F(CompareCli, RegionsFromTheGbuffer) {
   ASSERT_EQ(run(common + " --frames 1-2 --csv s1.csv", &out), 0) << out;
   ASSERT_EQ(run(common + " --frames 3-3 --csv s2.csv", &out), 0) << out;
   ASSERT_EQ(run("--merge s1.csv s2.csv --json merged.json", &out), 0) << out;
-  const auto merged = nlohmann::json::parse(read_text(dir_ / "merged.json"));
+  const auto merged = nlohmann::json::parse(test::read_file(dir_ / "merged.json"));
   for (std::size_t s = 0; s < 2; ++s) {
     EXPECT_EQ(j["sequences"][s]["regions"], merged["sequences"][s]["regions"]) << s;
     EXPECT_EQ(j["sequences"][s]["psnr_rgb_pooled"], merged["sequences"][s]["psnr_rgb_pooled"]) << s;
@@ -432,7 +426,7 @@ TEST_F(CompareCli, ListsMetricsAndFlagsTheParetoFront) {
   const std::string tests = "--reference ref.####.exr a.####.exr b.####.exr c.####.exr --gbuffer g.####.exr";
   for (const std::string metric : {"psnr_rgb", "ssim", "flicker"}) {
     ASSERT_EQ(run(tests + " --json p.json --speed-metric " + metric, &out), 0) << out;
-    const auto j = nlohmann::json::parse(read_text(dir_ / "p.json"));
+    const auto j = nlohmann::json::parse(test::read_file(dir_ / "p.json"));
     EXPECT_EQ(j["speed_metric"], metric);
     EXPECT_EQ(j["sequences"][0]["pareto"], true) << metric;   // a: the best
     EXPECT_EQ(j["sequences"][1]["pareto"], true) << metric;   // b: the fastest
@@ -471,7 +465,7 @@ TEST_F(CompareCli, OverflowingCropsAndPixelsPerDegreeAreUsageErrors) {
                     &out),
                 0)
           << mode << " " << ppd << out;
-      const auto j = nlohmann::json::parse(read_text(dir_ / "f.json"));
+      const auto j = nlohmann::json::parse(test::read_file(dir_ / "f.json"));
       const auto& flip = j["sequences"][0]["flip"];
       ASSERT_TRUE(flip.is_object()) << j.dump().substr(0, 600);
       ASSERT_TRUE(flip["mean"].is_number()) << "a NaN FLIP is written as null: " << flip.dump();

@@ -12,6 +12,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <initializer_list>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -46,11 +47,13 @@ std::string write_frame(const fs::path& dir, const std::string& name, int frame,
 
 std::string pattern(const fs::path& dir, const std::string& name) { return (dir / (name + ".####.exr")).string(); }
 
-std::string read_text(const std::string& path) {
-  std::ifstream in(path);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
+// The comparison of the sequences `tests` ("t" -> dir/t.####.exr) against dir/ref.####.exr, every other setting
+// at its default.
+ComparisonSetup setup_for(const fs::path& dir, std::initializer_list<const char*> tests) {
+  ComparisonSetup setup;
+  setup.reference = pattern(dir, "ref");
+  for (const char* t : tests) setup.tests.push_back(pattern(dir, t));
+  return setup;
 }
 
 // "Peak SNR = 24.7712" from idiff's output; NaN when absent.
@@ -77,9 +80,7 @@ TEST(Comparison, PsnrMatchesIdiffWithinUnitRange) {
   }
   const auto rp = write_frame(dir, "ref", 0, ref);
   const auto tp = write_frame(dir, "test", 0, test);
-  ComparisonSetup setup;
-  setup.reference = pattern(dir, "ref");
-  setup.tests = {pattern(dir, "test")};
+  ComparisonSetup setup = setup_for(dir, {"test"});
   auto report = compare_sequences(setup);
   ASSERT_TRUE(report) << report.error().message;
   const double ours = report->sequences[0].frames[0].value("psnr_rgb");
@@ -96,9 +97,7 @@ TEST(Comparison, PeakMaxMatchesIdiffOnHdrData) {
   const Image test = noise_image(32, 32, 4, 0.0f, 4.0f);
   const auto rp = write_frame(dir, "ref", 0, ref);
   const auto tp = write_frame(dir, "test", 0, test);
-  ComparisonSetup setup;
-  setup.reference = pattern(dir, "ref");
-  setup.tests = {pattern(dir, "test")};
+  ComparisonSetup setup = setup_for(dir, {"test"});
   setup.peak_from_data = true;
   auto report = compare_sequences(setup);
   ASSERT_TRUE(report);
@@ -124,9 +123,7 @@ TEST(Comparison, HandComputedPsnrAndFlicker) {
     write_frame(dir, "ref", f, ref);
     write_frame(dir, "t", f, t);
   }
-  ComparisonSetup setup;
-  setup.reference = pattern(dir, "ref");
-  setup.tests = {pattern(dir, "t")};
+  ComparisonSetup setup = setup_for(dir, {"t"});
   auto report = compare_sequences(setup);
   ASSERT_TRUE(report) << report.error().message;
   const auto& frames = report->sequences[0].frames;
@@ -148,9 +145,7 @@ TEST(Comparison, IdenticalSequencesGiveInfinitePsnrZeroFlickerAndNoNan) {
     write_frame(dir, "ref", f, img);
     write_frame(dir, "same", f, img);
   }
-  ComparisonSetup setup;
-  setup.reference = pattern(dir, "ref");
-  setup.tests = {pattern(dir, "same")};
+  ComparisonSetup setup = setup_for(dir, {"same"});
   auto report = compare_sequences(setup);
   ASSERT_TRUE(report);
   for (const auto& f : report->sequences[0].frames) {
@@ -164,15 +159,15 @@ TEST(Comparison, IdenticalSequencesGiveInfinitePsnrZeroFlickerAndNoNan) {
   const auto csv = (dir / "m.csv").string(), json = (dir / "m.json").string();
   ASSERT_TRUE(write_comparison_csv(*report, csv));
   ASSERT_TRUE(write_comparison_json(*report, {}, {}, "compare test", "", json));
-  const auto csv_text = read_text(csv);
+  const auto csv_text = test::read_file(csv);
   EXPECT_EQ(csv_text.find("nan"), std::string::npos);
   EXPECT_NE(csv_text.find("1,same,inf,inf,1,0,"), std::string::npos) << csv_text;
-  const auto j = nlohmann::json::parse(read_text(json));  // throws (fails the test) if invalid
+  const auto j = nlohmann::json::parse(test::read_file(json));  // throws (fails the test) if invalid
   const auto& s = j["sequences"][0];
   EXPECT_EQ(s["psnr_rgb"]["mean"], "inf");
   EXPECT_EQ(s["flicker"]["mean"], 0.0);
   EXPECT_EQ(s["flicker"]["frames"], 2);
-  EXPECT_EQ(read_text(json).find("NaN"), std::string::npos);
+  EXPECT_EQ(test::read_file(json).find("NaN"), std::string::npos);
 }
 
 TEST(Comparison, MaskSplitsInsideAndOutside) {
@@ -190,9 +185,7 @@ TEST(Comparison, MaskSplitsInsideAndOutside) {
     write_frame(dir, "ref", f, ref);
     write_frame(dir, "t", f, t);
   }
-  ComparisonSetup setup;
-  setup.reference = pattern(dir, "ref");
-  setup.tests = {pattern(dir, "t")};
+  ComparisonSetup setup = setup_for(dir, {"t"});
   setup.mask = "debug.disocclusion";
   auto report = compare_sequences(setup);
   ASSERT_TRUE(report) << report.error().message;
@@ -242,9 +235,7 @@ TEST(Comparison, MotionCompensatedFlickerWithGbuffer) {
     write_frame(dir, "t", f, t);
     write_frame(dir, "g", f, g);
   }
-  ComparisonSetup setup;
-  setup.reference = pattern(dir, "ref");
-  setup.tests = {pattern(dir, "t")};
+  ComparisonSetup setup = setup_for(dir, {"t"});
   setup.gbuffer = pattern(dir, "g");
   auto comp = compare_sequences(setup);
   ASSERT_TRUE(comp) << comp.error().message;
@@ -269,10 +260,8 @@ TEST(Comparison, ReferenceLayerAndCameraCut) {
     write_frame(dir, "ref", f, ref);
     write_frame(dir, "t", f, t);
   }
-  ComparisonSetup setup;
-  setup.reference = pattern(dir, "ref");
+  ComparisonSetup setup = setup_for(dir, {"t"});
   setup.reference_layer = "reference";
-  setup.tests = {pattern(dir, "t")};
   auto report = compare_sequences(setup);
   ASSERT_TRUE(report) << report.error().message;
   EXPECT_EQ(report->reference_channels, (std::vector<std::string>{"reference.R", "reference.G", "reference.B"}));
@@ -307,9 +296,7 @@ TEST(Comparison, NonFinitePixelsAreCountedAndExcluded) {
     write_frame(dir, "ref", f, ref);
     write_frame(dir, "t", f, t);
   }
-  ComparisonSetup setup;
-  setup.reference = pattern(dir, "ref");
-  setup.tests = {pattern(dir, "t")};
+  ComparisonSetup setup = setup_for(dir, {"t"});
   setup.error_maps = (dir / "maps").string();
   int warnings = 0;
   ComparisonHooks hooks;
@@ -423,10 +410,7 @@ ComparisonSetup flip_sequences(const fs::path& dir) {
     write_frame(dir, "ref", f, ref);
     write_frame(dir, "t", f, t);
   }
-  ComparisonSetup setup;
-  setup.reference = pattern(dir, "ref");
-  setup.tests = {pattern(dir, "t")};
-  return setup;
+  return setup_for(dir, {"t"});
 }
 
 TEST(Comparison, FlipIsTheLibraryFlipOfTheClampedFrames) {
@@ -473,13 +457,13 @@ TEST(Comparison, FlipIsTheLibraryFlipOfTheClampedFrames) {
   const auto csv = (dir / "m.csv").string(), json = (dir / "m.json").string();
   ASSERT_TRUE(write_comparison_csv(*report, csv));
   ASSERT_TRUE(write_comparison_json(*report, {}, {}, "compare test", "", json));
-  const auto header = read_text(csv).substr(0, read_text(csv).find('\n'));
+  const auto header = test::read_file(csv).substr(0, test::read_file(csv).find('\n'));
   EXPECT_EQ(header,
             "frame,sequence,psnr_rgb_db,psnr_y_db,ssim,flicker,mse_rgb,peak,valid_pixels,nonfinite_test,"
             "nonfinite_reference,compute_ms,metrics_ms,mask_fraction,psnr_rgb_in_db,psnr_rgb_out_db,psnr_y_in_db,"
             "psnr_y_out_db,ssim_in,ssim_out,flicker_in,flicker_out,flip,flip_weighted_median,flip_weighted_q1,"
             "flip_weighted_q3,flip_in,flip_out");
-  const auto j = nlohmann::json::parse(read_text(json));
+  const auto j = nlohmann::json::parse(test::read_file(json));
   EXPECT_EQ(j["flip"]["mode"], "ldr");
   EXPECT_EQ(j["flip"]["pixels_per_degree"], 40.0);
   const auto& js = j["sequences"][0]["flip"];
@@ -499,10 +483,10 @@ TEST(Comparison, FlipOffLeavesTheOutputsAsTheyWere) {
   const auto csv = (dir / "m.csv").string(), json = (dir / "m.json").string();
   ASSERT_TRUE(write_comparison_csv(*report, csv));
   ASSERT_TRUE(write_comparison_json(*report, {}, {}, "compare test", "", json));
-  EXPECT_EQ(read_text(csv).substr(0, read_text(csv).find('\n')),
+  EXPECT_EQ(test::read_file(csv).substr(0, test::read_file(csv).find('\n')),
             "frame,sequence,psnr_rgb_db,psnr_y_db,ssim,flicker,mse_rgb,peak,valid_pixels,nonfinite_test,"
             "nonfinite_reference,compute_ms,metrics_ms");
-  const auto j = nlohmann::json::parse(read_text(json));
+  const auto j = nlohmann::json::parse(test::read_file(json));
   EXPECT_FALSE(j.contains("flip"));
   EXPECT_FALSE(j["sequences"][0].contains("flip"));
   EXPECT_EQ(j["thresholds"].size(), 4u);  // psnr_rgb, ssim, flicker, judged_on
@@ -803,9 +787,7 @@ TEST(Regions, PerRegionAndPooledValuesOnAHandMadeSequence) {
     for (const char* c : {"R", "G", "B"}) u.add_channel(c, 0.55f);
     write_frame(dir, "u", f, u);
   }
-  ComparisonSetup setup;
-  setup.reference = pattern(dir, "ref");
-  setup.tests = {pattern(dir, "t"), pattern(dir, "u")};
+  ComparisonSetup setup = setup_for(dir, {"t", "u"});
   setup.gbuffer = pattern(dir, "g");
   setup.regions = true;
   setup.region_options.static_frames = 1;
@@ -856,7 +838,7 @@ TEST(Regions, PerRegionAndPooledValuesOnAHandMadeSequence) {
   // CSV: a region column, one row per region, region rows read back into the same values (merge).
   const auto csv_path = (dir / "r.csv").string();
   ASSERT_TRUE(write_comparison_csv(*rep, csv_path));
-  const auto csv = read_text(csv_path);
+  const auto csv = test::read_file(csv_path);
   EXPECT_EQ(csv.rfind("frame,sequence,region,region_share,psnr_rgb_db,", 0), 0u) << csv;
   EXPECT_NE(csv.find("\n1,t,static,0.3333333333333333,"), std::string::npos) << csv;
   EXPECT_NE(csv.find("\n1,t,all,1,"), std::string::npos) << csv;
@@ -874,7 +856,7 @@ TEST(Regions, PerRegionAndPooledValuesOnAHandMadeSequence) {
   // JSON: pooled beside the mean, regions with shares, per-region paired differences.
   const auto json_path = (dir / "r.json").string();
   ASSERT_TRUE(write_comparison_json(*rep, {}, {}, "test", "", json_path));
-  const auto j = nlohmann::json::parse(read_text(json_path));
+  const auto j = nlohmann::json::parse(test::read_file(json_path));
   EXPECT_EQ(j["regions"]["static_frames"], 1);
   const auto& js = j["sequences"][0];
   EXPECT_NEAR(js["psnr_rgb_pooled"]["value"].get<double>(), -10.0 * std::log10(0.04), 1e-5);
@@ -911,7 +893,7 @@ TEST(Regions, PerRegionAndPooledValuesOnAHandMadeSequence) {
   EXPECT_NEAR(m1.mask_fraction, 0.5, 1e-12);
   EXPECT_NEAR(m1.sample("psnr_rgb")->inside, -10.0 * std::log10((0.01 + 0.04 / 2.0) / 1.5), 1e-5);  // columns 0-5
   ASSERT_TRUE(write_comparison_csv(*masked, csv_path));
-  std::istringstream masked_csv(read_text(csv_path));
+  std::istringstream masked_csv(test::read_file(csv_path));
   std::string header, all_row, static_row;
   std::getline(masked_csv, header);
   std::getline(masked_csv, all_row);     // frame 0, t, all
@@ -945,9 +927,7 @@ TEST(Regions, NeedTheGbufferWithDepthAndIds) {
     g.add_channel("motion.Y", 0.0f);
     write_frame(dir, "g", f, g);
   }
-  ComparisonSetup setup;
-  setup.reference = pattern(dir, "ref");
-  setup.tests = {pattern(dir, "t")};
+  ComparisonSetup setup = setup_for(dir, {"t"});
   setup.regions = true;
   auto none = compare_sequences(setup);
   ASSERT_FALSE(none);

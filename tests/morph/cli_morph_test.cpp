@@ -18,17 +18,6 @@
 namespace temporal::morph {
 namespace {
 
-// The devices of an entry as --list-methods prints them ("cpu,gpu") and as the JSON lists them.
-template <typename Entry>
-std::pair<std::string, std::string> device_lists(const Entry& e) {
-  std::string text, json;
-  for (const auto& d : temporal::implementation_devices(e)) {
-    text += (text.empty() ? "" : ",") + d;
-    json += (json.empty() ? "" : ", ") + ("\"" + d + "\"");
-  }
-  return {text, "\"implementations\": [" + json + "]"};
-}
-
 class MorphCli : public ::testing::Test {
  protected:
   void SetUp() override {
@@ -129,8 +118,7 @@ TEST_F(MorphCli, ListMethodsPrintsTheRegistry) {
   std::string out;
   ASSERT_EQ(test::run_command(tool() + " --list-methods 2>/dev/null", &out), 0) << out;
   std::string expected;
-  for (const MethodEntry* e : registry())
-    expected += e->info.name + "\t--method " + e->info.name + "\t" + e->info.summary + "\t" + device_lists(*e).first + "\n";
+  for (const MethodEntry* e : registry()) expected += test::list_methods_line(*e);
   EXPECT_EQ(out, expected);
   EXPECT_NE(out.find("\tcpu,gpu\n"), std::string::npos) << "blend and warp have GPU kernels: " << out;
   ASSERT_EQ(test::run_command(tool() + " --list-methods-json 2>/dev/null", &out), 0) << out;
@@ -140,7 +128,8 @@ TEST_F(MorphCli, ListMethodsPrintsTheRegistry) {
             std::string::npos)
       << out;
   for (const MethodEntry* e : registry())
-    EXPECT_NE(out.find(device_lists(*e).second + ", \"latency_frames\": " + std::to_string(*e->info.latency_frames) + "}"),
+    EXPECT_NE(out.find(test::device_lists(*e).second + ", \"latency_frames\": " +
+                       std::to_string(*e->info.latency_frames) + "}"),
               std::string::npos)
         << e->info.name << ": " << out;
 }

@@ -5,13 +5,8 @@
 # paired-difference table, the noise floor, the region table and its paired differences) and the ablation's paired
 # table; issue 24: the list of the runs' arguments and the ablation's phlm-phi-linear row.
 # Usage: check_filter_phlm_pipeline.sh BUILD_DIR OUT_DIR
-set -euo pipefail
-here="$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)"
-build="$1"
-out="$2"
-rm -rf "$out"
-mkdir -p "$out"
-fail() { [[ -f "${2:-}" ]] && cat "$2" >&2; echo "check_filter_phlm_pipeline.sh: $1" >&2; exit 1; }
+# shellcheck source=tests/pipelines/check_lib.sh
+source "$(dirname "${BASH_SOURCE[0]}")/../pipelines/check_lib.sh"
 SIZE=64x48 FRAMES=0-5 WARMUP=2 REFERENCE_SPP=2 RENDER_ARGS="--payload direct,shadow" \
   bash "$here/pipelines/filter-phlm.sh" "$build" "$out/table2" "$here/assets/scenes/fence.glb" > "$out/table2.log" 2>&1 ||
   fail "filter-phlm.sh failed" "$out/table2.log"

@@ -6,13 +6,8 @@
 # the optimum per region, and tuned-variants.txt (the static and moving optimum as filter-phlm.sh VARIANTS lines,
 # consistent with the CSV's highest mean), and that APPEND=1 keeps the optimum over every run so far.
 # Usage: check_filter_phlm_tune.sh BUILD_DIR OUT_DIR
-set -euo pipefail
-here="$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)"
-build="$1"
-out="$2"
-rm -rf "$out"
-mkdir -p "$out"
-fail() { [[ -f "${2:-}" ]] && cat "$2" >&2; echo "check_filter_phlm_tune.sh: $1" >&2; exit 1; }
+# shellcheck source=tests/pipelines/check_lib.sh
+source "$(dirname "${BASH_SOURCE[0]}")/../pipelines/check_lib.sh"
 SIZE=64x48 TUNE_SET="walkers-tiny walkers.glb 0-5 --seed 7" TAA_ALPHAS="0.2 1" TAA_CLIPS=variance EMA_ALPHAS="0.5 0.9" \
   FXAA_SUBPIX="" PHLM_LAMBDAS="" STATIC_FRAMES=2 \
   bash "$here/pipelines/filter-phlm-tune.sh" "$build" "$out/tune" > "$out/tune.log" 2>&1 ||

@@ -17,17 +17,6 @@
 
 namespace {
 
-// The devices of an entry as --list-methods prints them ("cpu,gpu") and as the JSON lists them.
-template <typename Entry>
-std::pair<std::string, std::string> device_lists(const Entry& e) {
-  std::string text, json;
-  for (const auto& d : temporal::implementation_devices(e)) {
-    text += (text.empty() ? "" : ",") + d;
-    json += (json.empty() ? "" : ", ") + ("\"" + d + "\"");
-  }
-  return {text, "\"implementations\": [" + json + "]"};
-}
-
 using namespace temporal;
 using namespace temporal::phlm;
 namespace fs = std::filesystem;
@@ -220,8 +209,7 @@ TEST(FilterPhlmCli, ListMethodsPrintsTheRegistry) {
   std::string out;
   ASSERT_EQ(test::run_command(tool() + " --list-methods 2>/dev/null", &out), 0) << out;
   std::string expected;
-  for (const MethodEntry* e : registry())
-    expected += e->info.name + "\t--method " + e->info.name + "\t" + e->info.summary + "\t" + device_lists(*e).first + "\n";
+  for (const MethodEntry* e : registry()) expected += test::list_methods_line(*e);
   EXPECT_EQ(out, expected);
   EXPECT_NE(out.find("\tcpu,gpu\n"), std::string::npos) << "every filter has a GPU kernel: " << out;
   ASSERT_EQ(test::run_command(tool() + " --list-methods-json 2>/dev/null", &out), 0) << out;
@@ -229,7 +217,7 @@ TEST(FilterPhlmCli, ListMethodsPrintsTheRegistry) {
       << out;
   EXPECT_NE(out.find("\"stateful\": true, \"implementations\": [\"cpu\", \"gpu\"]}"), std::string::npos) << out;
   EXPECT_NE(out.find("{\"name\": \"fxaa\""), std::string::npos) << out;
-  EXPECT_NE(out.find("\"stateful\": false, " + device_lists(*find_entry("fxaa")).second + "}"), std::string::npos)
+  EXPECT_NE(out.find("\"stateful\": false, " + test::device_lists(*find_entry("fxaa")).second + "}"), std::string::npos)
       << "fxaa is spatial: " << out;
 }
 

@@ -2,6 +2,7 @@
 #include "temporal/io/exr.h"
 #include "temporal/phlm/phlm.h"
 
+#include "filter_frames.h"
 #include "test_support.h"
 
 #include <gtest/gtest.h>
@@ -16,26 +17,7 @@ namespace {
 
 using namespace temporal;
 using namespace temporal::phlm;
-
-const std::vector<std::string> kRgb = {"R", "G", "B"};
-
-Image make_frame(int w, int h, const std::function<float(int, int, int)>& f) {
-  Image img(w, h);
-  for (int c = 0; c < 3; ++c) {
-    float* p = img.add_channel(kRgb[std::size_t(c)]);
-    for (int y = 0; y < h; ++y)
-      for (int x = 0; x < w; ++x) p[std::size_t(y * w + x)] = f(x, y, c);
-  }
-  return img;
-}
-
-FilterInput input_for(const Image& img, bool reset = false) {
-  FilterInput in;
-  in.color = &img;
-  in.channels = kRgb;
-  in.reset = reset;
-  return in;
-}
+using namespace temporal::phlm::test_frames;
 
 bool all_finite(const Image& img) {
   for (const auto& n : img.channel_names())

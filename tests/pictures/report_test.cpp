@@ -31,13 +31,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-std::string read_text(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
 std::string frame_name(const std::string& stem, int f) {
   char digits[16];
   std::snprintf(digits, sizeof digits, "%04d", f);
@@ -256,7 +249,7 @@ TEST_F(Report, ChartsHaveTitlesNamesRangesAndOnlyMethodTimes) {
   // The JSON says what each compute time is.
   const auto json_path = test::scratch_dir("report-json") / "m.json";
   ASSERT_TRUE(write_comparison_json(*r, {}, {}, "compare", "", json_path.string()));
-  const auto j = nlohmann::json::parse(read_text(json_path));
+  const auto j = nlohmann::json::parse(test::read_file(json_path));
   EXPECT_EQ(j["sequences"][1]["compute_kind"], "method");
   EXPECT_EQ(j["sequences"][0]["compute_kind"], "render");
   EXPECT_EQ(j["sequences"][3]["compute_kind"], "simulation");
@@ -323,17 +316,17 @@ TEST_F(Report, PlotWritesPngSvgOrPdfByExtensionAndRefusesOthers) {
   ASSERT_EQ(run(base + "--plot charts/fig.png", &out), 0) << out;
   const fs::path d = dir / "charts";
   for (const char* stem : {"fig", "fig-psnr-y", "fig-ssim", "fig-flicker", "fig-speed"}) {
-    const std::string pdf = read_text(d / (std::string(stem) + ".pdf"));
+    const std::string pdf = test::read_file(d / (std::string(stem) + ".pdf"));
     EXPECT_EQ(pdf.rfind("%PDF-", 0), 0u) << stem << ".pdf is not a PDF";
-    const std::string svg = read_text(d / (std::string(stem) + ".svg"));
+    const std::string svg = test::read_file(d / (std::string(stem) + ".svg"));
     EXPECT_NE(svg.find("<svg"), std::string::npos) << stem << ".svg is not an SVG";
     EXPECT_NE(svg.find(">walkers: "), std::string::npos) << stem << ".svg has no title text";
     EXPECT_NE(svg.find(">phlm"), std::string::npos) << stem << ".svg has no legend text";
-    const std::string png = read_text(d / (std::string(stem) + ".png"));
+    const std::string png = test::read_file(d / (std::string(stem) + ".png"));
     EXPECT_EQ(png.compare(0, 8, std::string("\x89PNG\r\n\x1a\n", 8)), 0) << stem << ".png is not a PNG";
   }
   // The SSIM chart's tick labels stop at 1 (the old chart ran to 1.15).
-  const std::string ssim = read_text(d / "fig-ssim.svg");
+  const std::string ssim = test::read_file(d / "fig-ssim.svg");
   for (const char* tick : {">1.05<", ">1.1<", ">1.15<"}) EXPECT_EQ(ssim.find(tick), std::string::npos) << tick;
   for (const std::string bad : {"--plot fig.jpg", "--plot fig", "--plot fig.eps"}) {
     EXPECT_EQ(run(base + bad + " --csv never.csv", &out), 1) << bad << "\n" << out;
@@ -432,7 +425,7 @@ TEST_F(Report, ReportReplacesAnEarlierReportAndRefusesForeignFiles) {
   EXPECT_TRUE(fs::exists(dir / "rep/pictures/phlm-error.png")) << out;
   EXPECT_TRUE(fs::exists(dir / "rep/notes.txt")) << "a file the report does not own was removed";
   EXPECT_NE(out.find("removed the earlier report in rep"), std::string::npos) << out;
-  EXPECT_EQ(read_text(dir / "rep/index.html").find(">taa<"), std::string::npos) << "the new page shows taa";
+  EXPECT_EQ(test::read_file(dir / "rep/index.html").find(">taa<"), std::string::npos) << "the new page shows taa";
   // Report folders without a report of compare: refused before anything is measured or removed.
   fs::create_directories(dir / "other/pictures");
   std::ofstream(dir / "other/pictures/keep.png") << "someone's";
@@ -508,11 +501,11 @@ TEST_F(Report, ReportRefusesToReplaceAnInput) {
   fs::create_directories(dir / "clash" / "maps");
   for (int f = 0; f < 6; ++f) fs::copy_file(dir / frame_name("good", f), dir / "clash" / "maps" / frame_name("phlm", f),
                                             fs::copy_options::overwrite_existing);
-  const std::string before = read_text(dir / "clash" / "maps" / "phlm.0005.exr");
+  const std::string before = test::read_file(dir / "clash" / "maps" / "phlm.0005.exr");
   std::string out;
   EXPECT_EQ(run("--reference ref.####.exr clash/maps/phlm.####.exr --names phlm --report clash", &out), 1) << out;
   EXPECT_NE(out.find("one of this run's inputs"), std::string::npos) << out;
-  EXPECT_EQ(read_text(dir / "clash" / "maps" / "phlm.0005.exr"), before);
+  EXPECT_EQ(test::read_file(dir / "clash" / "maps" / "phlm.0005.exr"), before);
 }
 
 // Every file the page names exists; links point to EXRs; nothing comes from a network; the tables hold the JSON's
@@ -525,7 +518,7 @@ TEST_F(Report, ReportPageIsCompleteAndOffline) {
             0)
       << out;
   const fs::path d = dir / "rep";
-  const std::string html = read_text(d / "index.html");
+  const std::string html = test::read_file(d / "index.html");
   ASSERT_FALSE(html.empty());
   EXPECT_EQ(html.find("http://"), std::string::npos);
   EXPECT_EQ(html.find("https://"), std::string::npos);
@@ -557,7 +550,7 @@ TEST_F(Report, ReportPageIsCompleteAndOffline) {
     EXPECT_TRUE(mapped || linked) << tag;
   }
   // The table's intervals are the JSON's ci95 (same bootstrap), formatted to four significant digits.
-  const auto j = nlohmann::json::parse(read_text(d / "metrics.json"));
+  const auto j = nlohmann::json::parse(test::read_file(d / "metrics.json"));
   for (const auto& s : j["sequences"]) {
     const auto& ci = s["ssim"]["ci95"];
     const std::string cell = "[" + format_number(ci[0].get<double>(), 4) + ", " + format_number(ci[1].get<double>(), 4) + "]";
@@ -593,7 +586,7 @@ TEST_F(Report, RegionsSectionWithShareBarsAndTable) {
                 &out),
             0)
       << out;
-  const std::string html = read_text(dir / "rep" / "index.html");
+  const std::string html = test::read_file(dir / "rep" / "index.html");
   for (const char* part : {"<h2 id=\"regions\">Regions</h2>", "<table class=\"regions\">", "<div class=\"share\">",
                            "<span class=\"static\"", "<span class=\"moving\"", "<span class=\"disoccluded\"",
                            "<th class=\"name\">region</th>", "psnr_rgb_pooled"})
@@ -602,7 +595,7 @@ TEST_F(Report, RegionsSectionWithShareBarsAndTable) {
   for (auto at = html.find("<div class=\"share\">"); at != std::string::npos; at = html.find("<div class=\"share\">", at + 1))
     ++bars;
   EXPECT_EQ(bars, 2u);
-  const auto j = nlohmann::json::parse(read_text(dir / "rep" / "metrics.json"));
+  const auto j = nlohmann::json::parse(test::read_file(dir / "rep" / "metrics.json"));
   for (const auto& s : j["sequences"]) {
     const auto& ci = s["regions"]["disoccluded"]["psnr_rgb"]["ci95"];
     const std::string cell = "[" + format_number(ci[0].get<double>(), 4) + ", " + format_number(ci[1].get<double>(), 4) + "]";

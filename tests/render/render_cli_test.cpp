@@ -17,20 +17,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-std::string base64(const std::vector<unsigned char>& data) {
-  static const char* t = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-  std::string out;
-  for (std::size_t i = 0; i < data.size(); i += 3) {
-    unsigned v = unsigned(data[i]) << 16;
-    if (i + 1 < data.size()) v |= unsigned(data[i + 1]) << 8;
-    if (i + 2 < data.size()) v |= data[i + 2];
-    out += t[(v >> 18) & 63];
-    out += t[(v >> 12) & 63];
-    out += i + 1 < data.size() ? t[(v >> 6) & 63] : '=';
-    out += i + 2 < data.size() ? t[v & 63] : '=';
-  }
-  return out;
-}
+using test::base64;
 
 // A small valid glTF: a ground quad and a tilted quad above it, animated by a translation (LINEAR).
 // No camera and no light: the scene module adds an automatic camera and key light.

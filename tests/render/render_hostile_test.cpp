@@ -24,25 +24,8 @@ namespace fs = std::filesystem;
 
 std::string tool() { return test::tool_path("render-gbuffer").string(); }
 
-std::string read_file(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  return std::string(std::istreambuf_iterator<char>(in), {});
-}
-
-std::string base64(const std::vector<unsigned char>& data) {
-  static const char* t = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-  std::string out;
-  for (std::size_t i = 0; i < data.size(); i += 3) {
-    unsigned v = unsigned(data[i]) << 16;
-    if (i + 1 < data.size()) v |= unsigned(data[i + 1]) << 8;
-    if (i + 2 < data.size()) v |= data[i + 2];
-    out += t[(v >> 18) & 63];
-    out += t[(v >> 12) & 63];
-    out += i + 1 < data.size() ? t[(v >> 6) & 63] : '=';
-    out += i + 2 < data.size() ? t[v & 63] : '=';
-  }
-  return out;
-}
+using test::read_file;
+using test::base64;
 
 std::vector<unsigned char> bytes_of(const std::vector<float>& f) {
   const auto* p = reinterpret_cast<const unsigned char*>(f.data());

@@ -36,6 +36,16 @@ RenderOptions small_options(int w = 96, int h = 72) {
   return o;
 }
 
+// Frame 0 of `state` (no previous frame) from a new renderer for `geometry`: the set-up of the one-frame payload
+// tests. The renderer's error or the frame's.
+Expected<RenderedFrame> render_still(const RenderOptions& o, const SceneGeometry& geometry, const FrameState& state) {
+  auto r = Renderer::create(o, geometry);
+  if (!r) return r.error();
+  FrameInput in;
+  in.current = &state;
+  return r->render(in);
+}
+
 Image render_gbuffer(Renderer& r, const SyntheticScene& scene, int frame, double fps) {
   const FrameState cur = scene.evaluate(frame / fps);
   const FrameState prev = scene.evaluate((frame - 1) / fps);
@@ -464,12 +474,7 @@ TEST(RenderPayload, DirectLightOnAPlaneMatchesTheFormula) {
   RenderOptions o = small_options(64, 64);
   o.outputs = RenderOutputs{true, false, true, false};
   o.reference_spp = 1;
-  auto r = Renderer::create(o, scene.geometry());
-  ASSERT_TRUE(r) << r.error().message;
-  const FrameState s = scene.state();
-  FrameInput in;
-  in.current = &s;
-  auto out = r->render(in);
+  auto out = render_still(o, scene.geometry(), scene.state());
   ASSERT_TRUE(out) << out.error().message;
   const Image& ref = *out->reference;
   const Image& gb = *out->gbuffer;
@@ -532,12 +537,7 @@ TEST(RenderPayload, WallAddsIndirectLightAndOcclusionNearIt) {
   o.outputs = RenderOutputs{false, false, true, false};
   o.reference_spp = 1;
   o.payload.vpl_count = 500;
-  auto r = Renderer::create(o, scene.geometry());
-  ASSERT_TRUE(r) << r.error().message;
-  const FrameState s = scene.state();
-  FrameInput in;
-  in.current = &s;
-  auto out = r->render(in);
+  auto out = render_still(o, scene.geometry(), scene.state());
   ASSERT_TRUE(out) << out.error().message;
   const Image& ref = *out->reference;
   // The wall at x = 1 is seen edge-on; floor pixels just left of it (x slightly < 1) get bounce light
@@ -558,12 +558,7 @@ TEST(RenderPayload, ShadowUnderTheBox) {
   o.outputs = RenderOutputs{true, false, true, false};
   o.reference_spp = 1;
   o.payload.shadow_map_size = 1024;
-  auto r = Renderer::create(o, scene.geometry());
-  ASSERT_TRUE(r) << r.error().message;
-  const FrameState s = scene.evaluate(0.0);
-  FrameInput in;
-  in.current = &s;
-  auto out = r->render(in);
+  auto out = render_still(o, scene.geometry(), scene.evaluate(0.0));
   ASSERT_TRUE(out) << out.error().message;
   // Fully shadowed and fully lit ground pixels both exist; shadow stays in [0, 1].
   const auto* id = out->gbuffer->uint_plane("id");

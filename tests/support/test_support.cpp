@@ -9,6 +9,7 @@
 #include <array>
 #include <cmath>
 #include <cstdio>
+#include <fstream>
 #include <sstream>
 
 namespace temporal::test {
@@ -76,6 +77,28 @@ Image make_image(int width, int height, const std::vector<std::string>& channels
   return ::testing::AssertionFailure() << label << ": max |difference| " << worst << " > " << max_abs_error
                                        << " at (" << worst_x << "," << worst_y << ") channel " << worst_channel
                                        << "; difference image: " << path.string();
+}
+
+std::string read_file(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+std::string base64(const std::vector<unsigned char>& data) {
+  static const char* t = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+  std::string out;
+  for (std::size_t i = 0; i < data.size(); i += 3) {
+    unsigned v = unsigned(data[i]) << 16;
+    if (i + 1 < data.size()) v |= unsigned(data[i + 1]) << 8;
+    if (i + 2 < data.size()) v |= data[i + 2];
+    out += t[(v >> 18) & 63];
+    out += t[(v >> 12) & 63];
+    out += i + 1 < data.size() ? t[(v >> 6) & 63] : '=';
+    out += i + 2 < data.size() ? t[v & 63] : '=';
+  }
+  return out;
 }
 
 int run_command(const std::string& command, std::string* output) {

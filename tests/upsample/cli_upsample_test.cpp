@@ -192,13 +192,8 @@ TEST(UpsampleCli, ListMethods) {
     EXPECT_NE(output.find(v.name + "\t--method " + v.method), std::string::npos) << output;
   EXPECT_NE(output.find("herzog-lagged\t--method herzog --lagged-wf\t"), std::string::npos) << output;
   EXPECT_NE(output.find("*-demod\t--demodulate\t"), std::string::npos) << output;
-  for (const temporal::upsample::MethodEntry* e : temporal::upsample::registry()) {
-    std::string devices;
-    for (const auto& d : temporal::implementation_devices(*e)) devices += (devices.empty() ? "" : ",") + d;
-    EXPECT_NE(output.find(e->info.name + "\t--method " + e->info.name + "\t" + e->info.summary + "\t" + devices + "\n"),
-              std::string::npos)
-        << e->info.name << ": " << output;
-  }
+  for (const temporal::upsample::MethodEntry* e : temporal::upsample::registry())
+    EXPECT_NE(output.find(temporal::test::list_methods_line(*e)), std::string::npos) << e->info.name << ": " << output;
   // The machine-readable form (temporal/core/method.h, apps/common/method_list.h): one object per method and
   // variant with its statefulness and implementations, then the name suffixes.
   ASSERT_EQ(temporal::test::run_command(tool() + " --list-methods-json", &output), 0) << output;

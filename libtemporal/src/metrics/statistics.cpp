@@ -29,6 +29,27 @@ double percentile(const std::vector<double>& sorted, double p) {
   return sorted[i] + f * (sorted[i + 1] - sorted[i]);
 }
 
+// The resampling both bootstraps share: o.resamples resamples of n frames, each ceil(n / L) circular blocks of L
+// consecutive frame indices at uniformly drawn starts, truncated to n (L = o.block, else round(n^(1/3)), at least 1).
+// For every resample, take(t, i) receives its t-th index i (t = 0 .. n-1) and done() ends it; the same seed draws
+// the same blocks for both bootstraps.
+template <typename Take, typename Done>
+void resample_blocks(std::size_t n, const BootstrapOptions& o, Take&& take, Done&& done) {
+  const std::size_t block =
+      o.block > 0 ? std::size_t(o.block) : std::max<std::size_t>(1, std::size_t(std::lround(std::cbrt(double(n)))));
+  const std::size_t blocks = (n + block - 1) / block;
+  std::mt19937_64 rng(o.seed);
+  std::uniform_int_distribution<std::size_t> start(0, n - 1);
+  for (int r = 0; r < std::max(1, o.resamples); ++r) {
+    std::size_t taken = 0;
+    for (std::size_t b = 0; b < blocks; ++b) {
+      const std::size_t s = start(rng);
+      for (std::size_t k = 0; k < block && taken < n; ++k, ++taken) take(taken, (s + k) % n);
+    }
+    done();
+  }
+}
+
 MeanInterval block_bootstrap(const std::vector<double>& v, const BootstrapOptions& o) {
   MeanInterval r;
   r.count = v.size();
@@ -40,22 +61,13 @@ MeanInterval block_bootstrap(const std::vector<double>& v, const BootstrapOption
   }
   r.mean = mean_of(v);
   const std::size_t n = v.size();
-  const std::size_t block =
-      o.block > 0 ? std::size_t(o.block) : std::max<std::size_t>(1, std::size_t(std::lround(std::cbrt(double(n)))));
-  const std::size_t blocks = (n + block - 1) / block;
-  std::mt19937_64 rng(o.seed);
-  std::uniform_int_distribution<std::size_t> start(0, n - 1);
-  std::vector<double> means(std::size_t(std::max(1, o.resamples)));
-  for (auto& m : means) {
-    // ceil(n / L) circular blocks, truncated to n values.
-    double sum = 0.0;
-    std::size_t taken = 0;
-    for (std::size_t b = 0; b < blocks; ++b) {
-      const std::size_t s = start(rng);
-      for (std::size_t k = 0; k < block && taken < n; ++k, ++taken) sum += v[(s + k) % n];
-    }
-    m = sum / double(n);
-  }
+  std::vector<double> means;
+  means.reserve(std::size_t(std::max(1, o.resamples)));
+  double sum = 0.0;
+  resample_blocks(n, o, [&](std::size_t, std::size_t i) { sum += v[i]; }, [&] {
+    means.push_back(sum / double(n));
+    sum = 0.0;
+  });
   std::sort(means.begin(), means.end());
   const double tail = (1.0 - o.level) / 2.0;
   r.ci = {percentile(means, tail), percentile(means, 1.0 - tail)};
@@ -76,20 +88,9 @@ MeanInterval block_bootstrap_statistic(std::size_t n, const BootstrapOptions& o,
   std::vector<std::size_t> idx(n);
   for (std::size_t i = 0; i < n; ++i) idx[i] = i;
   r.mean = stat(idx);
-  const std::size_t block =
-      o.block > 0 ? std::size_t(o.block) : std::max<std::size_t>(1, std::size_t(std::lround(std::cbrt(double(n)))));
-  const std::size_t blocks = (n + block - 1) / block;
-  std::mt19937_64 rng(o.seed);
-  std::uniform_int_distribution<std::size_t> start(0, n - 1);
-  std::vector<double> values(std::size_t(std::max(1, o.resamples)));
-  for (auto& v : values) {
-    std::size_t taken = 0;
-    for (std::size_t b = 0; b < blocks; ++b) {
-      const std::size_t s = start(rng);
-      for (std::size_t k = 0; k < block && taken < n; ++k, ++taken) idx[taken] = (s + k) % n;
-    }
-    v = stat(idx);
-  }
+  std::vector<double> values;
+  values.reserve(std::size_t(std::max(1, o.resamples)));
+  resample_blocks(n, o, [&](std::size_t t, std::size_t i) { idx[t] = i; }, [&] { values.push_back(stat(idx)); });
   std::sort(values.begin(), values.end());
   const double tail = (1.0 - o.level) / 2.0;
   r.ci = {percentile(values, tail), percentile(values, 1.0 - tail)};

@@ -20,10 +20,7 @@ ParamList params(MorphOptions& o) {
   ParamList list = {
       Param::choice("--method", "Method (the registry's: morph-120hz --list-methods)", &o.method,
                     method_names(registry())),
-      Param::choice("--device",
-                    "Where the method runs: cpu (the C++ reference) or gpu (its GLSL compute kernel through EGL; "
-                    "--list-methods says which methods have one)",
-                    &o.device, device_names()),
+      device_param(&o.device),
       Param::integer("--factor", "Output frames per input frame (40 Hz -> 120 Hz: 3)", &o.factor, 2, 32),
       Param::real("--gamma", "Display gamma g of the compensation H' (displayed light = value^g)", &o.gamma, 0.1, 10),
       Param::flag_on("--debug-layers", "Add debug.grid, debug.distortion, debug.blur, debug.H, debug.Hprime (didyk)",
@@ -34,8 +31,7 @@ ParamList params(MorphOptions& o) {
 }
 
 Expected<MorphOptions> make_options(const std::string& method, const std::vector<std::string>& args) {
-  return make_options_with<MorphOptions>(method, args, [](MorphOptions& o) { return params(o); },
-                               [](const MorphOptions& o) { return check(o); });
+  return make_options_with<MorphOptions>(method, args, params, check);
 }
 
 std::vector<std::string> morph_gbuffer_channels(const std::string& layer) {

@@ -23,10 +23,7 @@ ParamList params(FilterOptions& o) {
       Param::choice("--method", "Filter method (filter-phlm --list-methods describes each)", &o.method,
                     method_names(registry())),
       Param::text("--layer", "Layer to filter: rgb (R,G,B) or a layer name (ssao, shadow, direct, ...)", &o.layer),
-      Param::choice("--device",
-                    "Where the method runs: cpu (the C++ reference) or gpu (its GLSL compute kernel through EGL; "
-                    "--list-methods says which methods have one)",
-                    &o.device, device_names()),
+      device_param(&o.device),
       Param::flag_on("--debug-layers",
                      "Add debug.* layers (phlm: feature, alpha, reset, traceP; taa: clip, noHistory, velocity; ema: "
                      "reject; fxaa: edge)",
@@ -36,17 +33,10 @@ ParamList params(FilterOptions& o) {
   return list;
 }
 
-Status check(const FilterOptions& options) {
-  if (Status s = check_method_name(registry(), options.method); !s) return s;
-  FilterOptions copy = options;  // params() points at the fields it is given
-  if (Status s = check_params(params(copy)); !s) return s;
-  if (Status s = check_method_device(*find_entry(options.method), options.device); !s) return s;
-  return check_method_options(registry(), options.per_method);
-}
+Status check(const FilterOptions& options) { return check_stage_options(registry(), options, params); }
 
 Expected<FilterOptions> make_options(const std::string& method, const std::vector<std::string>& args) {
-  return make_options_with<FilterOptions>(method, args, [](FilterOptions& o) { return params(o); },
-                               [](const FilterOptions& o) { return check(o); });
+  return make_options_with<FilterOptions>(method, args, params, check);
 }
 
 Expected<std::unique_ptr<FrameFilter>> make_filter(const FilterOptions& options,

@@ -148,4 +148,21 @@ Expected<std::unique_ptr<Layer>> read_usda(const std::string& path);
 // "/a/b" + "c" -> "/a/b/c"; relative targets ("c", "../c", ".prop") against a prim path.
 std::string absolute_path(std::string_view prim_path, std::string_view target);
 
+// The node at the absolute prim path `path` ("/World/Mesh") below `root` (the pseudo-root "/"), one path element at
+// a time through Node::child(name); nullptr for a relative path or a missing prim. Node is a layer's PrimSpec
+// (Layer::prim_at) or the composed stage's Prim (Stage::prim_at).
+template <typename Node>
+const Node* descend_path(const Node* root, std::string_view path) {
+  if (path.empty() || path[0] != '/') return nullptr;
+  const Node* p = root;
+  std::size_t i = 1;
+  while (p && i < path.size()) {
+    std::size_t j = path.find('/', i);
+    if (j == std::string_view::npos) j = path.size();
+    p = p->child(path.substr(i, j - i));
+    i = j + 1;
+  }
+  return p;
+}
+
 }  // namespace temporal::usd

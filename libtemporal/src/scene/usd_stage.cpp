@@ -133,18 +133,7 @@ bool Prim::has_api(std::string_view schema) const {
   return false;
 }
 
-const Prim* Stage::prim_at(std::string_view path) const {
-  if (path.empty() || path[0] != '/') return nullptr;
-  const Prim* p = &root_;
-  std::size_t i = 1;
-  while (p && i < path.size()) {
-    std::size_t j = path.find('/', i);
-    if (j == std::string_view::npos) j = path.size();
-    p = p->child(path.substr(i, j - i));
-    i = j + 1;
-  }
-  return p;
-}
+const Prim* Stage::prim_at(std::string_view path) const { return descend_path(&root_, path); }
 
 double Stage::start_time_code() const { return root_layer_->number("startTimeCode", 0.0); }
 double Stage::end_time_code() const { return root_layer_->number("endTimeCode", start_time_code()); }

@@ -72,18 +72,7 @@ std::string Layer::token(std::string_view key, const std::string& fallback) cons
   return fallback;
 }
 
-const PrimSpec* Layer::prim_at(std::string_view path) const {
-  if (path.empty() || path[0] != '/') return nullptr;
-  const PrimSpec* p = &root;
-  std::size_t i = 1;
-  while (p && i < path.size()) {
-    std::size_t j = path.find('/', i);
-    if (j == std::string_view::npos) j = path.size();
-    p = p->child(path.substr(i, j - i));
-    i = j + 1;
-  }
-  return p;
-}
+const PrimSpec* Layer::prim_at(std::string_view path) const { return descend_path(&root, path); }
 
 std::string absolute_path(std::string_view prim_path, std::string_view target) {
   if (!target.empty() && target[0] == '/') return std::string(target);
@@ -732,9 +721,8 @@ class Parser {
     if (Status s = expect('(', "to open a layer offset"); !s) return s;
     while (!accept(')')) {
       if (accept(';')) continue;
-      auto key = identifier("'offset' or 'scale'");
+      auto key = metadata_key("'offset' or 'scale'");
       if (!key) return key.error();
-      if (Status s = expect('=', "after '" + *key + "'"); !s) return s;
       if (*key == "offset" || *key == "scale") {
         auto v = number();
         if (!v) return v.error();
@@ -770,18 +758,34 @@ class Parser {
     return {};
   }
 
+  // In a metadata block `( ... )`: skips one ';' separator or one doc string (read and dropped). True when it
+  // skipped one (the caller goes on to the next entry), false at an entry; the string's error when it is bad.
+  Expected<bool> skip_separator_or_doc() {
+    ws();
+    if (accept(';')) return true;
+    if (cur() == '"' || cur() == '\'') {
+      auto doc = string_literal();
+      if (!doc) return doc.error();
+      return true;
+    }
+    return false;
+  }
+
+  // `key =` of a metadata entry: the key (`what` names it in the error when there is none).
+  Expected<std::string> metadata_key(const std::string& what) {
+    auto key = identifier(what);
+    if (!key) return key.error();
+    if (Status s = expect('=', "after '" + *key + "'"); !s) return s.error();
+    return key;
+  }
+
   Status layer_metadata(Layer& layer) {
     while (!accept(')')) {
-      ws();
-      if (accept(';')) continue;
-      if (cur() == '"' || cur() == '\'') {
-        auto doc = string_literal();
-        if (!doc) return doc.error();
-        continue;
-      }
-      auto key = identifier("a layer metadata key");
+      auto skipped = skip_separator_or_doc();
+      if (!skipped) return skipped.error();
+      if (*skipped) continue;
+      auto key = metadata_key("a layer metadata key");
       if (!key) return key.error();
-      if (Status s = expect('=', "after '" + *key + "'"); !s) return s;
       if (*key == "subLayers") {
         if (Status s = sublayers(layer); !s) return s;
         continue;
@@ -979,17 +983,12 @@ class Parser {
 
   Status prim_metadata(PrimSpec& prim) {
     while (!accept(')')) {
-      ws();
-      if (accept(';')) continue;
-      if (cur() == '"' || cur() == '\'') {
-        auto doc = string_literal();
-        if (!doc) return doc.error();
-        continue;
-      }
+      auto skipped = skip_separator_or_doc();
+      if (!skipped) return skipped.error();
+      if (*skipped) continue;
       const ListOpKind op = list_op_prefix();
-      auto key = identifier("a metadata key");
+      auto key = metadata_key("a metadata key");
       if (!key) return key.error();
-      if (Status s = expect('=', "after '" + *key + "'"); !s) return s;
       if (*key == "references" || *key == "payload") {
         std::vector<Reference> refs;
         if (Status s = references(refs, prim.path); !s) return s;
@@ -1166,17 +1165,12 @@ class Parser {
     if (cur() != '(') return {};
     ++i_;
     while (!accept(')')) {
-      ws();
-      if (accept(';')) continue;
-      if (cur() == '"' || cur() == '\'') {
-        auto doc = string_literal();
-        if (!doc) return doc.error();
-        continue;
-      }
+      auto skipped = skip_separator_or_doc();
+      if (!skipped) return skipped.error();
+      if (*skipped) continue;
       list_op_prefix();
-      auto key = identifier("a property metadata key");
+      auto key = metadata_key("a property metadata key");
       if (!key) return key.error();
-      if (Status s = expect('=', "after '" + *key + "'"); !s) return s;
       Value v;
       if (Status s = value(v, prim, 1); !s) return s;
       p.metadata.emplace_back(std::move(*key), std::move(v));

@@ -10,15 +10,12 @@
 #include <cstring>
 
 namespace temporal::upsample {
-namespace {
 
-std::string join(const std::vector<std::string>& v) {
+std::string join_names(const std::vector<std::string>& names) {
   std::string s;
-  for (const auto& x : v) s += (s.empty() ? "" : ", ") + x;
+  for (const auto& x : names) s += (s.empty() ? "" : ", ") + x;
   return s.empty() ? "(none)" : s;
 }
-
-}  // namespace
 
 Expected<std::vector<std::string>> select_channels(const Image& low, const std::string& layers, const std::string& file) {
   return select_layers(low, layers, file);  // the --layer rule of every tool (temporal/core/image.h)
@@ -179,7 +176,7 @@ void copy_out(T* dst, const T* src, int w, int h, int stride) {
   for (int y = 0; y < h; ++y) std::copy_n(src + std::size_t(y) * stride, w, dst + std::size_t(y) * w);
 }
 Error missing(const Image& state, const std::string& name) {
-  return Error::input({}, "the state has no channel '" + name + "' (have: " + join(state.channel_names()) +
+  return Error::input({}, "the state has no channel '" + name + "' (have: " + join_names(state.channel_names()) +
                               "); pass a --state-out file of the same method and options");
 }
 }  // namespace

@@ -13,6 +13,9 @@
 
 namespace temporal::upsample {
 
+// "a, b, c" ("(none)" for an empty list): the channel lists of messages and of the state's channel header.
+std::string join_names(const std::vector<std::string>& names);
+
 // The sizes a method's state is allocated for; a change discards the history and re-creates the state.
 struct Geometry {
   int W = 0, H = 0, k = 0, lw = 0, lh = 0;

@@ -35,10 +35,7 @@ ParamList params(Options& o) {
       Param::choice("--method", "Upsampling method (upsample-st --list-methods describes each)", &o.method,
                     method_names(registry())),
       Param::text("--layer", "Payload layers to upsample: rgb (bare R,G,B) or layer names, comma-separated", &o.layer),
-      Param::choice("--device",
-                    "Where the method runs: cpu (the C++ reference) or gpu (its GLSL compute kernel through EGL; "
-                    "--list-methods says which methods have one)",
-                    &o.device, device_names()),
+      device_param(&o.device),
       Param::flag_on("--debug-layers",
                      "Add debug.* layers: confidence, disocclusion, gradient, wf, historyWeight, convergence",
                      &o.debug_layers),
@@ -71,17 +68,10 @@ ParamList params(Options& o) {
   return list;
 }
 
-Status check(const Options& options) {
-  if (Status s = check_method_name(registry(), options.method); !s) return s;
-  Options copy = options;  // params() points at the fields it is given
-  if (Status s = check_params(params(copy)); !s) return s;
-  if (Status s = check_method_device(*find_entry(options.method), options.device); !s) return s;
-  return check_method_options(registry(), options.per_method);
-}
+Status check(const Options& options) { return check_stage_options(registry(), options, params); }
 
 Expected<Options> make_options(const std::string& method, const std::vector<std::string>& args) {
-  return make_options_with<Options>(method, args, [](Options& o) { return params(o); },
-                               [](const Options& o) { return check(o); });
+  return make_options_with<Options>(method, args, params, check);
 }
 
 std::string method_parameters(const Options& o) {

@@ -14,12 +14,6 @@
 namespace temporal::upsample {
 namespace {
 
-std::string join(const std::vector<std::string>& v) {
-  std::string s;
-  for (const auto& x : v) s += (s.empty() ? "" : ", ") + x;
-  return s.empty() ? "(none)" : s;
-}
-
 std::string dims(int w, int h) { return std::to_string(w) + "x" + std::to_string(h); }
 
 // Albedo below this is not divided by (black or nearly black surfaces, background): the payload passes
@@ -92,7 +86,8 @@ Status Upsampler::Impl::validate(const Image& gbuffer, const Image& low, std::sp
     return Error::usage("at most 16 payload channels per run (" + std::to_string(channels.size()) +
                         " selected): split --layer over several runs");
   for (const auto& c : channels)
-    if (!low.plane(c)) return Error::input(lname, "no float channel '" + c + "' (have: " + join(low.channel_names()) + ")");
+    if (!low.plane(c))
+      return Error::input(lname, "no float channel '" + c + "' (have: " + join_names(low.channel_names()) + ")");
   const FrameMetadata& lm = low.metadata();
   if (!lm.jitter_factor)
     return Error::input(lname, "no temporal:jitterFactor in the header: upsample-st needs the low-resolution "
@@ -132,13 +127,15 @@ Status Upsampler::Impl::validate(const Image& gbuffer, const Image& low, std::sp
       const std::string a = albedo_channel(c);
       if (a.empty()) continue;
       if (!gbuffer.plane(a))
-        return Error::input(gname, "no channel '" + a + "' for --demodulate (have: " + join(gbuffer.channel_names()) +
+        return Error::input(gname, "no channel '" + a + "' for --demodulate (have: " +
+                                       join_names(gbuffer.channel_names()) +
                                        "); render the G-buffer with render-gbuffer --outputs gbuffer");
       ++n;
     }
     if (n == 0)
       return Error::usage("--demodulate needs colour channels (R, G, B or LAYER.R, .G, .B) in the payload; "
-                          "the selected ones are " + join(std::vector<std::string>(channels.begin(), channels.end())));
+                          "the selected ones are " +
+                          join_names(std::vector<std::string>(channels.begin(), channels.end())));
   }
   return Status::ok();
 }
@@ -230,10 +227,10 @@ Status Upsampler::Impl::prepare_state(std::span<const std::string> channels, con
   const FrameMetadata& md = pending->metadata();
   const std::string size = md.extra.count(kStateSize) ? md.extra.at(kStateSize) : "";
   const std::string chans = md.extra.count(kStateChannels) ? md.extra.at(kStateChannels) : "";
-  if (size != size_text(g) || chans != join(g.channels) || pending->width() != g.W || pending->height() != g.H)
+  if (size != size_text(g) || chans != join_names(g.channels) || pending->width() != g.W || pending->height() != g.H)
     return Error::input(names.input, "the state of --state-in is for frames of " + size + " (width height k) and "
                                      "channels " + chans + ", but this frame is " + size_text(g) + " with channels " +
-                                     join(g.channels) + ": resume with the sequence and --layer the state was "
+                                     join_names(g.channels) + ": resume with the sequence and --layer the state was "
                                      "written for");
   if (Status s = state->load(*pending); !s) return s;
   pending.reset();
@@ -369,7 +366,7 @@ Expected<Image> Upsampler::save_state() const {
   FrameMetadata& md = state.metadata();
   md.extra[kStateMethod] = u.options.method;
   md.extra[kStateSize] = size_text(u.geometry);
-  md.extra[kStateChannels] = join(u.geometry.channels);
+  md.extra[kStateChannels] = join_names(u.geometry.channels);
   md.extra[kStateDemodulated] = u.options.demodulate ? "1" : "0";
   if (u.entry->state_layout) md.extra[kStateLayout] = u.entry->state_layout(u.options);
   u.state->save(state);

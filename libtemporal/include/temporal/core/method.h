@@ -43,6 +43,14 @@ inline const std::vector<std::string>& device_names() {
   static const std::vector<std::string> names = {kCpuDevice, kGpuDevice};
   return names;
 }
+// The --device parameter of every method tool, bound to `device` (check_method_device says whether the chosen
+// method has an implementation there).
+inline Param device_param(std::string* device) {
+  return Param::choice("--device",
+                       "Where the method runs: cpu (the C++ reference) or gpu (its GLSL compute kernel through EGL; "
+                       "--list-methods says which methods have one)",
+                       device, device_names());
+}
 
 // A named way to run a method: the method and the arguments that select the variant, written as on the command
 // line ("herzog-lagged" = --method herzog --lagged-wf).
@@ -197,9 +205,9 @@ const Variant* find_variant_in(const std::vector<Variant>& variants, std::string
 
 // Options of a stage for `method`, with parameters set by command-line style arguments (the stage's params() and
 // check()); usage error for an unknown method or parameter, or an invalid value.
-template <typename Options, typename ParamsFn, typename CheckFn>
+template <typename Options>
 Expected<Options> make_options_with(const std::string& method, const std::vector<std::string>& args,
-                                    ParamsFn&& params, CheckFn&& check) {
+                                    ParamList (*params)(Options&), Status (*check)(const Options&)) {
   Options o;
   o.method = method;
   if (Status s = apply_args(params(o), args); !s) return s.error();
@@ -295,6 +303,19 @@ Status check_device(std::string_view method, std::string_view device, const std:
 template <typename Entry>
 Status check_method_device(const Entry& entry, std::string_view device) {
   return check_device(entry.info.name, device, implementation_devices(entry));
+}
+
+// The check() of a stage whose options are all Params (upsample-st's, filter-phlm's): --method is registered,
+// the stage's own parameters (`params`, the stage's params()) are in range, the method has an implementation on
+// --device, then each method's own parameters. Usage error naming the first that fails.
+template <typename Entry, typename Options>
+Status check_stage_options(const std::vector<const Entry*>& registry, const Options& options,
+                           ParamList (*params)(std::type_identity_t<Options>&)) {
+  if (Status s = check_method_name(registry, options.method); !s) return s;
+  Options copy = options;  // params() points at the fields it is given
+  if (Status s = check_params(params(copy)); !s) return s;
+  if (Status s = check_method_device(*find_entry_in(registry, options.method), options.device); !s) return s;
+  return check_method_options(registry, options.per_method);
 }
 
 }  // namespace temporal
