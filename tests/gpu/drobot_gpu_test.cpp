@@ -5,7 +5,6 @@
 // and the state round trips GPU -> CPU and CPU -> GPU. The FrameContext is built as Upsampler::build_context builds it.
 #include "drobot_options.h"
 #include "upsample_gpu_support.h"
-#include "temporal/gpu/timer.h"
 
 #include <gtest/gtest.h>
 
@@ -134,22 +133,13 @@ TEST(DrobotGpu, MatchesTheCppMethodWithoutIds) {
 // same as 12 frames on the CPU, within the bounds above. Both directions, both modes.
 TEST(DrobotGpu, StateResumesOnTheCpuAndBack) {
   TEMPORAL_GPU_CONTEXT_OR_SKIP(ctx);
-  const auto frames = sequence(12);
-  for (bool lagged : {false, true}) {  // "lagged": --mode refresh here
-    const Options o = options_with([lagged](DrobotOptions& h) { h.mode = lagged ? "refresh" : "cache"; });
-    const test::StatePlanes planes =
-        lagged ? test::StatePlanes{{"history.R", "history.G", "history.B", "prev.depth"}, "prev.id"}
-               : test::StatePlanes{{"cache.R", "cache.G", "cache.B", "cache.depth", "cache.frames"}, "cache.id"};
-    for (bool gpu_first : {true, false}) {
-      SCOPED_TRACE(::testing::Message() << (gpu_first ? "GPU -> CPU" : "CPU -> GPU") << " refresh " << lagged);
-      const test::Agreement a =
-          test::resume_on_the_other_device(ctx, "drobot", make_drobot_state_gpu, o, frames, 6, gpu_first, planes);
-      test::expect_within(a, kDrobotMaxAbs, kDrobotPsnr);
-      RecordProperty(std::string("round_trip_max_abs_") + (gpu_first ? "gpu_cpu" : "cpu_gpu") +
-                         (lagged ? "_refresh" : "_cache"),
-                     (::testing::Message() << a.max_abs).GetString());
-    }
-  }
+  test::expect_resumes_on_either_device(
+      ctx, "drobot", make_drobot_state_gpu, sequence(12),
+      {{"_cache", options_with([](DrobotOptions& h) { h.mode = "cache"; }),
+        {{"cache.R", "cache.G", "cache.B", "cache.depth", "cache.frames"}, "cache.id"}},
+       {"_refresh", options_with([](DrobotOptions& h) { h.mode = "refresh"; }),
+        {{"history.R", "history.G", "history.B", "prev.depth"}, "prev.id"}}},
+      kDrobotMaxAbs, kDrobotPsnr);
 }
 
 TEST(DrobotGpu, LoadNamesAMissingPlane) {
@@ -168,16 +158,9 @@ TEST(DrobotGpu, LoadNamesAMissingPlane) {
 // The registry's "gpu" implementation of herzog (what --device gpu picks): the same kernels on the shared context.
 TEST(DrobotGpu, IsRegisteredAsTheGpuImplementation) {
   TEMPORAL_GPU_CONTEXT_OR_SKIP(ctx);
-  const auto* implementation = find_implementation(*find_entry("drobot"), kGpuDevice);
-  ASSERT_NE(implementation, nullptr);
-  const auto frames = sequence(3);
-  const Geometry g = geometry_of(frames[0]);
-  const Options o = options_with(nullptr);
-  auto gpu = implementation->make(o, g);
-  auto cpu = test::cpu_state("drobot", o, g);
-  ASSERT_TRUE(gpu && cpu);
-  EXPECT_NE(dynamic_cast<gpu::TimedKernel*>(gpu.get()), nullptr);
-  EXPECT_LE(test::compare_states(*cpu, *gpu, o, {frames, -1, true, false}).colour.max_abs, kDrobotMaxAbs);
+  const test::RegisteredComparison r = test::compare_registered(*find_entry("drobot"), options_with(nullptr), sequence(3));
+  EXPECT_TRUE(r.timed);
+  EXPECT_LE(r.colour.max_abs, kDrobotMaxAbs);
 }
 
 }  // namespace

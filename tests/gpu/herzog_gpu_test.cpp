@@ -5,10 +5,10 @@
 // and the state round trips GPU -> CPU and CPU -> GPU. The FrameContext is built as Upsampler::build_context builds it.
 #include "herzog.h"
 #include "upsample_gpu_support.h"
-#include "temporal/gpu/timer.h"
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <functional>
 
 namespace {
@@ -119,22 +119,14 @@ TEST(HerzogGpu, MatchesTheCppMethodWithoutIds) {
 // same as 12 frames on the CPU, within the bounds above. Both directions, the defaults and --lagged-wf.
 TEST(HerzogGpu, StateResumesOnTheCpuAndBack) {
   TEMPORAL_GPU_CONTEXT_OR_SKIP(ctx);
-  const auto frames = sequence(12);
   const test::StatePlanes planes = {{"history.R", "history.G", "history.B", "history.weight", "gradient.t1",
                                      "gradient.t2", "gradient.t3", "gradient.wf", "prev.depth"},
                                     "prev.id"};
-  for (bool lagged : {false, true}) {
-    const Options o = options_with([lagged](HerzogOptions& h) { h.lagged_wf = lagged; });
-    for (bool gpu_first : {true, false}) {
-      SCOPED_TRACE(::testing::Message() << (gpu_first ? "GPU -> CPU" : "CPU -> GPU") << " lagged " << lagged);
-      const test::Agreement a =
-          test::resume_on_the_other_device(ctx, "herzog", make_herzog_state_gpu, o, frames, 6, gpu_first, planes);
-      test::expect_within(a, kHerzogMaxAbs, kHerzogPsnr);
-      RecordProperty(std::string("round_trip_max_abs_") + (gpu_first ? "gpu_cpu" : "cpu_gpu") +
-                         (lagged ? "_lagged" : ""),
-                     (::testing::Message() << a.max_abs).GetString());
-    }
-  }
+  test::expect_resumes_on_either_device(
+      ctx, "herzog", make_herzog_state_gpu, sequence(12),
+      {{"", options_with(nullptr), planes},
+       {"_lagged", options_with([](HerzogOptions& h) { h.lagged_wf = true; }), planes}},
+      kHerzogMaxAbs, kHerzogPsnr);
 }
 
 TEST(HerzogGpu, LoadNamesAMissingPlane) {
@@ -153,16 +145,9 @@ TEST(HerzogGpu, LoadNamesAMissingPlane) {
 // The registry's "gpu" implementation of herzog (what --device gpu picks): the same kernels on the shared context.
 TEST(HerzogGpu, IsRegisteredAsTheGpuImplementation) {
   TEMPORAL_GPU_CONTEXT_OR_SKIP(ctx);
-  const auto* implementation = find_implementation(*find_entry("herzog"), kGpuDevice);
-  ASSERT_NE(implementation, nullptr);
-  const auto frames = sequence(3);
-  const Geometry g = geometry_of(frames[0]);
-  const Options o = options_with(nullptr);
-  auto gpu = implementation->make(o, g);
-  auto cpu = test::cpu_state("herzog", o, g);
-  ASSERT_TRUE(gpu && cpu);
-  EXPECT_NE(dynamic_cast<gpu::TimedKernel*>(gpu.get()), nullptr);
-  EXPECT_LE(test::compare_states(*cpu, *gpu, o, {frames, -1, true, false}).colour.max_abs, kHerzogMaxAbs);
+  const test::RegisteredComparison r = test::compare_registered(*find_entry("herzog"), options_with(nullptr), sequence(3));
+  EXPECT_TRUE(r.timed);
+  EXPECT_LE(r.colour.max_abs, kHerzogMaxAbs);
 }
 
 // Every upsampling method is registered with a "gpu" implementation (what --device gpu picks), and the registered
@@ -170,16 +155,9 @@ TEST(HerzogGpu, IsRegisteredAsTheGpuImplementation) {
 TEST(GpuImplementation, EveryUpsampleMethodHasOne) {
   TEMPORAL_GPU_CONTEXT_OR_SKIP(ctx);
   const auto frames = sequence(3);
-  const Geometry g = geometry_of(frames[0]);
-  const Options o;
   for (const MethodEntry* e : registry()) {
     SCOPED_TRACE(e->info.name);
-    const auto* gpu_impl = find_implementation(*e, kGpuDevice);
-    ASSERT_NE(gpu_impl, nullptr);
-    auto gpu = gpu_impl->make(o, g);
-    auto cpu = find_implementation(*e, kCpuDevice)->make(o, g);
-    ASSERT_TRUE(gpu && cpu);
-    EXPECT_LE(test::compare_states(*cpu, *gpu, o, {frames, -1, true, false}).colour.max_abs, 1e-5);
+    EXPECT_LE(test::compare_registered(*e, Options{}, frames).colour.max_abs, 1e-5);
   }
 }
 

@@ -6,7 +6,6 @@
 // and the state round trips GPU -> CPU and CPU -> GPU. The FrameContext is built as Upsampler::build_context builds it.
 #include "taau.h"
 #include "upsample_gpu_support.h"
-#include "temporal/gpu/timer.h"
 
 #include <gtest/gtest.h>
 
@@ -143,22 +142,13 @@ TEST(TaauGpu, MatchesTheCppMethodWithoutIds) {
 // same as 12 frames on the CPU, within the bounds above. Both directions, the defaults and --no-locks.
 TEST(TaauGpu, StateResumesOnTheCpuAndBack) {
   TEMPORAL_GPU_CONTEXT_OR_SKIP(ctx);
-  const auto frames = sequence(12);
   const test::StatePlanes planes = {
       {"history.R", "history.G", "history.B", "history.weight", "lock.lifetime", "lock.luma", "prev.depth"},
       "prev.id"};
-  for (bool lagged : {false, true}) {  // "lagged": --no-locks here
-    const Options o = options_with([lagged](TaauOptions& h) { h.locks = !lagged; });
-    for (bool gpu_first : {true, false}) {
-      SCOPED_TRACE(::testing::Message() << (gpu_first ? "GPU -> CPU" : "CPU -> GPU") << " no-locks " << lagged);
-      const test::Agreement a =
-          test::resume_on_the_other_device(ctx, "taau", make_taau_state_gpu, o, frames, 6, gpu_first, planes);
-      test::expect_within(a, kTaauMaxAbs, kTaauPsnr);
-      RecordProperty(std::string("round_trip_max_abs_") + (gpu_first ? "gpu_cpu" : "cpu_gpu") +
-                         (lagged ? "_no_locks" : ""),
-                     (::testing::Message() << a.max_abs).GetString());
-    }
-  }
+  test::expect_resumes_on_either_device(
+      ctx, "taau", make_taau_state_gpu, sequence(12),
+      {{"", options_with(nullptr), planes}, {"_no_locks", options_with([](TaauOptions& h) { h.locks = false; }), planes}},
+      kTaauMaxAbs, kTaauPsnr);
 }
 
 TEST(TaauGpu, LoadNamesAMissingPlane) {
@@ -177,16 +167,9 @@ TEST(TaauGpu, LoadNamesAMissingPlane) {
 // The registry's "gpu" implementation of herzog (what --device gpu picks): the same kernels on the shared context.
 TEST(TaauGpu, IsRegisteredAsTheGpuImplementation) {
   TEMPORAL_GPU_CONTEXT_OR_SKIP(ctx);
-  const auto* implementation = find_implementation(*find_entry("taau"), kGpuDevice);
-  ASSERT_NE(implementation, nullptr);
-  const auto frames = sequence(3);
-  const Geometry g = geometry_of(frames[0]);
-  const Options o = options_with(nullptr);
-  auto gpu = implementation->make(o, g);
-  auto cpu = test::cpu_state("taau", o, g);
-  ASSERT_TRUE(gpu && cpu);
-  EXPECT_NE(dynamic_cast<gpu::TimedKernel*>(gpu.get()), nullptr);
-  EXPECT_LE(test::compare_states(*cpu, *gpu, o, {frames, -1, true, false}).colour.max_abs, kTaauMaxAbs);
+  const test::RegisteredComparison r = test::compare_registered(*find_entry("taau"), options_with(nullptr), sequence(3));
+  EXPECT_TRUE(r.timed);
+  EXPECT_LE(r.colour.max_abs, kTaauMaxAbs);
 }
 
 }  // namespace

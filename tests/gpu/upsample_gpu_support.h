@@ -9,6 +9,7 @@
 #include "gpu_support.h"
 #include "synthetic.h"  // tests/upsample
 #include "upsample_context.h"
+#include "temporal/gpu/timer.h"
 
 #include <gtest/gtest.h>
 
@@ -223,6 +224,54 @@ inline Agreement resume_on_the_other_device(const std::shared_ptr<gpu::Context>&
     EXPECT_TRUE(second.run_status()) << second.run_status().error().message;
   }
   return agreement(got, expected, kRgb);
+}
+
+// One case of a method's state round trips: the options, the planes its state file must hold, and the suffix of the
+// measured figure's test property (round_trip_max_abs_<gpu_cpu|cpu_gpu><suffix>).
+struct ResumeCase {
+  const char* suffix;
+  upsample::Options options;
+  StatePlanes planes;
+};
+
+// Each case's round trip on `frames` in both directions (half the frames on one device, the rest on the other:
+// resume_on_the_other_device) within the method's bounds, the measured max |GPU - CPU| recorded as a test property.
+inline void expect_resumes_on_either_device(const std::shared_ptr<gpu::Context>& ctx, const char* method,
+                                            GpuStateFactory make_gpu, const std::vector<SyntheticFrame>& frames,
+                                            const std::vector<ResumeCase>& cases, double max_abs, double min_psnr) {
+  const int split = int(frames.size()) / 2;
+  for (const ResumeCase& c : cases)
+    for (bool gpu_first : {true, false}) {
+      SCOPED_TRACE(::testing::Message() << (gpu_first ? "GPU -> CPU" : "CPU -> GPU") << " " << c.suffix);
+      const Agreement a = resume_on_the_other_device(ctx, method, make_gpu, c.options, frames, split, gpu_first, c.planes);
+      expect_within(a, max_abs, min_psnr);
+      ::testing::Test::RecordProperty(std::string("round_trip_max_abs_") + (gpu_first ? "gpu_cpu" : "cpu_gpu") +
+                                          c.suffix,
+                                      (::testing::Message() << a.max_abs).GetString());
+    }
+}
+
+// The registry's "gpu" implementation of a method (what --device gpu picks) against its "cpu" one on `frames`
+// (warped depth, no cut): the colour's agreement, and whether the GPU state reports its kernel time.
+struct RegisteredComparison {
+  Agreement colour{INFINITY, 0.0, 0, 1, 1};  // as bad as can be until both implementations ran
+  bool timed = false;
+};
+inline RegisteredComparison compare_registered(const upsample::MethodEntry& entry, const upsample::Options& o,
+                                               const std::vector<SyntheticFrame>& frames) {
+  RegisteredComparison r;
+  const auto* gpu_implementation = find_implementation(entry, kGpuDevice);
+  const auto* cpu_implementation = find_implementation(entry, kCpuDevice);
+  EXPECT_TRUE(gpu_implementation && cpu_implementation) << entry.info.name;
+  if (!gpu_implementation || !cpu_implementation) return r;
+  const upsample::Geometry g = geometry_of(frames[0]);
+  auto gpu = gpu_implementation->make(o, g);
+  auto cpu = cpu_implementation->make(o, g);
+  EXPECT_TRUE(gpu && cpu) << entry.info.name;
+  if (!gpu || !cpu) return r;
+  r.timed = dynamic_cast<gpu::TimedKernel*>(gpu.get()) != nullptr;
+  r.colour = compare_states(*cpu, *gpu, o, {frames, -1, true, false}).colour;
+  return r;
 }
 
 }  // namespace temporal::test
