@@ -14,7 +14,6 @@ namespace {
 
 using namespace temporal;
 using namespace temporal::upsample;
-using test::geometry_of;
 const std::vector<std::string> kRgb = {"R", "G", "B"};
 
 // The upsampling GPU tests' sequence (test::upsample_gpu_sequence) with a sample drobot must refuse and normals that
@@ -144,15 +143,8 @@ TEST(DrobotGpu, StateResumesOnTheCpuAndBack) {
 
 TEST(DrobotGpu, LoadNamesAMissingPlane) {
   TEMPORAL_GPU_CONTEXT_OR_SKIP(ctx);
-  const auto frames = sequence(1);
-  const Geometry g = geometry_of(frames[0]);
-  auto gpu = make_drobot_state_gpu(ctx, options_with(nullptr), g);
-  ASSERT_TRUE(gpu);
-  Image state(g.W, g.H);
-  state.add_channel("cache.R");
-  const Status st = (*gpu)->load(state);
-  ASSERT_FALSE(st);
-  EXPECT_NE(st.error().message.find("cache.G"), std::string::npos) << st.error().message;
+  const std::string error = test::load_error_with_only(ctx, make_drobot_state_gpu, options_with(nullptr), {"cache.R"});
+  EXPECT_NE(error.find("cache.G"), std::string::npos) << error;
 }
 
 // The registry's "gpu" implementation of herzog (what --device gpu picks): the same kernels on the shared context.

@@ -162,6 +162,33 @@ void expect_resumes_on_either_device(const std::shared_ptr<gpu::Context>& ctx, c
   }
 }
 
+// The input variants of the filter comparisons besides the defaults: one channel (G), no motion, a reset at frame 4.
+InputOptions mono_input() {
+  InputOptions o;
+  o.mono = true;
+  return o;
+}
+InputOptions no_motion_input() {
+  InputOptions o;
+  o.motion = false;
+  return o;
+}
+InputOptions reset_at_frame_4() {
+  InputOptions o;
+  o.reset_frame = 4;
+  return o;
+}
+
+// One case of a filter comparison: the GPU filter `make_gpu` makes against the C++ one over every frame (compare).
+Comparison compare_case(const std::shared_ptr<gpu::Context>& ctx, const Factory& make_gpu, const CpuFactory& make_cpu,
+                        const std::vector<Frame>& frames, const InputOptions& o,
+                        const std::vector<std::string>& debug_planes) {
+  auto gpu = make_gpu(ctx);
+  EXPECT_TRUE(gpu) << gpu.error().message;
+  if (!gpu) return {{INFINITY, 0.0, 0, 1, 1}};
+  return compare(**gpu, *make_cpu(), frames, 0, int(frames.size()), o, debug_planes);
+}
+
 // --- EMA -----------------------------------------------------------------------------------------------------
 // The same arithmetic as ema.cpp (one multiply-add per channel after the same bilinear gather): differences are
 // float rounding of FMA contraction only, and every decision (debug.reject, the counts) is equal. Measured on
@@ -185,10 +212,7 @@ TEST(EmaGpu, MatchesTheCppFilter) {
                                InputOptions{true, true, true, false, false, true, 5}}) {
     SCOPED_TRACE(::testing::Message() << "motion " << o.motion << " depth " << o.depth << " ids " << o.ids
                                       << " warped " << o.warped << " mono " << o.mono << " reset " << o.reset_frame);
-    auto gpu = make_ema_filter_gpu(ctx);
-    ASSERT_TRUE(gpu) << gpu.error().message;
-    EmaFilter cpu;
-    const Comparison r = compare(**gpu, cpu, frames, 0, int(frames.size()), o, {"debug.reject"});
+    const Comparison r = compare_case(ctx, ema_gpu(), ema_cpu(), frames, o, {"debug.reject"});
     test::expect_within(r.colour, kEmaMaxAbs, kEmaPsnr);
     EXPECT_EQ(r.debug_mismatches, 0u);
     EXPECT_EQ(r.stat_mismatches, 0u);
@@ -255,23 +279,14 @@ TEST(TaaGpu, MatchesTheCppFilter) {
   TaaParams nearest;
   nearest.history = "nearest";
   nearest.alpha = 0.1f;
-  InputOptions mono;
-  mono.mono = true;
-  InputOptions no_motion;
-  no_motion.motion = false;
-  InputOptions reset;
-  reset.reset_frame = 4;
   int case_index = 0;  // the measured agreement of each case goes to the test's XML properties
-  for (const Case& c : {Case{{}, {}}, Case{minmax, {}}, Case{nearest, {}}, Case{{}, mono}, Case{{}, no_motion},
-                        Case{minmax, reset}}) {
+  for (const Case& c : {Case{{}, {}}, Case{minmax, {}}, Case{nearest, {}}, Case{{}, mono_input()},
+                        Case{{}, no_motion_input()}, Case{minmax, reset_at_frame_4()}}) {
     SCOPED_TRACE(::testing::Message() << "clip " << c.params.clip << " history " << c.params.history << " velocity "
                                       << c.params.velocity << " mono " << c.input.mono << " motion "
                                       << c.input.motion << " reset " << c.input.reset_frame);
-    auto gpu = make_taa_filter_gpu(ctx, c.params);
-    ASSERT_TRUE(gpu) << gpu.error().message;
-    TaaFilter cpu(c.params);
-    const Comparison r = compare(**gpu, cpu, frames, 0, int(frames.size()), c.input,
-                          {"debug.noHistory", "debug.velocity.X", "debug.velocity.Y"});
+    const Comparison r = compare_case(ctx, taa_gpu(c.params), taa_cpu(c.params), frames, c.input,
+                                      {"debug.noHistory", "debug.velocity.X", "debug.velocity.Y"});
     test::expect_within(r.colour, kTaaMaxAbs, kTaaPsnr);
     EXPECT_EQ(r.debug_mismatches, 0u);
     record("", case_index++, r.colour);
@@ -331,20 +346,12 @@ TEST(PhlmGpu, MatchesTheCppFilter) {
   no_box.no_box_test = true;
   eq1.alpha_reading = "eq1";
   phi_linear.feature_phi = "linear";  // issue 24's ablation: phi = (a + b v) l
-  InputOptions mono;
-  mono.mono = true;
-  InputOptions no_motion;
-  no_motion.motion = false;
-  InputOptions reset;
-  reset.reset_frame = 4;
   int case_index = 0;  // the measured agreement of each case goes to the test's XML properties
   for (const Case& c : {Case{{}, {}}, Case{nearest, {}}, Case{catmull, {}}, Case{no_feature, {}}, Case{no_box, {}},
-                        Case{eq1, {}}, Case{phi_linear, {}}, Case{{}, mono}, Case{{}, no_motion}, Case{{}, reset}}) {
+                        Case{eq1, {}}, Case{phi_linear, {}}, Case{{}, mono_input()}, Case{{}, no_motion_input()},
+                        Case{{}, reset_at_frame_4()}}) {
     SCOPED_TRACE(::testing::Message() << "case " << case_index);
-    auto gpu = make_phlm_filter_gpu(ctx, c.params);
-    ASSERT_TRUE(gpu) << gpu.error().message;
-    PhlmFilter cpu(c.params);
-    const Comparison r = compare(**gpu, cpu, frames, 0, int(frames.size()), c.input, {"debug.reset"});
+    const Comparison r = compare_case(ctx, phlm_gpu(c.params), phlm_cpu(c.params), frames, c.input, {"debug.reset"});
     test::expect_within(r.colour, kPhlmMaxAbs, kPhlmPsnr);
     EXPECT_EQ(r.debug_mismatches, 0u);
     record("phlm_", case_index++, r.colour);

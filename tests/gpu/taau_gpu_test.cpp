@@ -16,8 +16,6 @@ namespace {
 
 using namespace temporal;
 using namespace temporal::upsample;
-using test::geometry_of;
-const std::vector<std::string> kRgb = {"R", "G", "B"};
 
 // The upsampling GPU tests' sequence (test::upsample_gpu_sequence) with samples taau must handle besides.
 std::vector<test::SyntheticFrame> sequence(int n) {
@@ -153,15 +151,8 @@ TEST(TaauGpu, StateResumesOnTheCpuAndBack) {
 
 TEST(TaauGpu, LoadNamesAMissingPlane) {
   TEMPORAL_GPU_CONTEXT_OR_SKIP(ctx);
-  const auto frames = sequence(1);
-  const Geometry g = geometry_of(frames[0]);
-  auto gpu = make_taau_state_gpu(ctx, options_with(nullptr), g);
-  ASSERT_TRUE(gpu);
-  Image state(g.W, g.H);
-  for (const auto& c : kRgb) state.add_channel("history." + c);
-  const Status st = (*gpu)->load(state);
-  ASSERT_FALSE(st);
-  EXPECT_NE(st.error().message.find("history.weight"), std::string::npos) << st.error().message;
+  const std::string error = test::load_error_with_only(ctx, make_taau_state_gpu, options_with(nullptr), {"history.R", "history.G", "history.B"});
+  EXPECT_NE(error.find("history.weight"), std::string::npos) << error;
 }
 
 // The registry's "gpu" implementation of herzog (what --device gpu picks): the same kernels on the shared context.

@@ -226,6 +226,20 @@ inline Agreement resume_on_the_other_device(const std::shared_ptr<gpu::Context>&
   return agreement(got, expected, kRgb);
 }
 
+// What a new GPU state's load() says of a state file (the synthetic sequence's size) that holds only the float
+// planes `planes`: the error's message, empty when it loaded.
+inline std::string load_error_with_only(const std::shared_ptr<gpu::Context>& ctx, GpuStateFactory make_gpu,
+                                        const upsample::Options& o, const std::vector<std::string>& planes) {
+  const upsample::Geometry g = geometry_of(upsample_gpu_sequence(1)[0]);
+  auto gpu = make_gpu(ctx, o, g);
+  EXPECT_TRUE(gpu) << gpu.error().message;
+  if (!gpu) return gpu.error().message;
+  Image state(g.W, g.H);
+  for (const auto& n : planes) state.add_channel(n);
+  const Status st = (*gpu)->load(state);
+  return st ? std::string() : st.error().message;
+}
+
 // One case of a method's state round trips: the options, the planes its state file must hold, and the suffix of the
 // measured figure's test property (round_trip_max_abs_<gpu_cpu|cpu_gpu><suffix>).
 struct ResumeCase {

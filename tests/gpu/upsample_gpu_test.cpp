@@ -10,7 +10,6 @@ namespace {
 
 using namespace temporal;
 using namespace temporal::upsample;
-using test::geometry_of;
 
 // The debug plane both methods write: the joint-bilateral weight sum, relative to its value.
 const std::vector<test::DebugPlaneBound> kConfidence = {{"debug.confidence", true, 1e-5, false, 1e-30}};
@@ -62,15 +61,8 @@ TEST(TemporalGpu, StateResumesOnTheCpuAndBack) {
 
 TEST(TemporalGpu, LoadNamesAMissingPlane) {
   TEMPORAL_GPU_CONTEXT_OR_SKIP(ctx);
-  const auto frames = test::upsample_gpu_sequence(1);
-  const Geometry g = geometry_of(frames[0]);
-  auto gpu = make_temporal_state_gpu(ctx, Options{}, g);
-  ASSERT_TRUE(gpu);
-  Image state(g.W, g.H);
-  state.add_channel("history.R");
-  const Status st = (*gpu)->load(state);
-  ASSERT_FALSE(st);
-  EXPECT_NE(st.error().message.find("history.G"), std::string::npos) << st.error().message;
+  const std::string error = test::load_error_with_only(ctx, make_temporal_state_gpu, Options{}, {"history.R"});
+  EXPECT_NE(error.find("history.G"), std::string::npos) << error;
 }
 
 }  // namespace
