@@ -184,16 +184,8 @@ class EmaFilterGpu final : public FrameFilter, public gpu::TimedKernel {
   Status allocate(int channels, int w, int h) {
     channels_ = channels;
     if (src_.width() == w && src_.height() == h && src_.planes() == channels + 5) return Status::ok();
-    auto src = gpu::ImageBuffer::create(ctx_, w, h, channels + 5);
-    if (!src) return src.error();
-    auto hist = gpu::ImageBuffer::create(ctx_, w, h, channels + 3);
-    if (!hist) return hist.error();
-    auto next = gpu::ImageBuffer::create(ctx_, w, h, channels + 3);
-    if (!next) return next.error();
-    src_ = std::move(*src);
-    hist_ = std::move(*hist);
-    next_ = std::move(*next);
-    return Status::ok();
+    return gpu::ImageBuffer::create_all(
+        ctx_, {{&src_, w, h, channels + 5}, {&hist_, w, h, channels + 3}, {&next_, w, h, channels + 3}});
   }
 
   std::shared_ptr<gpu::Context> ctx_;

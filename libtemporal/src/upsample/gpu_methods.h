@@ -58,6 +58,15 @@ std::unique_ptr<MethodState> gpu_implementation(const Options& options, const Ge
 // low-resolution offsets and their weights; jb_value(j, c) the payload value of a tap.
 std::string_view joint_bilateral_glsl();
 
+// GLSL of the frame's sampling grid: the uniforms ivec2 u_full, u_low (full and low resolution); int u_k, u_sx,
+// u_sy (the factor and this frame's jitter offset), u_C (payload channels); uint u_n, u_ln (full- and
+// low-resolution plane sizes); and gather_low_geometry's validity of low-resolution sample q, `bool low_valid(uint
+// q)`: finite geometry at its full-resolution pixel and a payload that is a sample (is_sample: finite and at most
+// kMaxSampleMagnitude, as usable_sample in frame.cpp). low_valid reads `gb` and `lowb` (GpuFrame's bindings 0, 1).
+std::string_view sampling_grid_glsl();
+// Sets those uniforms from the frame.
+void set_sampling_grid_uniforms(const gpu::Program& program, const FrameContext& f);
+
 // Sets the uniforms joint_bilateral_glsl() reads from the frame (the constants computed on the host exactly as the
 // C++ kernels compute them).
 void set_joint_bilateral_uniforms(const gpu::Program& program, const FrameContext& f);

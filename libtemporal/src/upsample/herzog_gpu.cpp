@@ -33,11 +33,7 @@ namespace {
 
 // The constants of herzog.cpp and upsample_internal.h's fast_exp2, printed exactly (%.9g round-trips a float).
 std::string constants() {
-  auto line = [](const char* name, float v) {
-    char b[128];
-    std::snprintf(b, sizeof b, "const float %s = %.9g;\n", name, double(v));
-    return std::string(b);
-  };
+  const auto line = gpu::glsl::float_constant;  // "const float NAME = VALUE;", the float exactly
   return line("kMaxGradient", kMaxGradient) + line("kG0", kGradientWeights[0]) + line("kG1", kGradientWeights[1]) +
          line("kG2", kGradientWeights[2]) + line("kG3", kGradientWeights[3]) + line("kLn2", 0.69314718056f) +
          line("kInv6", 1.0f / 6) + line("kInv24", 1.0f / 24) + line("kInv120", 1.0f / 120) +
@@ -389,16 +385,15 @@ class HerzogStateGpu final : public MethodState, public gpu::TimedKernel {
   // the gradients kMaxGradient, w_f 0, the output 0).
   Status allocate() {
     if (!out_[0].empty()) return Status::ok();
-    const int C = int(g_.channels.size());
-    auto make = [&](gpu::ImageBuffer& b, int w, int h, int planes) {
-      return gpu::ImageBuffer::create_cleared(ctx_, w, h, planes, b);
-    };
-    for (auto& b : out_)
-      if (Status s = make(b, g_.W, g_.H, C + 6); !s) return s;
-    if (Status s = make(prevg_, g_.W, g_.H, 2); !s) return s;
-    if (Status s = make(scratch_, g_.W, g_.H, kScratchFixed + C); !s) return s;
-    if (Status s = make(hw_, g_.W, g_.H, 2); !s) return s;
-    if (Status s = make(grid_, GW_, GH_, kGridPlanes); !s) return s;
+    const int C = int(g_.channels.size()), W = g_.W, H = g_.H;
+    if (Status s = gpu::ImageBuffer::create_all_cleared(ctx_, {{&out_[0], W, H, C + 6},
+                                                               {&out_[1], W, H, C + 6},
+                                                               {&prevg_, W, H, 2},
+                                                               {&scratch_, W, H, kScratchFixed + C},
+                                                               {&hw_, W, H, 2},
+                                                               {&grid_, GW_, GH_, kGridPlanes}});
+        !s)
+      return s;
     const std::vector<float> max_gradient(std::size_t(GW_) * GH_, kMaxGradient);
     for (int par = 0; par < 2; ++par)
       for (int t = 0; t < 3; ++t)
@@ -638,10 +633,7 @@ Expected<std::unique_ptr<MethodState>> make_herzog_state_gpu(std::shared_ptr<gpu
   };
   // Only gb and prevg need their uint view (ids): one block for each other buffer keeps pass A at 12 storage blocks
   // (two views each would be 19; llvmpipe's GL_MAX_COMPUTE_SHADER_STORAGE_BLOCKS is 16).
-  auto floats = [](int binding, const char* name) {
-    const std::string b = std::to_string(binding), n = name;
-    return "layout(std430, binding = " + b + ") buffer " + n + "_F { float " + n + "[]; };\n";
-  };
+  const auto floats = gpu::glsl::float_storage;  // a float-only storage block
   const std::string s0 = gpu::glsl::storage(0, "gb"), s1 = floats(1, "lowb"), s2 = floats(2, "outb"),
                     s3 = floats(3, "hist"), s4 = gpu::glsl::storage(4, "prevg"), s5 = floats(5, "scr"),
                     s6 = floats(6, "hwb"), s7 = floats(7, "grid"), s8 = floats(8, "tab"), s9 = floats(9, "pyr"),

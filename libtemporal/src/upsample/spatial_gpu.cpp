@@ -174,6 +174,34 @@ Status GpuFrame::upload(const std::shared_ptr<gpu::Context>& context, const Fram
   return Status::ok();
 }
 
+std::string_view sampling_grid_glsl() {
+  return R"(
+uniform ivec2 u_full, u_low;
+uniform int u_k, u_sx, u_sy, u_C;
+uniform uint u_n, u_ln;
+
+bool low_valid(uint q) {
+  const uint lx = q % uint(u_low.x), ly = q / uint(u_low.x);
+  const uint g = (uint(u_k) * ly + uint(u_sy)) * uint(u_full.x) + uint(u_sx) + uint(u_k) * lx;
+  bool ok = is_finite_bits(gb[g]) && is_finite_bits(gb[u_n + g]) && is_finite_bits(gb[2u * u_n + g]) &&
+            is_finite_bits(gb[3u * u_n + g]);
+  for (int c = 0; c < u_C; ++c) ok = ok && is_sample(lowb[uint(c) * u_ln + q]);
+  return ok;
+}
+)";
+}
+
+void set_sampling_grid_uniforms(const gpu::Program& program, const FrameContext& f) {
+  program.set_int2("u_full", f.W, f.H);
+  program.set_int2("u_low", f.lw, f.lh);
+  program.set("u_k", f.grid.k);
+  program.set("u_sx", f.grid.sx);
+  program.set("u_sy", f.grid.sy);
+  program.set("u_C", f.C);
+  program.set("u_n", std::uint32_t(std::size_t(f.W) * f.H));
+  program.set("u_ln", std::uint32_t(std::size_t(f.lw) * f.lh));
+}
+
 Expected<std::shared_ptr<gpu::Context>> shared_gpu_context() {
   static std::mutex mutex;
   static std::weak_ptr<gpu::Context> shared;

@@ -24,31 +24,14 @@ namespace temporal::upsample {
 namespace {
 
 std::string constants() {
-  auto line = [](const char* name, float v) {
-    char b[128];
-    std::snprintf(b, sizeof b, "const float %s = %.9g;\n", name, double(v));
-    return std::string(b);
-  };
+  const auto line = gpu::glsl::float_constant;  // "const float NAME = VALUE;", the float exactly
   return line("kLanczosWeightScale", kLanczosWeightScale) + line("kMaxAccumulation", kMaxAccumulation) +
          line("kEpsilon", kEpsilon) + line("kRectifiedAccumulation", kRectifiedAccumulation) +
          line("kSimilarLuma", kSimilarLuma) + line("kFloatMax", std::numeric_limits<float>::max()) + R"(
-uniform ivec2 u_full, u_low;
-uniform int u_k, u_sx, u_sy, u_C;
-uniform uint u_n, u_ln;
 uniform float u_luma[16];
 uniform bool u_locks;
 
-// gather_low_geometry's validity of low-resolution sample q: finite geometry at its full-resolution pixel and a
-// payload that is a sample (is_sample: finite and at most kMaxSampleMagnitude, as usable_sample in frame.cpp).
-bool low_valid(uint q) {
-  const uint lx = q % uint(u_low.x), ly = q / uint(u_low.x);
-  const uint g = (uint(u_k) * ly + uint(u_sy)) * uint(u_full.x) + uint(u_sx) + uint(u_k) * lx;
-  bool ok = is_finite_bits(gb[g]) && is_finite_bits(gb[u_n + g]) && is_finite_bits(gb[2u * u_n + g]) &&
-            is_finite_bits(gb[3u * u_n + g]);
-  for (int c = 0; c < u_C; ++c) ok = ok && is_sample(lowb[uint(c) * u_ln + q]);
-  return ok;
-}
-)";
+)" + std::string(sampling_grid_glsl());
 }
 
 // L: dispatch lw x lh (u_size = the low resolution). lowl (6): plane 0 the luminance, plane 1 the thin features.
@@ -373,26 +356,16 @@ class TaauStateGpu final : public MethodState, public gpu::TimedKernel {
   // TaauState's constructor: weights, locks and the outputs 0.
   Status allocate() {
     if (!out_[0].empty()) return Status::ok();
-    const int C = int(g_.channels.size());
-    auto make = [&](gpu::ImageBuffer& b, int w, int h, int planes) {
-      return gpu::ImageBuffer::create_cleared(ctx_, w, h, planes, b);
-    };
-    for (auto& b : out_)
-      if (Status s = make(b, g_.W, g_.H, C + 7); !s) return s;
-    if (Status s = make(prevg_, g_.W, g_.H, 2); !s) return s;
-    if (Status s = make(st_, g_.W, g_.H, 6); !s) return s;
-    return make(lowl_, g_.lw, g_.lh, 2);
+    const int C = int(g_.channels.size()), W = g_.W, H = g_.H;
+    return gpu::ImageBuffer::create_all_cleared(ctx_, {{&out_[0], W, H, C + 7},
+                                                       {&out_[1], W, H, C + 7},
+                                                       {&prevg_, W, H, 2},
+                                                       {&st_, W, H, 6},
+                                                       {&lowl_, g_.lw, g_.lh, 2}});
   }
 
   void set_common(const gpu::Program& prog, const FrameContext& f, const TaauOptions& to) const {
-    prog.set_int2("u_full", f.W, f.H);
-    prog.set_int2("u_low", f.lw, f.lh);
-    prog.set("u_k", f.grid.k);
-    prog.set("u_sx", f.grid.sx);
-    prog.set("u_sy", f.grid.sy);
-    prog.set("u_C", f.C);
-    prog.set("u_n", std::uint32_t(std::size_t(f.W) * f.H));
-    prog.set("u_ln", std::uint32_t(std::size_t(f.lw) * f.lh));
+    set_sampling_grid_uniforms(prog, f);
     float luma[16] = {};
     for (int c = 0; c < f.C && c < 16; ++c) luma[c] = f.luma[std::size_t(c)];
     prog.set("u_luma", luma, 16);
@@ -490,10 +463,7 @@ class TaauStateGpu final : public MethodState, public gpu::TimedKernel {
 Expected<std::unique_ptr<MethodState>> make_taau_state_gpu(std::shared_ptr<gpu::Context> context, const Options&,
                                                            const Geometry& geometry) {
   if (Status s = gpu::Context::ensure(context); !s) return s.error();
-  auto floats = [](int binding, const char* name) {
-    const std::string b = std::to_string(binding), n = name;
-    return "layout(std430, binding = " + b + ") buffer " + n + "_F { float " + n + "[]; };\n";
-  };
+  const auto floats = gpu::glsl::float_storage;  // a float-only storage block
   const std::string consts = constants();
   const std::string s0 = gpu::glsl::storage(0, "gb"), s1 = floats(1, "lowb"), s2 = floats(2, "outb"),
                     s3 = floats(3, "hist"), s4 = gpu::glsl::storage(4, "prevg"), s5 = floats(5, "st"),

@@ -100,15 +100,8 @@ class TemporalStateGpu final : public MethodState, public gpu::TimedKernel {
   Status allocate() {
     if (allocate_const_ok()) return Status::ok();
     const int planes = int(g_.channels.size()) + 2;
-    for (auto& b : out_) {
-      auto created = gpu::ImageBuffer::create(ctx_, g_.W, g_.H, planes);
-      if (!created) return created.error();
-      b = std::move(*created);
-    }
-    auto prev = gpu::ImageBuffer::create(ctx_, g_.W, g_.H, 2);
-    if (!prev) return prev.error();
-    prevg_ = std::move(*prev);
-    return Status::ok();
+    return gpu::ImageBuffer::create_all(
+        ctx_, {{&out_[0], g_.W, g_.H, planes}, {&out_[1], g_.W, g_.H, planes}, {&prevg_, g_.W, g_.H, 2}});
   }
 
   Status run_gpu(const FrameContext& f, bool history, FrameStats& stats) {
