@@ -55,7 +55,8 @@ std::unique_ptr<MethodState> gpu_implementation(const Options& options, const Ge
 // GLSL of the joint-bilateral weights (spatial_row / expanded_geometric_weights: the same operations in the same
 // order), shared by the upsampling kernels. Reads binding 0 `gb` (full-resolution planes: depth.Z 0, N.X/Y/Z 1-3)
 // and binding 1 `lowb` (the low-resolution payload, C planes of lw x lh). jb_weights(P) returns the four taps'
-// low-resolution offsets and their weights; jb_value(j, c) the payload value of a tap.
+// low-resolution offsets and their weights; jb_value(j, c) the payload value of a tap. Includes sampling_grid_glsl()
+// (below): a kernel that uses it declares neither.
 std::string_view joint_bilateral_glsl();
 
 // GLSL of the frame's sampling grid: the uniforms ivec2 u_full, u_low (full and low resolution); int u_k, u_sx,
@@ -68,7 +69,7 @@ std::string_view sampling_grid_glsl();
 void set_sampling_grid_uniforms(const gpu::Program& program, const FrameContext& f);
 
 // Sets the uniforms joint_bilateral_glsl() reads from the frame (the constants computed on the host exactly as the
-// C++ kernels compute them).
+// C++ kernels compute them), set_sampling_grid_uniforms() included.
 void set_joint_bilateral_uniforms(const gpu::Program& program, const FrameContext& f);
 
 // A state file's previous depth (and ids, when it has them) into planes 0 and 1 of `prevg` (the C++ states'

@@ -104,7 +104,7 @@ void main() {
     }
     // spatial_estimate_row: the four taps' geometric weights (expanded_geometric_weights), w~' with the sharp
     // kernel, then the adaptive kernel hat * 2^(ek log2 base) (eq. 3) and w~.
-    const int k = u_k, lw = u_low_size.x, lh = u_low_size.y;
+    const int k = u_k, lw = u_low.x, lh = u_low.y;
     const int x0 = floor_div(p.x - u_sx, k), y0 = floor_div(p.y - u_sy, k);
     const int dx = p.x - u_sx - k * x0, dy = p.y - u_sy - k * y0;
     const float cv0 = (x0 >= 0 && x0 < lw) ? 1.0 : 0.0, cv1 = (x0 + 1 >= 0 && x0 + 1 < lw) ? 1.0 : 0.0;
