@@ -361,28 +361,18 @@ void main() {
 }
 )";
 
-class DrobotStateGpu final : public MethodState, public gpu::TimedKernel {
+class DrobotStateGpu final : public GpuHistoryState {
  public:
   DrobotStateGpu(std::shared_ptr<gpu::Context> ctx, std::vector<gpu::Program> programs, gpu::ImageBuffer counters,
                  const Geometry& g, bool refresh)
-      : ctx_(std::move(ctx)), prog_(std::move(programs)), counters_(std::move(counters)), g_(g), refresh_(refresh),
-        timer_(ctx_) {}
-
-  Image& run(const FrameContext& f, bool history, FrameStats& stats) override {
-    status_ = refresh_ ? run_refresh(f, history, stats) : run_cache(f, history, stats);
-    return result_;
-  }
-  Status run_status() const override { return status_; }
+      : GpuHistoryState(std::move(ctx), std::move(counters), g), prog_(std::move(programs)), refresh_(refresh) {}
 
   // DrobotState::save's planes.
   void save(Image& state) const override {
     if (out_[0].empty()) return;  // save() cannot report an error; load() names a missing plane
     const int C = int(g_.channels.size());
     if (refresh_) {
-      std::vector<float> plane(std::size_t(g_.W) * g_.H);
-      for (int c = 0; c < C; ++c)
-        if (out_[cur_].download(c, plane.data()))
-          put_plane(state, "history." + g_.channels[std::size_t(c)], plane.data(), g_.W, g_.H);
+      save_history(state);
       save_previous_geometry(prevg_, has_prev_id_, g_, state);
       return;
     }
@@ -404,12 +394,7 @@ class DrobotStateGpu final : public MethodState, public gpu::TimedKernel {
     cur_ = 1 - cur_;  // OutputPair::next()
     const int C = int(g_.channels.size());
     if (refresh_) {
-      std::vector<float> plane(std::size_t(g_.W) * g_.H);
-      for (int c = 0; c < C; ++c) {
-        if (Status s = get_plane(state, "history." + g_.channels[std::size_t(c)], plane.data(), g_.W, g_.H); !s)
-          return s;
-        if (Status s = out_[cur_].upload(c, plane.data()); !s) return s;
-      }
+      if (Status s = load_history(state); !s) return s;
       if (Status s = upload_previous_geometry(state, g_, prevg_, has_prev_id_); !s) return s;
       has_history_ = true;
       return Status::ok();
@@ -434,8 +419,6 @@ class DrobotStateGpu final : public MethodState, public gpu::TimedKernel {
     has_history_ = true;
     return Status::ok();
   }
-
-  gpu::KernelTiming last_timing() const override { return timing_; }
 
  private:
   enum { kGrid, kAccumulate, kFilter, kCacheUpsample, kRefresh };
@@ -491,6 +474,10 @@ class DrobotStateGpu final : public MethodState, public gpu::TimedKernel {
       }
     }
     return Status::ok();
+  }
+
+  Status run_gpu(const FrameContext& f, bool history, FrameStats& stats) override {
+    return refresh_ ? run_refresh(f, history, stats) : run_cache(f, history, stats);
   }
 
   Status run_cache(const FrameContext& f, bool have_history, FrameStats& stats) {
@@ -640,10 +627,7 @@ class DrobotStateGpu final : public MethodState, public gpu::TimedKernel {
                           (f.debug ? 3.0 * full : 0.0);  // drobot.cpp's streamed_bytes (refresh mode)
     static const char* const kNames[3] = {"debug.confidence", "debug.disocclusion", "debug.convergence"};
     if (Status s = finish(f, 3, kNames); !s) return s;
-    if (Status s = prevg_.copy_plane(frame_.gb, 0, 0); !s) return s;  // PreviousGeometry::store
-    has_prev_id_ = f.id != nullptr;
-    if (has_prev_id_)
-      if (Status s = prevg_.copy_plane(frame_.gb, 7, 1); !s) return s;
+    if (Status s = store_previous_geometry(f); !s) return s;
     has_history_ = true;
     std::uint32_t counts[4] = {};
     if (Status s = counters_.download(0, counts); !s) return s;
@@ -652,19 +636,10 @@ class DrobotStateGpu final : public MethodState, public gpu::TimedKernel {
     return Status::ok();
   }
 
-  std::shared_ptr<gpu::Context> ctx_;
   std::vector<gpu::Program> prog_;
-  gpu::ImageBuffer counters_;
-  Geometry g_;
   bool refresh_;
-  gpu::Timer timer_;
-  GpuFrame frame_;
-  gpu::ImageBuffer out_[2], prevg_, cg_, cache_, cb_, tmp_, tab_;
-  int cur_ = 0;
-  bool has_prev_id_ = false, has_cache_id_ = false, has_history_ = false;
-  Image result_;
-  Status status_;
-  gpu::KernelTiming timing_;
+  gpu::ImageBuffer cg_, cache_, cb_, tmp_, tab_;
+  bool has_cache_id_ = false, has_history_ = false;
 };
 
 }  // namespace

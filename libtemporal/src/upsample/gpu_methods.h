@@ -7,6 +7,7 @@
 #include "temporal/gpu/buffer.h"
 #include "temporal/gpu/context.h"
 #include "temporal/gpu/program.h"
+#include "temporal/gpu/timer.h"
 
 #include <memory>
 #include <string_view>
@@ -89,6 +90,45 @@ struct GpuFrame {
     gb.bind(0);
     low.bind(1);
   }
+};
+
+// What the GPU states with a history (temporal, herzog, taau, drobot) share: the context and the counters their
+// kernels count into (binding 15), the frame's inputs, the two output parities of OutputPair (out_[cur_] this
+// frame's, the other the previous output) and the previous frame's geometry (prevg_: depth, ids), the result and
+// run()'s status (run() itself cannot return an error: the Upsampler asks run_status()), the kernel timing. A state
+// implements run_gpu().
+class GpuHistoryState : public MethodState, public gpu::TimedKernel {
+ public:
+  Image& run(const FrameContext& f, bool history, FrameStats& stats) final {
+    status_ = run_gpu(f, history, stats);
+    return result_;
+  }
+  Status run_status() const final { return status_; }
+  gpu::KernelTiming last_timing() const final { return timing_; }
+
+ protected:
+  GpuHistoryState(std::shared_ptr<gpu::Context> context, gpu::ImageBuffer counters, const Geometry& g)
+      : ctx_(std::move(context)), counters_(std::move(counters)), g_(g), timer_(ctx_) {}
+  virtual Status run_gpu(const FrameContext& f, bool history, FrameStats& stats) = 0;
+
+  // The state file's `history.<c>` planes from / into planes 0..C-1 of out_[cur_] (save() cannot report an error:
+  // a failed download leaves the plane out, and load() names it).
+  void save_history(Image& state) const;
+  Status load_history(const Image& state);
+  // PreviousGeometry::store: this frame's depth and ids (GpuFrame planes 0 and 7) become the previous frame's.
+  Status store_previous_geometry(const FrameContext& f);
+
+  std::shared_ptr<gpu::Context> ctx_;
+  gpu::ImageBuffer counters_;
+  Geometry g_;
+  gpu::Timer timer_;
+  GpuFrame frame_;
+  gpu::ImageBuffer out_[2], prevg_;
+  int cur_ = 0;
+  bool has_prev_id_ = false;
+  Image result_;
+  Status status_;
+  gpu::KernelTiming timing_;
 };
 
 }  // namespace temporal::upsample

@@ -326,30 +326,22 @@ struct Programs {
   gpu::Program a, b, pyramid, low_pass, c;
 };
 
-class HerzogStateGpu final : public MethodState, public gpu::TimedKernel {
+class HerzogStateGpu final : public GpuHistoryState {
  public:
   HerzogStateGpu(std::shared_ptr<gpu::Context> ctx, Programs programs, gpu::ImageBuffer counters, const Geometry& g,
                  const HerzogOptions& ho)
-      : ctx_(std::move(ctx)), prog_(std::move(programs)), counters_(std::move(counters)), g_(g), timer_(ctx_) {
+      : GpuHistoryState(std::move(ctx), std::move(counters), g), prog_(std::move(programs)) {
     gs_ = std::max(1, ho.gradient_scale);  // fixed for the state's life (its layout: state_layout)
     GW_ = (g_.W + gs_ - 1) / gs_;
     GH_ = (g_.H + gs_ - 1) / gs_;
   }
 
-  Image& run(const FrameContext& f, bool history, FrameStats& stats) override {
-    status_ = run_gpu(f, history, stats);
-    return result_;
-  }
-  Status run_status() const override { return status_; }
-
   // The planes HerzogState::save writes, from the parity of the last frame.
   void save(Image& state) const override {
     // save() cannot report an error; a failed download leaves the plane out and load() names it.
     if (out_[0].empty()) return;
+    save_history(state);
     std::vector<float> plane(std::size_t(g_.W) * g_.H), cell(std::size_t(GW_) * GH_);
-    for (int c = 0; c < int(g_.channels.size()); ++c)
-      if (out_[cur_].download(c, plane.data()))
-        put_plane(state, "history." + g_.channels[std::size_t(c)], plane.data(), g_.W, g_.H);
     if (hw_.download(cur_, plane.data())) put_plane(state, "history.weight", plane.data(), g_.W, g_.H);
     for (int t = 0; t < 3; ++t)
       if (grid_.download(4 * cur_ + t, cell.data()))
@@ -361,12 +353,8 @@ class HerzogStateGpu final : public MethodState, public gpu::TimedKernel {
   Status load(const Image& state) override {
     if (Status s = allocate(); !s) return s;
     cur_ = 1 - cur_;  // as OutputPair::next(): what is loaded is the previous frame of the next run()
+    if (Status s = load_history(state); !s) return s;
     std::vector<float> plane(std::size_t(g_.W) * g_.H), cell(std::size_t(GW_) * GH_);
-    for (int c = 0; c < int(g_.channels.size()); ++c) {
-      if (Status s = get_plane(state, "history." + g_.channels[std::size_t(c)], plane.data(), g_.W, g_.H); !s)
-        return s;
-      if (Status s = out_[cur_].upload(c, plane.data()); !s) return s;
-    }
     if (Status s = get_plane(state, "history.weight", plane.data(), g_.W, g_.H); !s) return s;
     if (Status s = hw_.upload(cur_, plane.data()); !s) return s;
     for (int t = 0; t < 4; ++t) {
@@ -374,11 +362,8 @@ class HerzogStateGpu final : public MethodState, public gpu::TimedKernel {
       if (Status s = get_plane(state, name, cell.data(), GW_, GH_); !s) return s;
       if (Status s = grid_.upload(4 * cur_ + t, cell.data()); !s) return s;
     }
-    if (Status s = upload_previous_geometry(state, g_, prevg_, has_prev_id_); !s) return s;
-    return Status::ok();
+    return upload_previous_geometry(state, g_, prevg_, has_prev_id_);
   }
-
-  gpu::KernelTiming last_timing() const override { return timing_; }
 
  private:
   // The buffers of the state's geometry, initialised as HerzogState's constructor initialises its vectors (h_w 0,
@@ -452,7 +437,7 @@ class HerzogStateGpu final : public MethodState, public gpu::TimedKernel {
     return Status::ok();
   }
 
-  Status run_gpu(const FrameContext& f, bool history, FrameStats& stats) {
+  Status run_gpu(const FrameContext& f, bool history, FrameStats& stats) override {
     const HerzogOptions& ho = herzog_options(*f.options);
     if (Status s = allocate(); !s) return s;
     if (Status s = frame_.upload(ctx_, f, true); !s) return s;
@@ -572,11 +557,7 @@ class HerzogStateGpu final : public MethodState, public gpu::TimedKernel {
         result_.remove_channel(kDebugNames[d]);
       }
     }
-    // PreviousGeometry::store: this frame's depth and ids become the previous frame's.
-    if (Status s = prevg_.copy_plane(frame_.gb, 0, 0); !s) return s;
-    has_prev_id_ = f.id != nullptr;
-    if (has_prev_id_)
-      if (Status s = prevg_.copy_plane(frame_.gb, 7, 1); !s) return s;
+    if (Status s = store_previous_geometry(f); !s) return s;
     std::uint32_t counts[4] = {};
     if (Status s = counters_.download(0, counts); !s) return s;
     stats.history_pixels = history ? counts[0] : 0;
@@ -603,23 +584,13 @@ class HerzogStateGpu final : public MethodState, public gpu::TimedKernel {
     return a + b + pyramid + low_pass + c;
   }
 
-  std::shared_ptr<gpu::Context> ctx_;
   Programs prog_;
-  gpu::ImageBuffer counters_;
-  Geometry g_;
-  gpu::Timer timer_;
   int gs_ = 1, GW_ = 0, GH_ = 0;
-  GpuFrame frame_;
-  gpu::ImageBuffer out_[2], prevg_, scratch_, hw_, grid_, tables_;
+  gpu::ImageBuffer scratch_, hw_, grid_, tables_;
   std::vector<gpu::ImageBuffer> pyr_;
   std::vector<int> pyr_w_, pyr_h_;
   int l0_ = 0, nlev_ = 1;
   float frac_ = 0.0f;
-  int cur_ = 0;
-  bool has_prev_id_ = false;
-  Image result_;
-  Status status_;
-  gpu::KernelTiming timing_;
 };
 
 }  // namespace

@@ -152,6 +152,31 @@ Status GpuFrame::upload(const std::shared_ptr<gpu::Context>& context, const Fram
   return Status::ok();
 }
 
+void GpuHistoryState::save_history(Image& state) const {
+  std::vector<float> plane(std::size_t(g_.W) * g_.H);
+  for (int c = 0; c < int(g_.channels.size()); ++c)
+    if (out_[cur_].download(c, plane.data()))
+      put_plane(state, "history." + g_.channels[std::size_t(c)], plane.data(), g_.W, g_.H);
+}
+
+Status GpuHistoryState::load_history(const Image& state) {
+  std::vector<float> plane(std::size_t(g_.W) * g_.H);
+  for (int c = 0; c < int(g_.channels.size()); ++c) {
+    if (Status s = get_plane(state, "history." + g_.channels[std::size_t(c)], plane.data(), g_.W, g_.H); !s)
+      return s;
+    if (Status s = out_[cur_].upload(c, plane.data()); !s) return s;
+  }
+  return Status::ok();
+}
+
+Status GpuHistoryState::store_previous_geometry(const FrameContext& f) {
+  if (Status s = prevg_.copy_plane(frame_.gb, 0, 0); !s) return s;
+  has_prev_id_ = f.id != nullptr;
+  if (has_prev_id_)
+    if (Status s = prevg_.copy_plane(frame_.gb, 7, 1); !s) return s;
+  return Status::ok();
+}
+
 std::string_view sampling_grid_glsl() {
   return R"(
 uniform ivec2 u_full, u_low;

@@ -306,26 +306,17 @@ void main() {
 constexpr const char* kDebugNames[7] = {"debug.confidence", "debug.disocclusion", "debug.gradient", "debug.wf",
                                         "debug.historyWeight", "debug.convergence", "debug.lock"};
 
-class TaauStateGpu final : public MethodState, public gpu::TimedKernel {
+class TaauStateGpu final : public GpuHistoryState {
  public:
   TaauStateGpu(std::shared_ptr<gpu::Context> ctx, gpu::Program low, gpu::Program pixel, gpu::ImageBuffer counters,
                const Geometry& g)
-      : ctx_(std::move(ctx)), low_(std::move(low)), pixel_(std::move(pixel)), counters_(std::move(counters)), g_(g),
-        timer_(ctx_) {}
-
-  Image& run(const FrameContext& f, bool history, FrameStats& stats) override {
-    status_ = run_gpu(f, history, stats);
-    return result_;
-  }
-  Status run_status() const override { return status_; }
+      : GpuHistoryState(std::move(ctx), std::move(counters), g), low_(std::move(low)), pixel_(std::move(pixel)) {}
 
   // The planes TaauState::save writes, from the parity of the last frame.
   void save(Image& state) const override {
     if (out_[0].empty()) return;  // save() cannot report an error; load() names a missing plane
+    save_history(state);
     std::vector<float> plane(std::size_t(g_.W) * g_.H);
-    for (int c = 0; c < int(g_.channels.size()); ++c)
-      if (out_[cur_].download(c, plane.data()))
-        put_plane(state, "history." + g_.channels[std::size_t(c)], plane.data(), g_.W, g_.H);
     const char* names[3] = {"history.weight", "lock.lifetime", "lock.luma"};
     for (int q = 0; q < 3; ++q)
       if (st_.download(3 * cur_ + q, plane.data())) put_plane(state, names[q], plane.data(), g_.W, g_.H);
@@ -335,22 +326,15 @@ class TaauStateGpu final : public MethodState, public gpu::TimedKernel {
   Status load(const Image& state) override {
     if (Status s = allocate(); !s) return s;
     cur_ = 1 - cur_;  // OutputPair::next()
+    if (Status s = load_history(state); !s) return s;
     std::vector<float> plane(std::size_t(g_.W) * g_.H);
-    for (int c = 0; c < int(g_.channels.size()); ++c) {
-      if (Status s = get_plane(state, "history." + g_.channels[std::size_t(c)], plane.data(), g_.W, g_.H); !s)
-        return s;
-      if (Status s = out_[cur_].upload(c, plane.data()); !s) return s;
-    }
     const char* names[3] = {"history.weight", "lock.lifetime", "lock.luma"};
     for (int q = 0; q < 3; ++q) {
       if (Status s = get_plane(state, names[q], plane.data(), g_.W, g_.H); !s) return s;
       if (Status s = st_.upload(3 * cur_ + q, plane.data()); !s) return s;
     }
-    if (Status s = upload_previous_geometry(state, g_, prevg_, has_prev_id_); !s) return s;
-    return Status::ok();
+    return upload_previous_geometry(state, g_, prevg_, has_prev_id_);
   }
-
-  gpu::KernelTiming last_timing() const override { return timing_; }
 
  private:
   // TaauState's constructor: weights, locks and the outputs 0.
@@ -372,7 +356,7 @@ class TaauStateGpu final : public MethodState, public gpu::TimedKernel {
     prog.set("u_locks", int(to.locks));
   }
 
-  Status run_gpu(const FrameContext& f, bool history, FrameStats& stats) {
+  Status run_gpu(const FrameContext& f, bool history, FrameStats& stats) override {
     const TaauOptions& to = taau_options(*f.options);
     if (f.C > 16) return Error::usage("taau on the GPU takes at most 16 payload channels, not " + std::to_string(f.C));
     if (Status s = allocate(); !s) return s;
@@ -433,10 +417,7 @@ class TaauStateGpu final : public MethodState, public gpu::TimedKernel {
         result_.remove_channel(kDebugNames[d]);
       }
     }
-    if (Status s = prevg_.copy_plane(frame_.gb, 0, 0); !s) return s;  // PreviousGeometry::store
-    has_prev_id_ = f.id != nullptr;
-    if (has_prev_id_)
-      if (Status s = prevg_.copy_plane(frame_.gb, 7, 1); !s) return s;
+    if (Status s = store_previous_geometry(f); !s) return s;
     std::uint32_t counts[4] = {};
     if (Status s = counters_.download(0, counts); !s) return s;
     stats.history_pixels = history ? counts[0] : 0;
@@ -444,18 +425,8 @@ class TaauStateGpu final : public MethodState, public gpu::TimedKernel {
     return Status::ok();
   }
 
-  std::shared_ptr<gpu::Context> ctx_;
   gpu::Program low_, pixel_;
-  gpu::ImageBuffer counters_;
-  Geometry g_;
-  gpu::Timer timer_;
-  GpuFrame frame_;
-  gpu::ImageBuffer out_[2], prevg_, st_, lowl_;
-  int cur_ = 0;
-  bool has_prev_id_ = false;
-  Image result_;
-  Status status_;
-  gpu::KernelTiming timing_;
+  gpu::ImageBuffer st_, lowl_;
 };
 
 }  // namespace
