@@ -462,20 +462,6 @@ class DrobotStateGpu final : public GpuHistoryState {
     prog.set("u_pow32", int(o.normal_power == 32.0f));
   }
 
-  Status finish(const FrameContext& f, int debug_planes, const char* const* debug_names) {
-    if (result_.width() != f.W || result_.height() != f.H) result_ = Image(f.W, f.H);
-    for (int c = 0; c < f.C; ++c)
-      if (Status s = out_[cur_].download(c, result_, g_.channels[std::size_t(c)]); !s) return s;
-    for (int d = 0; d < 4; ++d) {
-      if (d < debug_planes && f.debug) {
-        if (Status s = out_[cur_].download(f.C + d, result_, debug_names[d]); !s) return s;
-      } else if (d < debug_planes) {
-        result_.remove_channel(debug_names[d]);
-      }
-    }
-    return Status::ok();
-  }
-
   Status run_gpu(const FrameContext& f, bool history, FrameStats& stats) override {
     return refresh_ ? run_refresh(f, history, stats) : run_cache(f, history, stats);
   }
@@ -580,7 +566,7 @@ class DrobotStateGpu final : public GpuHistoryState {
                           (f.debug ? 4.0 * full : 0.0);
     static const char* const kNames[4] = {"debug.confidence", "debug.disocclusion", "debug.convergence",
                                           "debug.historyWeight"};
-    if (Status s = finish(f, 4, kNames); !s) return s;
+    if (Status s = download_result(f, kNames); !s) return s;
     has_history_ = true;
     has_cache_id_ = f.id != nullptr;
     std::uint32_t counts[4] = {};
@@ -626,7 +612,7 @@ class DrobotStateGpu final : public GpuHistoryState {
     timing_.bytes_moved = 4 * full + f.C * low + f.C * full + 2 * full + full + 2 * (2 * full) + f.C * full +
                           (f.debug ? 3.0 * full : 0.0);  // drobot.cpp's streamed_bytes (refresh mode)
     static const char* const kNames[3] = {"debug.confidence", "debug.disocclusion", "debug.convergence"};
-    if (Status s = finish(f, 3, kNames); !s) return s;
+    if (Status s = download_result(f, kNames); !s) return s;
     if (Status s = store_previous_geometry(f); !s) return s;
     has_history_ = true;
     std::uint32_t counts[4] = {};

@@ -10,6 +10,7 @@
 #include "temporal/gpu/timer.h"
 
 #include <memory>
+#include <span>
 #include <string_view>
 
 namespace temporal::upsample {
@@ -117,6 +118,9 @@ class GpuHistoryState : public MethodState, public gpu::TimedKernel {
   Status load_history(const Image& state);
   // PreviousGeometry::store: this frame's depth and ids (GpuFrame planes 0 and 7) become the previous frame's.
   Status store_previous_geometry(const FrameContext& f);
+  // The frame's output into result_: planes 0..C-1 of out_[cur_] as the payload channels, then with f.debug planes
+  // C.. as `debug_names` (without f.debug those channels are removed from result_).
+  Status download_result(const FrameContext& f, std::span<const char* const> debug_names);
 
   std::shared_ptr<gpu::Context> ctx_;
   gpu::ImageBuffer counters_;

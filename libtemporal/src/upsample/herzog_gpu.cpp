@@ -546,17 +546,7 @@ class HerzogStateGpu final : public GpuHistoryState {
   // Downloads the output (and debug planes), keeps this frame's depth and ids as the previous frame's, and counts
   // the history pixels.
   Status read_back(const FrameContext& f, bool history, FrameStats& stats) {
-    const int C = f.C;
-    if (result_.width() != f.W || result_.height() != f.H) result_ = Image(f.W, f.H);
-    for (int c = 0; c < C; ++c)
-      if (Status s = out_[cur_].download(c, result_, g_.channels[std::size_t(c)]); !s) return s;
-    for (int d = 0; d < 6; ++d) {
-      if (f.debug) {
-        if (Status s = out_[cur_].download(C + d, result_, kDebugNames[d]); !s) return s;
-      } else {
-        result_.remove_channel(kDebugNames[d]);
-      }
-    }
+    if (Status s = download_result(f, kDebugNames); !s) return s;
     if (Status s = store_previous_geometry(f); !s) return s;
     std::uint32_t counts[4] = {};
     if (Status s = counters_.download(0, counts); !s) return s;

@@ -177,6 +177,20 @@ Status GpuHistoryState::store_previous_geometry(const FrameContext& f) {
   return Status::ok();
 }
 
+Status GpuHistoryState::download_result(const FrameContext& f, std::span<const char* const> debug_names) {
+  if (result_.width() != f.W || result_.height() != f.H) result_ = Image(f.W, f.H);
+  for (int c = 0; c < f.C; ++c)
+    if (Status s = out_[cur_].download(c, result_, g_.channels[std::size_t(c)]); !s) return s;
+  for (std::size_t d = 0; d < debug_names.size(); ++d) {
+    if (f.debug) {
+      if (Status s = out_[cur_].download(f.C + int(d), result_, debug_names[d]); !s) return s;
+    } else {
+      result_.remove_channel(debug_names[d]);
+    }
+  }
+  return Status::ok();
+}
+
 std::string_view sampling_grid_glsl() {
   return R"(
 uniform ivec2 u_full, u_low;

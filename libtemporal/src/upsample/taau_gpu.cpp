@@ -407,16 +407,7 @@ class TaauStateGpu final : public GpuHistoryState {
     timing_.bytes_moved = (C * low + 4 * low + 2 * low) + 4 * full + C * low + C * full + 2 * full + full +
                           2 * (2 * full) + C * full + 3 * 2 * full + 2 * low + (f.debug ? 7.0 * full : 0.0);
 
-    if (result_.width() != f.W || result_.height() != f.H) result_ = Image(f.W, f.H);
-    for (int c = 0; c < C; ++c)
-      if (Status s = out_[cur_].download(c, result_, g_.channels[std::size_t(c)]); !s) return s;
-    for (int d = 0; d < 7; ++d) {
-      if (f.debug) {
-        if (Status s = out_[cur_].download(C + d, result_, kDebugNames[d]); !s) return s;
-      } else {
-        result_.remove_channel(kDebugNames[d]);
-      }
-    }
+    if (Status s = download_result(f, kDebugNames); !s) return s;
     if (Status s = store_previous_geometry(f); !s) return s;
     std::uint32_t counts[4] = {};
     if (Status s = counters_.download(0, counts); !s) return s;

@@ -117,13 +117,8 @@ class TemporalStateGpu final : public GpuHistoryState {
     timing_.bytes_moved = 4.0 * full + f.C * low + f.C * full + 2 * full + full + 2 * (2 * full) + f.C * full +
                           (f.debug ? 2.0 * full : 0.0);
 
-    if (result_.width() != f.W || result_.height() != f.H) result_ = Image(f.W, f.H);
-    for (int c = 0; c < f.C; ++c)
-      if (Status s = out_[cur_].download(c, result_, g_.channels[std::size_t(c)]); !s) return s;
-    if (f.debug) {
-      if (Status s = out_[cur_].download(f.C, result_, "debug.disocclusion"); !s) return s;
-      if (Status s = out_[cur_].download(f.C + 1, result_, "debug.confidence"); !s) return s;
-    }
+    static const char* const kDebugNames[2] = {"debug.disocclusion", "debug.confidence"};
+    if (Status s = download_result(f, kDebugNames); !s) return s;
     if (Status s = store_previous_geometry(f); !s) return s;
     std::uint32_t counts[4] = {};
     if (Status s = counters_.download(0, counts); !s) return s;
