@@ -153,8 +153,9 @@ Outcome compare(std::shared_ptr<gpu::Context> ctx, const std::vector<Frame>& fra
     if (debug) {
       r.debug_values.merge(test::slots_agreement(b, a, {"debug.distortion", "debug.blur", "debug.H", "debug.Hprime"}));
       for (std::size_t k = 0; k < a.size(); ++k) {
-        r.grid_pixels += std::size_t(std::count_if(a[k].plane("debug.grid"), a[k].plane("debug.grid") + f.color.pixel_count(),
-                                                   [](float v) { return v != 0.0f; }));
+        const float* grid = a[k].plane("debug.grid");
+        r.grid_pixels +=
+            std::size_t(std::count_if(grid, grid + f.color.pixel_count(), [](float v) { return v != 0.0f; }));
         r.grid_differing += test::differing_values(b[k], a[k], "debug.grid");
       }
     }

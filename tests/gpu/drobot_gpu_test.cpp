@@ -45,9 +45,9 @@ Options options_with(const std::function<void(DrobotOptions&)>& set) { return te
 // GCC (and the fast_exp2 / fast_log2 polynomials for a --normal-power other than 32): float roundings; every decision
 // (cache hit, a block's validity) is the same. Measured on llvmpipe (Mesa 22.3.6, 2026-11-26): max |GPU - CPU|
 // 6.6e-7 (PSNR >= 137.3 dB) over both modes and every option, round trips 3.6e-7 (re-measured with the 1e20 sample,
-// 2026-11-26); the debug planes within 4.3e-7 (relative weight sum) and 1.9e-6 (frame count). Before refresh mode's fallback read 0
-// at a tap that is no sample, the 1e20 sample made refresh mode differ by 1.1e12: the sample reached the output on
-// both devices, and a float rounding of 1e20 is ~1e13.
+// 2026-11-26); the debug planes within 4.3e-7 (relative weight sum) and 1.9e-6 (frame count). Before refresh mode's
+// fallback read 0 at a tap that is no sample, the 1e20 sample made refresh mode differ by 1.1e12: the sample reached
+// the output on both devices, and a float rounding of 1e20 is ~1e13.
 constexpr double kDrobotMaxAbs = 2e-6, kDrobotPsnr = 125.0;
 // The debug planes: the Listing 7.1 weight sum relative, Listing 7.2's confidence / the convergence and the frame
 // count absolute.
@@ -150,7 +150,8 @@ TEST(DrobotGpu, LoadNamesAMissingPlane) {
 // The registry's "gpu" implementation of herzog (what --device gpu picks): the same kernels on the shared context.
 TEST(DrobotGpu, IsRegisteredAsTheGpuImplementation) {
   TEMPORAL_GPU_CONTEXT_OR_SKIP(ctx);
-  const test::RegisteredComparison r = test::compare_registered(*find_entry("drobot"), options_with(nullptr), sequence(3));
+  const test::RegisteredComparison r =
+      test::compare_registered(*find_entry("drobot"), options_with(nullptr), sequence(3));
   EXPECT_TRUE(r.timed);
   EXPECT_LE(r.colour.max_abs, kDrobotMaxAbs);
 }

@@ -130,14 +130,16 @@ TEST(HerzogGpu, StateResumesOnTheCpuAndBack) {
 
 TEST(HerzogGpu, LoadNamesAMissingPlane) {
   TEMPORAL_GPU_CONTEXT_OR_SKIP(ctx);
-  const std::string error = test::load_error_with_only(ctx, make_herzog_state_gpu, options_with(nullptr), {"history.R", "history.G", "history.B"});
+  const std::string error = test::load_error_with_only(ctx, make_herzog_state_gpu, options_with(nullptr),
+                                                       {"history.R", "history.G", "history.B"});
   EXPECT_NE(error.find("history.weight"), std::string::npos) << error;
 }
 
 // The registry's "gpu" implementation of herzog (what --device gpu picks): the same kernels on the shared context.
 TEST(HerzogGpu, IsRegisteredAsTheGpuImplementation) {
   TEMPORAL_GPU_CONTEXT_OR_SKIP(ctx);
-  const test::RegisteredComparison r = test::compare_registered(*find_entry("herzog"), options_with(nullptr), sequence(3));
+  const test::RegisteredComparison r =
+      test::compare_registered(*find_entry("herzog"), options_with(nullptr), sequence(3));
   EXPECT_TRUE(r.timed);
   EXPECT_LE(r.colour.max_abs, kHerzogMaxAbs);
 }

@@ -68,8 +68,9 @@ Comparison compare(const std::shared_ptr<gpu::Context>& ctx, const Options& o, b
     if (const float* lock = cpu.plane("debug.lock"))
       for (std::size_t i = 0; i < cpu.pixel_count(); ++i) r.locked_pixels += lock[i] > 0.0f;
   };
-  static_cast<test::StateComparison&>(r) = test::compare_method(
-      ctx, "taau", make_taau_state_gpu, o, {frames, 6, warped, debug}, {"debug.disocclusion"}, kDebugBounds, count_locks);
+  test::StateComparison& states = r;  // compare_method fills this part; count_locks the rest
+  states = test::compare_method(ctx, "taau", make_taau_state_gpu, o, {frames, 6, warped, debug}, {"debug.disocclusion"},
+                                kDebugBounds, count_locks);
   return r;
 }
 
@@ -145,20 +146,23 @@ TEST(TaauGpu, StateResumesOnTheCpuAndBack) {
       "prev.id"};
   test::expect_resumes_on_either_device(
       ctx, "taau", make_taau_state_gpu, sequence(12),
-      {{"", options_with(nullptr), planes}, {"_no_locks", options_with([](TaauOptions& h) { h.locks = false; }), planes}},
+      {{"", options_with(nullptr), planes},
+       {"_no_locks", options_with([](TaauOptions& h) { h.locks = false; }), planes}},
       kTaauMaxAbs, kTaauPsnr);
 }
 
 TEST(TaauGpu, LoadNamesAMissingPlane) {
   TEMPORAL_GPU_CONTEXT_OR_SKIP(ctx);
-  const std::string error = test::load_error_with_only(ctx, make_taau_state_gpu, options_with(nullptr), {"history.R", "history.G", "history.B"});
+  const std::string error = test::load_error_with_only(ctx, make_taau_state_gpu, options_with(nullptr),
+                                                       {"history.R", "history.G", "history.B"});
   EXPECT_NE(error.find("history.weight"), std::string::npos) << error;
 }
 
 // The registry's "gpu" implementation of herzog (what --device gpu picks): the same kernels on the shared context.
 TEST(TaauGpu, IsRegisteredAsTheGpuImplementation) {
   TEMPORAL_GPU_CONTEXT_OR_SKIP(ctx);
-  const test::RegisteredComparison r = test::compare_registered(*find_entry("taau"), options_with(nullptr), sequence(3));
+  const test::RegisteredComparison r =
+      test::compare_registered(*find_entry("taau"), options_with(nullptr), sequence(3));
   EXPECT_TRUE(r.timed);
   EXPECT_LE(r.colour.max_abs, kTaauMaxAbs);
 }

@@ -97,8 +97,9 @@ struct StateComparison {
 // Runs the C++ state `cpu` and the GPU state `gpu` on the same frames and compares their outputs frame by frame: the
 // colour, the statistics, and with s.debug the planes of `exact_planes` (decisions, equal value for value) and of
 // `debug_bounds`. `each_frame(cpu_output, gpu_output)`, when given, sees both outputs of every frame.
-inline StateComparison compare_states(upsample::MethodState& cpu, upsample::MethodState& gpu, const upsample::Options& o,
-                                      const StateSequence& s, const std::vector<std::string>& exact_planes = {},
+inline StateComparison compare_states(upsample::MethodState& cpu, upsample::MethodState& gpu,
+                                      const upsample::Options& o, const StateSequence& s,
+                                      const std::vector<std::string>& exact_planes = {},
                                       const std::vector<DebugPlaneBound>& debug_bounds = {},
                                       const std::function<void(const Image&, const Image&)>& each_frame = {}) {
   static const std::vector<std::string> kRgb = {"R", "G", "B"};
@@ -257,7 +258,8 @@ inline void expect_resumes_on_either_device(const std::shared_ptr<gpu::Context>&
   for (const ResumeCase& c : cases)
     for (bool gpu_first : {true, false}) {
       SCOPED_TRACE(::testing::Message() << (gpu_first ? "GPU -> CPU" : "CPU -> GPU") << " " << c.suffix);
-      const Agreement a = resume_on_the_other_device(ctx, method, make_gpu, c.options, frames, split, gpu_first, c.planes);
+      const Agreement a =
+          resume_on_the_other_device(ctx, method, make_gpu, c.options, frames, split, gpu_first, c.planes);
       expect_within(a, max_abs, min_psnr);
       ::testing::Test::RecordProperty(std::string("round_trip_max_abs_") + (gpu_first ? "gpu_cpu" : "cpu_gpu") +
                                           c.suffix,

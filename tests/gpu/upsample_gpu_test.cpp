@@ -54,9 +54,9 @@ TEST(TemporalGpu, MatchesTheCppMethod) {
 
 TEST(TemporalGpu, StateResumesOnTheCpuAndBack) {
   TEMPORAL_GPU_CONTEXT_OR_SKIP(ctx);
+  const test::StatePlanes planes = {{"history.R", "history.G", "history.B", "prev.depth"}, "prev.id"};
   test::expect_resumes_on_either_device(ctx, "temporal", make_temporal_state_gpu, test::upsample_gpu_sequence(12),
-                                        {{"", Options{}, {{"history.R", "history.G", "history.B", "prev.depth"}, "prev.id"}}},
-                                        kUpsampleMaxAbs, kUpsamplePsnr);
+                                        {{"", Options{}, planes}}, kUpsampleMaxAbs, kUpsamplePsnr);
 }
 
 TEST(TemporalGpu, LoadNamesAMissingPlane) {
