@@ -51,6 +51,10 @@ struct Agreement {
     values_beyond += g.values_beyond;
   }
   double share_beyond() const { return values ? double(values_beyond) / double(values) : 0.0; }
+
+  // The agreement of a comparison that could not run (a missing plane, a state that was not made): as bad as can
+  // be, so that every bound fails.
+  static Agreement failed() { return {INFINITY, 0.0, 0, 1, 1}; }
 };
 
 inline Agreement agreement(const float* a, const float* b, std::size_t n, double beyond = 0.0) {
@@ -84,7 +88,7 @@ inline Agreement agreement(const Image& a, const Image& b, const std::vector<std
     const float* pa = a.plane(c);
     const float* pb = b.plane(c);
     EXPECT_TRUE(pa && pb) << "channel " << c;
-    if (!pa || !pb) return {INFINITY, 0.0, 0, 1, 1};
+    if (!pa || !pb) return Agreement::failed();
     worst.merge(agreement(pa, pb, a.pixel_count(), beyond));
   }
   return worst;

@@ -185,7 +185,7 @@ Comparison compare_case(const std::shared_ptr<gpu::Context>& ctx, const Factory&
                         const std::vector<std::string>& debug_planes) {
   auto gpu = make_gpu(ctx);
   EXPECT_TRUE(gpu) << gpu.error().message;
-  if (!gpu) return {{INFINITY, 0.0, 0, 1, 1}};
+  if (!gpu) return {test::Agreement::failed()};
   return compare(**gpu, *make_cpu(), frames, 0, int(frames.size()), o, debug_planes);
 }
 

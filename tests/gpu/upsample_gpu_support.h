@@ -1,8 +1,10 @@
 // Shared by the upsampling methods' GPU tests (upsample_gpu_test.cpp, herzog_gpu_test.cpp, taau_gpu_test.cpp,
 // drobot_gpu_test.cpp, upsample_render_gpu_test.cpp): the synthetic sequence, a method's options and C++ state,
-// and the three comparisons each of them makes between a method's C++ state (the reference of record) and its GPU
-// state: over a sequence (compare_states), after a state file moved between the devices (resume_on_the_other_device),
-// and the bounds every method's sequence comparison is held to (expect_state_agreement).
+// and the comparisons each of them makes between a method's C++ state (the reference of record) and its GPU state:
+// over a sequence (compare_states, compare_method) and the bounds that comparison is held to
+// (expect_state_agreement), after a state file moved between the devices (resume_on_the_other_device,
+// expect_resumes_on_either_device), through the registry's implementations (compare_registered), and what load()
+// says of a state file that lacks a plane (load_error_with_only).
 #pragma once
 
 #include "gpu_methods.h"  // libtemporal/src/upsample (internal)
@@ -204,7 +206,7 @@ inline Agreement resume_on_the_other_device(const std::shared_ptr<gpu::Context>&
   auto cpu = cpu_state(method, o, g);
   auto gpu = make_gpu(ctx, o, g);
   EXPECT_TRUE(gpu) << gpu.error().message;
-  if (!gpu) return {INFINITY, 0.0, 0, 1, 1};
+  if (!gpu) return Agreement::failed();
   upsample::MethodState& first = gpu_first ? **gpu : *cpu;
   upsample::MethodState& second = gpu_first ? *cpu : **gpu;
   for (int t = 0; t < split; ++t) {
@@ -217,7 +219,7 @@ inline Agreement resume_on_the_other_device(const std::shared_ptr<gpu::Context>&
   EXPECT_TRUE(state.uint_plane(planes.ids)) << planes.ids;
   const Status loaded = second.load(state);
   EXPECT_TRUE(loaded) << loaded.error().message;
-  if (!loaded) return {INFINITY, 0.0, 0, 1, 1};
+  if (!loaded) return Agreement::failed();
   Image got;
   for (int t = split; t < int(frames.size()); ++t) {
     build_context(f, o, frames[std::size_t(t)], true, false);
@@ -270,7 +272,7 @@ inline void expect_resumes_on_either_device(const std::shared_ptr<gpu::Context>&
 // The registry's "gpu" implementation of a method (what --device gpu picks) against its "cpu" one on `frames`
 // (warped depth, no cut): the colour's agreement, and whether the GPU state reports its kernel time.
 struct RegisteredComparison {
-  Agreement colour{INFINITY, 0.0, 0, 1, 1};  // as bad as can be until both implementations ran
+  Agreement colour = Agreement::failed();  // until both implementations ran
   bool timed = false;
 };
 inline RegisteredComparison compare_registered(const upsample::MethodEntry& entry, const upsample::Options& o,
