@@ -9,9 +9,11 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstring>
 #include <limits>
 #include <random>
+#include <vector>
 
 namespace {
 
@@ -62,6 +64,29 @@ TEST(GpuStage, ImageBufferRoundTripsFloatAndUintPlanesBitForBit) {
   EXPECT_EQ(std::memcmp(back.uint_plane("id"), u, img.pixel_count() * 4), 0);
   EXPECT_FALSE(buf->upload(0, img, "G"));  // a missing channel is an error, not garbage
   EXPECT_FALSE(buf->download(2, back, "X"));
+}
+
+// create_all / create_all_cleared (the buffers of one frame size made together): every buffer its shape, cleared
+// when asked; one that cannot be made (past the device's storage block size) leaves every buffer as it was.
+TEST(GpuStage, ImageBufferSetIsMadeWholeOrNotAtAll) {
+  TEMPORAL_GPU_CONTEXT_OR_SKIP(ctx);
+  gpu::ImageBuffer a, b;
+  ASSERT_TRUE(gpu::ImageBuffer::create_all_cleared(ctx, {{&a, 5, 3, 2}, {&b, 7, 1, 1}}));
+  EXPECT_EQ(a.width(), 5);
+  EXPECT_EQ(a.height(), 3);
+  EXPECT_EQ(a.planes(), 2);
+  EXPECT_EQ(b.width(), 7);
+  EXPECT_EQ(b.planes(), 1);
+  std::vector<float> plane(a.pixel_count(), 1.0f);
+  ASSERT_TRUE(a.download(1, plane.data()));
+  EXPECT_EQ(std::count(plane.begin(), plane.end(), 0.0f), 15);
+  const int too_many = int(ctx->max_storage_bytes() / (16 * 16 * 4)) + 1;
+  const Status s = gpu::ImageBuffer::create_all(ctx, {{&a, 16, 16, 1}, {&b, 16, 16, too_many}});
+  ASSERT_FALSE(s);
+  EXPECT_NE(s.error().message.find("exceeds the device's storage block size"), std::string::npos) << s.error().message;
+  EXPECT_EQ(a.width(), 5);
+  EXPECT_EQ(a.planes(), 2);
+  EXPECT_EQ(b.width(), 7);
 }
 
 TEST(GpuStage, CompileErrorsCarryTheDriversLog) {

@@ -82,12 +82,11 @@ FilterInput input_for(const Frame& f, int t, const InputOptions& o) {
   return in;
 }
 
-// Runs both filters over frames [first, last) and returns the worst agreement of the filtered channels; the
-// debug planes and the counts must match exactly (they are decisions, not sums).
+// Runs both filters over frames [first, last) and returns the worst agreement of the filtered channels (with the
+// values beyond 1e-5 counted); the debug planes and the counts must match exactly (they are decisions, not sums).
 struct Comparison {
   test::Agreement colour;
   std::size_t debug_mismatches = 0, stat_mismatches = 0;
-  std::size_t values_over = 0, values = 0;  // output values differing by more than 1e-5, of all compared
 };
 
 Comparison compare(FrameFilter& gpu, FrameFilter& cpu, const std::vector<Frame>& frames, int first, int last,
@@ -102,25 +101,20 @@ Comparison compare(FrameFilter& gpu, FrameFilter& cpu, const std::vector<Frame>&
     EXPECT_TRUE(a) << a.error().message;
     EXPECT_TRUE(b) << b.error().message;
     if (!a || !b) return r;
-    const test::Agreement g = test::agreement(out_gpu, out_cpu, in.channels);
-    for (const auto& ch : in.channels)
-      for (std::size_t i = 0; i < out_cpu.pixel_count(); ++i) {
-        r.values_over += std::abs(out_gpu.plane(ch)[i] - out_cpu.plane(ch)[i]) > 1e-5f;
-        ++r.values;
-      }
-    r.colour.merge(g);
+    r.colour.merge(test::agreement(out_gpu, out_cpu, in.channels, 1e-5));
     if (o.debug)
-      for (const auto& d : debug_planes) {
-        const float* pg = out_gpu.plane(d);
-        const float* pc = out_cpu.plane(d);
-        EXPECT_TRUE(pg && pc) << d;
-        if (!pg || !pc) continue;
-        for (std::size_t i = 0; i < out_cpu.pixel_count(); ++i) r.debug_mismatches += pg[i] != pc[i] ? 1 : 0;
-      }
+      for (const auto& d : debug_planes) r.debug_mismatches += test::differing_values(out_gpu, out_cpu, d);
     r.stat_mismatches += (sg.non_finite != sc.non_finite) + (sg.history_resets != sc.history_resets) +
                          (sg.clamped != sc.clamped);
   }
   return r;
+}
+
+// The measured agreement of case `index` in the test's XML properties.
+void record(const std::string& prefix, int index, const test::Agreement& a) {
+  ::testing::Test::RecordProperty(prefix + "max_abs_" + std::to_string(index),
+                                  (::testing::Message() << a.max_abs).GetString());
+  ::testing::Test::RecordProperty(prefix + "psnr_" + std::to_string(index), std::to_string(a.psnr));
 }
 
 using Factory = std::function<Expected<std::unique_ptr<FrameFilter>>(std::shared_ptr<gpu::Context>)>;
@@ -159,6 +153,42 @@ test::Agreement round_trip(std::shared_ptr<gpu::Context> ctx, const Factory& mak
   return test::agreement(out, ref_out, o.mono ? std::vector<std::string>{"G"} : kRgb);
 }
 
+// round_trip in both directions within the filter's bounds.
+void expect_resumes_on_either_device(const std::shared_ptr<gpu::Context>& ctx, const Factory& make_gpu,
+                                     const CpuFactory& make_cpu, double max_abs, double min_psnr) {
+  for (bool gpu_first : {true, false}) {
+    SCOPED_TRACE(gpu_first ? "GPU -> CPU" : "CPU -> GPU");
+    test::expect_within(round_trip(ctx, make_gpu, make_cpu, gpu_first, {}), max_abs, min_psnr);
+  }
+}
+
+// The input variants of the filter comparisons besides the defaults: one channel (G), no motion, a reset at frame 4.
+InputOptions mono_input() {
+  InputOptions o;
+  o.mono = true;
+  return o;
+}
+InputOptions no_motion_input() {
+  InputOptions o;
+  o.motion = false;
+  return o;
+}
+InputOptions reset_at_frame_4() {
+  InputOptions o;
+  o.reset_frame = 4;
+  return o;
+}
+
+// One case of a filter comparison: the GPU filter `make_gpu` makes against the C++ one over every frame (compare).
+Comparison compare_case(const std::shared_ptr<gpu::Context>& ctx, const Factory& make_gpu, const CpuFactory& make_cpu,
+                        const std::vector<Frame>& frames, const InputOptions& o,
+                        const std::vector<std::string>& debug_planes) {
+  auto gpu = make_gpu(ctx);
+  EXPECT_TRUE(gpu) << gpu.error().message;
+  if (!gpu) return {test::Agreement::failed()};
+  return compare(**gpu, *make_cpu(), frames, 0, int(frames.size()), o, debug_planes);
+}
+
 // --- EMA -----------------------------------------------------------------------------------------------------
 // The same arithmetic as ema.cpp (one multiply-add per channel after the same bilinear gather): differences are
 // float rounding of FMA contraction only, and every decision (debug.reject, the counts) is equal. Measured on
@@ -182,17 +212,11 @@ TEST(EmaGpu, MatchesTheCppFilter) {
                                InputOptions{true, true, true, false, false, true, 5}}) {
     SCOPED_TRACE(::testing::Message() << "motion " << o.motion << " depth " << o.depth << " ids " << o.ids
                                       << " warped " << o.warped << " mono " << o.mono << " reset " << o.reset_frame);
-    auto gpu = make_ema_filter_gpu(ctx);
-    ASSERT_TRUE(gpu) << gpu.error().message;
-    EmaFilter cpu;
-    const Comparison r = compare(**gpu, cpu, frames, 0, int(frames.size()), o, {"debug.reject"});
-    EXPECT_LE(r.colour.max_abs, kEmaMaxAbs);
-    EXPECT_GE(r.colour.psnr, kEmaPsnr);
-    EXPECT_EQ(r.colour.finiteness_mismatches, 0u);
+    const Comparison r = compare_case(ctx, ema_gpu(), ema_cpu(), frames, o, {"debug.reject"});
+    test::expect_within(r.colour, kEmaMaxAbs, kEmaPsnr);
     EXPECT_EQ(r.debug_mismatches, 0u);
     EXPECT_EQ(r.stat_mismatches, 0u);
-    RecordProperty("max_abs_" + std::to_string(case_index), (::testing::Message() << r.colour.max_abs).GetString());
-    RecordProperty("psnr_" + std::to_string(case_index++), std::to_string(r.colour.psnr));
+    record("", case_index++, r.colour);
   }
 }
 
@@ -212,13 +236,7 @@ TEST(EmaGpu, ReportsItsKernelTime) {
 
 TEST(EmaGpu, StateResumesOnTheCpuAndBack) {
   TEMPORAL_GPU_CONTEXT_OR_SKIP(ctx);
-  for (bool gpu_first : {true, false}) {
-    SCOPED_TRACE(gpu_first ? "GPU -> CPU" : "CPU -> GPU");
-    const test::Agreement g = round_trip(ctx, ema_gpu(), ema_cpu(), gpu_first, {});
-    EXPECT_LE(g.max_abs, kEmaMaxAbs);
-    EXPECT_GE(g.psnr, kEmaPsnr);
-    EXPECT_EQ(g.finiteness_mismatches, 0u);
-  }
+  expect_resumes_on_either_device(ctx, ema_gpu(), ema_cpu(), kEmaMaxAbs, kEmaPsnr);
 }
 
 TEST(EmaGpu, RefusesAStateWithoutHistory) {
@@ -261,41 +279,23 @@ TEST(TaaGpu, MatchesTheCppFilter) {
   TaaParams nearest;
   nearest.history = "nearest";
   nearest.alpha = 0.1f;
-  InputOptions mono;
-  mono.mono = true;
-  InputOptions no_motion;
-  no_motion.motion = false;
-  InputOptions reset;
-  reset.reset_frame = 4;
   int case_index = 0;  // the measured agreement of each case goes to the test's XML properties
-  for (const Case& c : {Case{{}, {}}, Case{minmax, {}}, Case{nearest, {}}, Case{{}, mono}, Case{{}, no_motion},
-                        Case{minmax, reset}}) {
+  for (const Case& c : {Case{{}, {}}, Case{minmax, {}}, Case{nearest, {}}, Case{{}, mono_input()},
+                        Case{{}, no_motion_input()}, Case{minmax, reset_at_frame_4()}}) {
     SCOPED_TRACE(::testing::Message() << "clip " << c.params.clip << " history " << c.params.history << " velocity "
                                       << c.params.velocity << " mono " << c.input.mono << " motion "
                                       << c.input.motion << " reset " << c.input.reset_frame);
-    auto gpu = make_taa_filter_gpu(ctx, c.params);
-    ASSERT_TRUE(gpu) << gpu.error().message;
-    TaaFilter cpu(c.params);
-    const Comparison r = compare(**gpu, cpu, frames, 0, int(frames.size()), c.input,
-                          {"debug.noHistory", "debug.velocity.X", "debug.velocity.Y"});
-    EXPECT_LE(r.colour.max_abs, kTaaMaxAbs);
-    EXPECT_GE(r.colour.psnr, kTaaPsnr);
-    EXPECT_EQ(r.colour.finiteness_mismatches, 0u);
+    const Comparison r = compare_case(ctx, taa_gpu(c.params), taa_cpu(c.params), frames, c.input,
+                                      {"debug.noHistory", "debug.velocity.X", "debug.velocity.Y"});
+    test::expect_within(r.colour, kTaaMaxAbs, kTaaPsnr);
     EXPECT_EQ(r.debug_mismatches, 0u);
-    RecordProperty("max_abs_" + std::to_string(case_index), (::testing::Message() << r.colour.max_abs).GetString());
-    RecordProperty("psnr_" + std::to_string(case_index++), std::to_string(r.colour.psnr));
+    record("", case_index++, r.colour);
   }
 }
 
 TEST(TaaGpu, StateResumesOnTheCpuAndBack) {
   TEMPORAL_GPU_CONTEXT_OR_SKIP(ctx);
-  for (bool gpu_first : {true, false}) {
-    SCOPED_TRACE(gpu_first ? "GPU -> CPU" : "CPU -> GPU");
-    const test::Agreement g = round_trip(ctx, taa_gpu(), taa_cpu(), gpu_first, {});
-    EXPECT_LE(g.max_abs, kTaaMaxAbs);
-    EXPECT_GE(g.psnr, kTaaPsnr);
-    EXPECT_EQ(g.finiteness_mismatches, 0u);
-  }
+  expect_resumes_on_either_device(ctx, taa_gpu(), taa_cpu(), kTaaMaxAbs, kTaaPsnr);
 }
 
 TEST(TaaGpu, SameUsageErrorsAsTheCppFilter) {
@@ -346,38 +346,21 @@ TEST(PhlmGpu, MatchesTheCppFilter) {
   no_box.no_box_test = true;
   eq1.alpha_reading = "eq1";
   phi_linear.feature_phi = "linear";  // issue 24's ablation: phi = (a + b v) l
-  InputOptions mono;
-  mono.mono = true;
-  InputOptions no_motion;
-  no_motion.motion = false;
-  InputOptions reset;
-  reset.reset_frame = 4;
   int case_index = 0;  // the measured agreement of each case goes to the test's XML properties
   for (const Case& c : {Case{{}, {}}, Case{nearest, {}}, Case{catmull, {}}, Case{no_feature, {}}, Case{no_box, {}},
-                        Case{eq1, {}}, Case{phi_linear, {}}, Case{{}, mono}, Case{{}, no_motion}, Case{{}, reset}}) {
+                        Case{eq1, {}}, Case{phi_linear, {}}, Case{{}, mono_input()}, Case{{}, no_motion_input()},
+                        Case{{}, reset_at_frame_4()}}) {
     SCOPED_TRACE(::testing::Message() << "case " << case_index);
-    auto gpu = make_phlm_filter_gpu(ctx, c.params);
-    ASSERT_TRUE(gpu) << gpu.error().message;
-    PhlmFilter cpu(c.params);
-    const Comparison r = compare(**gpu, cpu, frames, 0, int(frames.size()), c.input, {"debug.reset"});
-    EXPECT_LE(r.colour.max_abs, kPhlmMaxAbs);
-    EXPECT_GE(r.colour.psnr, kPhlmPsnr);
-    EXPECT_EQ(r.colour.finiteness_mismatches, 0u);
+    const Comparison r = compare_case(ctx, phlm_gpu(c.params), phlm_cpu(c.params), frames, c.input, {"debug.reset"});
+    test::expect_within(r.colour, kPhlmMaxAbs, kPhlmPsnr);
     EXPECT_EQ(r.debug_mismatches, 0u);
-    RecordProperty("phlm_max_abs_" + std::to_string(case_index), (::testing::Message() << r.colour.max_abs).GetString());
-    RecordProperty("phlm_psnr_" + std::to_string(case_index++), std::to_string(r.colour.psnr));
+    record("phlm_", case_index++, r.colour);
   }
 }
 
 TEST(PhlmGpu, StateResumesOnTheCpuAndBack) {
   TEMPORAL_GPU_CONTEXT_OR_SKIP(ctx);
-  for (bool gpu_first : {true, false}) {
-    SCOPED_TRACE(gpu_first ? "GPU -> CPU" : "CPU -> GPU");
-    const test::Agreement g = round_trip(ctx, phlm_gpu(), phlm_cpu(), gpu_first, {});
-    EXPECT_LE(g.max_abs, kPhlmMaxAbs);
-    EXPECT_GE(g.psnr, kPhlmPsnr);
-    EXPECT_EQ(g.finiteness_mismatches, 0u);
-  }
+  expect_resumes_on_either_device(ctx, phlm_gpu(), phlm_cpu(), kPhlmMaxAbs, kPhlmPsnr);
 }
 
 TEST(PhlmGpu, RefusesWhatTheCppFilterRefuses) {
@@ -433,13 +416,12 @@ TEST(FxaaGpu, MatchesTheCppFilter) {
     EXPECT_FALSE(find_entry("fxaa")->info.has_state);
     const Comparison r = compare(**gpu, cpu, frames, 0, int(frames.size()), o, {"debug.edge"});
     EXPECT_GE(r.colour.psnr, kFxaaPsnr);
-    EXPECT_LE(double(r.values_over), kFxaaMaxShareOver * double(r.values));
+    EXPECT_LE(r.colour.share_beyond(), kFxaaMaxShareOver);
     EXPECT_EQ(r.colour.finiteness_mismatches, 0u);
     EXPECT_EQ(r.debug_mismatches, 0u);
     EXPECT_EQ(r.stat_mismatches, 0u);
-    RecordProperty("max_abs_" + std::to_string(case_index), (::testing::Message() << r.colour.max_abs).GetString());
-    RecordProperty("psnr_" + std::to_string(case_index), std::to_string(r.colour.psnr));
-    RecordProperty("share_over_" + std::to_string(case_index++), std::to_string(double(r.values_over) / double(r.values)));
+    RecordProperty("share_over_" + std::to_string(case_index), std::to_string(r.colour.share_beyond()));
+    record("", case_index++, r.colour);
   }
   auto gpu = make_fxaa_filter_gpu(ctx);
   ASSERT_TRUE(gpu);

@@ -4,10 +4,8 @@
 // depth (prevDepth.Z) and ids. The synthetic tests (herzog_gpu_test.cpp, taau_gpu_test.cpp, upsample_gpu_test.cpp)
 // cover every option; this one checks that real G-buffers (HDR payload, skinned motion, silhouettes) keep the same
 // agreement. The method states are run directly, as in those tests.
-#include "gpu_methods.h"
-#include "gpu_support.h"
 #include "test_support.h"
-#include "upsample_context.h"
+#include "upsample_gpu_support.h"
 
 #include "temporal/render/render.h"
 #include "temporal/scene/scene.h"
@@ -18,7 +16,6 @@ namespace {
 
 using namespace temporal;
 using namespace temporal::upsample;
-const std::vector<std::string> kRgb = {"R", "G", "B"};
 
 // Frames 5-12 of walkers.glb at 40 fps (each with its previous frame's state for the motion), G-buffer and shade.
 const std::vector<test::SyntheticFrame>& rendered() {
@@ -65,45 +62,23 @@ const std::vector<test::SyntheticFrame>& rendered() {
   return frames;
 }
 
-using GpuFactory = Expected<std::unique_ptr<MethodState>> (*)(std::shared_ptr<gpu::Context>, const Options&,
-                                                             const Geometry&);
-
 struct Result {
-  test::Agreement colour;
+  test::StateComparison states;
   double peak = 0.0;  // the largest |value| of the C++ output (the payload is HDR)
-  std::size_t stat_mismatches = 0, misses = 0, history_pixels = 0;
 };
 
-Result compare(const std::shared_ptr<gpu::Context>& ctx, const char* method, GpuFactory make_gpu) {
+// The rendered frames with a cut after the fourth and the renderer's warped depth (prevDepth.Z), default options.
+Result compare(const std::shared_ptr<gpu::Context>& ctx, const char* method, test::GpuStateFactory make_gpu) {
   const auto& frames = rendered();
   Result r;
   if (frames.empty()) return r;
-  const Options o;
-  const Geometry g = test::geometry_of(frames[0]);
-  auto cpu = find_implementation(*find_entry(method), kCpuDevice)->make(o, g);
-  auto gpu = make_gpu(ctx, o, g);
-  EXPECT_TRUE(gpu) << gpu.error().message;
-  if (!gpu) return r;
-  FrameContext f;
-  for (int t = 0; t < int(frames.size()); ++t) {
-    test::build_context(f, o, frames[std::size_t(t)], false, false);
-    f.prev_z = frames[std::size_t(t)].gbuffer.plane("prevDepth.Z");  // the renderer's warped depth
-    EXPECT_NE(f.prev_z, nullptr);
-    const bool history = t > 0 && t != 4;  // a cut after the fourth frame
-    FrameStats sc, sg;
-    const Image& a = cpu->run(f, history, sc);
-    const Image& b = (*gpu)->run(f, history, sg);
-    EXPECT_TRUE((*gpu)->run_status()) << (*gpu)->run_status().error().message;
-    const test::Agreement ag = test::agreement(b, a, kRgb);
-    r.colour.merge(ag);
-    for (const auto& c : kRgb)
-      for (std::size_t i = 0; i < a.pixel_count(); ++i) r.peak = std::max(r.peak, double(std::abs(a.plane(c)[i])));
-    r.stat_mismatches += (sc.hole_pixels != sg.hole_pixels) + (sc.history_pixels != sg.history_pixels);
-    if (history) {
-      r.misses += sc.hole_pixels;
-      r.history_pixels += sc.history_pixels;
-    }
-  }
+  auto peak = [&r](const Image& cpu, const Image&) {
+    for (const char* c : {"R", "G", "B"})
+      for (std::size_t i = 0; i < cpu.pixel_count(); ++i) r.peak = std::max(r.peak, double(std::abs(cpu.plane(c)[i])));
+  };
+  test::StateSequence sequence{frames, 4, false, false};
+  sequence.warped_depth_plane = "prevDepth.Z";
+  r.states = test::compare_method(ctx, method, make_gpu, Options{}, sequence, {}, {}, peak);
   return r;
 }
 
@@ -114,17 +89,18 @@ Result compare(const std::shared_ptr<gpu::Context>& ctx, const char* method, Gpu
 void expect_agreement(const char* method, const Result& r, double max_rel) {
   SCOPED_TRACE(method);
   ASSERT_GT(r.peak, 0.0);
-  EXPECT_LE(r.colour.max_abs / r.peak, max_rel);
-  EXPECT_GE(r.colour.psnr + 20.0 * std::log10(r.peak), 125.0);  // PSNR with the peak as the signal
-  EXPECT_EQ(r.colour.finiteness_mismatches, 0u);
-  EXPECT_EQ(r.stat_mismatches, 0u);
+  const test::StateComparison& s = r.states;
+  EXPECT_LE(s.colour.max_abs / r.peak, max_rel);
+  EXPECT_GE(s.colour.psnr + 20.0 * std::log10(r.peak), 125.0);  // PSNR with the peak as the signal
+  EXPECT_EQ(s.colour.finiteness_mismatches, 0u);
+  EXPECT_EQ(s.stat_mismatches, 0u);
   if (std::string(method) != "spatial") {
-    EXPECT_GT(r.history_pixels, 0u);
-    EXPECT_GT(r.misses, 0u);  // the walkers disocclude
+    EXPECT_GT(s.history_pixels, 0u);
+    EXPECT_GT(s.misses, 0u);  // the walkers disocclude
   }
   ::testing::Test::RecordProperty(std::string("max_abs_") + method,
-                                 (::testing::Message() << r.colour.max_abs << " peak " << r.peak << " psnr(peak) "
-                                                       << r.colour.psnr + 20.0 * std::log10(r.peak)).GetString());
+                                 (::testing::Message() << s.colour.max_abs << " peak " << r.peak << " psnr(peak) "
+                                                       << s.colour.psnr + 20.0 * std::log10(r.peak)).GetString());
 }
 
 TEST(UpsampleGpuRendered, EveryGpuMethodMatchesItsCppMethod) {

@@ -1,6 +1,7 @@
 #include "temporal/gpu/buffer.h"
 
 #include <utility>
+#include <vector>
 
 namespace temporal::gpu {
 
@@ -10,6 +11,33 @@ Status ImageBuffer::create_cleared(std::shared_ptr<Context> context, int width, 
   if (!created) return created.error();
   buffer = std::move(*created);
   return buffer.clear(0, planes);
+}
+
+namespace {
+// create_all's and create_all_cleared's work: every buffer made (and cleared) before any is replaced.
+Status create_each(const std::shared_ptr<Context>& context, std::initializer_list<ImageBuffer::Shape> shapes,
+                   bool cleared) {
+  std::vector<ImageBuffer> made;
+  made.reserve(shapes.size());
+  for (const ImageBuffer::Shape& shape : shapes) {
+    auto created = ImageBuffer::create(context, shape.width, shape.height, shape.planes);
+    if (!created) return created.error();
+    if (cleared)
+      if (Status s = created->clear(0, shape.planes); !s) return s;
+    made.push_back(std::move(*created));
+  }
+  auto next = made.begin();
+  for (const ImageBuffer::Shape& shape : shapes) *shape.buffer = std::move(*next++);
+  return Status::ok();
+}
+}  // namespace
+
+Status ImageBuffer::create_all(const std::shared_ptr<Context>& context, std::initializer_list<Shape> shapes) {
+  return create_each(context, shapes, false);
+}
+
+Status ImageBuffer::create_all_cleared(const std::shared_ptr<Context>& context, std::initializer_list<Shape> shapes) {
+  return create_each(context, shapes, true);
 }
 
 Expected<ImageBuffer> ImageBuffer::create(std::shared_ptr<Context> context, int width, int height, int planes) {

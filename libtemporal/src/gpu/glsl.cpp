@@ -47,10 +47,21 @@ void count_end() {
   return text;
 }
 
+std::string float_storage(int binding, const char* name) {
+  const std::string b = std::to_string(binding), n = name;
+  return "layout(std430, binding = " + b + ") buffer " + n + "_F { float " + n + "[]; };\n";
+}
+
 std::string storage(int binding, const char* name) {
   const std::string b = std::to_string(binding), n = name;
-  return "layout(std430, binding = " + b + ") buffer " + n + "_F { float " + n + "[]; };\n" +
-         "layout(std430, binding = " + b + ") buffer " + n + "_U { uint " + n + "_u[]; };\n";
+  return float_storage(binding, name) + "layout(std430, binding = " + b + ") buffer " + n + "_U { uint " + n +
+         "_u[]; };\n";
+}
+
+std::string float_constant(const char* name, float value) {
+  char line[160];
+  std::snprintf(line, sizeof line, "const float %s = %.9g;\n", name, double(value));
+  return line;
 }
 
 namespace {
@@ -198,12 +209,7 @@ float expect_tolerance(float tol, float warped_tol, bool has_warped) { return ha
 }  // namespace
 
 std::string_view reproject() {
-  static const std::string text = [] {
-    char constants[256];
-    std::snprintf(constants, sizeof constants, "const float kMinHitWeight = %.9g;\n",
-                  double(reproject::kMinHitWeight));
-    return std::string(constants) + kReprojectGlsl;
-  }();
+  static const std::string text = float_constant("kMinHitWeight", reproject::kMinHitWeight) + kReprojectGlsl;
   return text;
 }
 

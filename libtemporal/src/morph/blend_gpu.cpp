@@ -42,14 +42,8 @@ class BlendGpu final : public MorphMethod, public gpu::TimedKernel {
   Status run_gpu(const Image& color, const Image& next, std::vector<Image>& out) {
     const int w = color.width(), h = color.height();
     const std::size_t np = color.pixel_count();
-    if (frames_.width() != w || frames_.height() != h) {
-      auto f = gpu::ImageBuffer::create(ctx_, w, h, 6);
-      if (!f) return f.error();
-      auto o = gpu::ImageBuffer::create(ctx_, w, h, 3);
-      if (!o) return o.error();
-      frames_ = std::move(*f);
-      slot_ = std::move(*o);
-    }
+    if (frames_.width() != w || frames_.height() != h)
+      if (Status s = gpu::ImageBuffer::create_all(ctx_, {{&frames_, w, h, 6}, {&slot_, w, h, 3}}); !s) return s;
     for (int c = 0; c < 3; ++c) {
       if (Status s = frames_.upload(c, color, kRGB[c]); !s) return s;
       if (Status s = frames_.upload(3 + c, next, kRGB[c]); !s) return s;

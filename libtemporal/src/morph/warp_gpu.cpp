@@ -78,15 +78,8 @@ class WarpGpu final : public MorphMethod, public gpu::TimedKernel {
     const int w = color.width(), h = color.height();
     const std::size_t np = color.pixel_count();
     if (src_.width() != w || src_.height() != h) {
-      auto s = gpu::ImageBuffer::create(ctx_, w, h, 6);
-      if (!s) return s.error();
-      auto k = gpu::ImageBuffer::create(ctx_, w, h, 2);
-      if (!k) return k.error();
-      auto o = gpu::ImageBuffer::create(ctx_, w, h, 3);
-      if (!o) return o.error();
-      src_ = std::move(*s);
-      keys_ = std::move(*k);
-      slot_ = std::move(*o);
+      if (Status s = gpu::ImageBuffer::create_all(ctx_, {{&src_, w, h, 6}, {&keys_, w, h, 2}, {&slot_, w, h, 3}}); !s)
+        return s;
       empty_.assign(np * 2, 0xffffffffu);
     }
     const char* names[6] = {"R", "G", "B", "motion.X", "motion.Y", "depth.Z"};

@@ -1,6 +1,7 @@
 // The EMA filter (ema.cpp) as one GLSL compute kernel: the same reprojection (the gpu stage's GLSL version of
 // core/reproject.h), the same eq. 1, the same state planes (history.<c>, history.depth, history.id).
 #include "filter_common.h"
+#include "gpu_history.h"
 #include "temporal/gpu/buffer.h"
 #include "temporal/gpu/glsl.h"
 #include "temporal/gpu/program.h"
@@ -151,11 +152,7 @@ class EmaFilterGpu final : public FrameFilter, public gpu::TimedKernel {
 
   Image saved_state() const override {
     if (!have_state_) return {};
-    Image state(hist_.width(), hist_.height());
-    const auto names = EmaFilter::state_channel_names(channels_);
-    // saved_state() cannot report an error; a failed download leaves the plane absent and set_state refuses it.
-    for (int c = 0; c < channels_; ++c)
-      if (!hist_.download(c, state, names[std::size_t(c)])) state.remove_channel(names[std::size_t(c)]);
+    Image state = detail::download_history(hist_, channels_);
     if (has_depth_) (void)hist_.download(channels_, state, "history.depth");
     if (has_id_) (void)hist_.download(channels_ + 1, state, "history.id", true);
     return state;
@@ -165,9 +162,7 @@ class EmaFilterGpu final : public FrameFilter, public gpu::TimedKernel {
     Image history, next;
     if (Status s = detail::load_history(state, channels, "ema", history, next); !s) return s;
     if (Status s = allocate(channels, state.width(), state.height()); !s) return s;
-    const auto names = EmaFilter::state_channel_names(channels);
-    for (int c = 0; c < channels; ++c)
-      if (Status s = hist_.upload(c, history, names[std::size_t(c)]); !s) return s;
+    if (Status s = detail::upload_history(history, channels, hist_); !s) return s;
     has_depth_ = state.plane("history.depth") != nullptr;
     has_id_ = state.uint_plane("history.id") != nullptr;
     if (has_depth_)
@@ -184,16 +179,8 @@ class EmaFilterGpu final : public FrameFilter, public gpu::TimedKernel {
   Status allocate(int channels, int w, int h) {
     channels_ = channels;
     if (src_.width() == w && src_.height() == h && src_.planes() == channels + 5) return Status::ok();
-    auto src = gpu::ImageBuffer::create(ctx_, w, h, channels + 5);
-    if (!src) return src.error();
-    auto hist = gpu::ImageBuffer::create(ctx_, w, h, channels + 3);
-    if (!hist) return hist.error();
-    auto next = gpu::ImageBuffer::create(ctx_, w, h, channels + 3);
-    if (!next) return next.error();
-    src_ = std::move(*src);
-    hist_ = std::move(*hist);
-    next_ = std::move(*next);
-    return Status::ok();
+    return gpu::ImageBuffer::create_all(
+        ctx_, {{&src_, w, h, channels + 5}, {&hist_, w, h, channels + 3}, {&next_, w, h, channels + 3}});
   }
 
   std::shared_ptr<gpu::Context> ctx_;

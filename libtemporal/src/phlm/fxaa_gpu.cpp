@@ -191,17 +191,10 @@ class FxaaFilterGpu final : public FrameFilter, public gpu::TimedKernel {
     if (Status s = validate_filter_input(in); !s) return s;
     const int C = int(in.channels.size());
     const int w = in.color->width(), h = in.color->height();
-    if (src_.width() != w || src_.height() != h || src_.planes() != C) {
-      auto s = gpu::ImageBuffer::create(ctx_, w, h, C);
-      if (!s) return s.error();
-      auto k = gpu::ImageBuffer::create(ctx_, w, h, 2);
-      if (!k) return k.error();
-      auto o = gpu::ImageBuffer::create(ctx_, w, h, C + 1);
-      if (!o) return o.error();
-      src_ = std::move(*s);
-      work_ = std::move(*k);
-      out_ = std::move(*o);
-    }
+    if (src_.width() != w || src_.height() != h || src_.planes() != C)
+      if (Status s = gpu::ImageBuffer::create_all(ctx_, {{&src_, w, h, C}, {&work_, w, h, 2}, {&out_, w, h, C + 1}});
+          !s)
+        return s;
     for (int c = 0; c < C; ++c)
       if (Status s = src_.upload(c, *in.color, in.channels[std::size_t(c)]); !s) return s;
     if (Status s = counters_.clear(0, 1); !s) return s;

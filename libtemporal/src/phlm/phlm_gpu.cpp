@@ -445,18 +445,10 @@ class PhlmFilterGpu final : public FrameFilter, public gpu::TimedKernel {
     channels_ = channels;
     const int k = phlm_state_floats(channels);
     if (src_.width() == w && src_.height() == h && state_[0].planes() == k) return Status::ok();
-    auto src = gpu::ImageBuffer::create(ctx_, w, h, channels + 2);
-    if (!src) return src.error();
-    src_ = std::move(*src);
-    for (auto& b : state_) {
-      auto created = gpu::ImageBuffer::create(ctx_, w, h, k);
-      if (!created) return created.error();
-      b = std::move(*created);
-    }
-    auto out = gpu::ImageBuffer::create(ctx_, w, h, 2 * channels + 3);
-    if (!out) return out.error();
-    out_ = std::move(*out);
-    return Status::ok();
+    return gpu::ImageBuffer::create_all(ctx_, {{&src_, w, h, channels + 2},
+                                               {&state_[0], w, h, k},
+                                               {&state_[1], w, h, k},
+                                               {&out_, w, h, 2 * channels + 3}});
   }
 
   std::shared_ptr<gpu::Context> ctx_;

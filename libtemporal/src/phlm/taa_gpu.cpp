@@ -4,6 +4,7 @@
 // (history.<c>). The reconstruction weights exp(-k d^2) are computed on the host with std::exp as in taa.cpp, so
 // no GPU exp enters the result.
 #include "filter_common.h"
+#include "gpu_history.h"
 #include "temporal/gpu/buffer.h"
 #include "temporal/gpu/glsl.h"
 #include "temporal/gpu/program.h"
@@ -255,21 +256,14 @@ class TaaFilterGpu final : public FrameFilter, public gpu::TimedKernel {
 
   Image saved_state() const override {
     if (!have_state_) return {};
-    Image state(hist_.width(), hist_.height());
-    const auto names = TaaFilter::state_channel_names(channels_);
-    // saved_state() cannot report an error; a failed download leaves the plane absent and set_state refuses it.
-    for (int c = 0; c < channels_; ++c)
-      if (!hist_.download(c, state, names[std::size_t(c)])) state.remove_channel(names[std::size_t(c)]);
-    return state;
+    return detail::download_history(hist_, channels_);
   }
 
   Status set_state(const Image& state, int channels) override {
     Image history, next;
     if (Status s = detail::load_history(state, channels, "taa", history, next); !s) return s;
     if (Status s = allocate(channels, state.width(), state.height()); !s) return s;
-    const auto names = TaaFilter::state_channel_names(channels);
-    for (int c = 0; c < channels; ++c)
-      if (Status s = hist_.upload(c, history, names[std::size_t(c)]); !s) return s;
+    if (Status s = detail::upload_history(history, channels, hist_); !s) return s;
     have_state_ = true;
     return Status::ok();
   }
@@ -280,16 +274,8 @@ class TaaFilterGpu final : public FrameFilter, public gpu::TimedKernel {
   Status allocate(int channels, int w, int h) {
     channels_ = channels;
     if (src_.width() == w && src_.height() == h && src_.planes() == channels + 3) return Status::ok();
-    auto src = gpu::ImageBuffer::create(ctx_, w, h, channels + 3);
-    if (!src) return src.error();
-    auto hist = gpu::ImageBuffer::create(ctx_, w, h, channels + 4);
-    if (!hist) return hist.error();
-    auto next = gpu::ImageBuffer::create(ctx_, w, h, channels + 4);
-    if (!next) return next.error();
-    src_ = std::move(*src);
-    hist_ = std::move(*hist);
-    next_ = std::move(*next);
-    return Status::ok();
+    return gpu::ImageBuffer::create_all(
+        ctx_, {{&src_, w, h, channels + 3}, {&hist_, w, h, channels + 4}, {&next_, w, h, channels + 4}});
   }
 
   std::shared_ptr<gpu::Context> ctx_;

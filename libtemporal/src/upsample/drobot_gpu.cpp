@@ -24,11 +24,7 @@ namespace temporal::upsample {
 namespace {
 
 std::string constants() {
-  auto line = [](const char* name, float v) {
-    char b[128];
-    std::snprintf(b, sizeof b, "const float %s = %.9g;\n", name, double(v));
-    return std::string(b);
-  };
+  const auto line = gpu::glsl::float_constant;  // "const float NAME = VALUE;", the float exactly
   return line("kCenterWeight", kDrobotCenterWeight) + line("kTap0", kDrobotTapWeights[0]) +
          line("kTap1", kDrobotTapWeights[1]) + line("kTap2", kDrobotTapWeights[2]) +
          line("kTap3", kDrobotTapWeights[3]) + line("kE", kDrobotE) + line("kDepthBias", kDrobotDepthBias) +
@@ -36,26 +32,13 @@ std::string constants() {
          line("kInv9", 1.0f / 9) + line("k2OverLn2", 2.8853900817779268f) + line("kInv6", 1.0f / 6) +
          line("kInv24", 1.0f / 24) + line("kInv120", 1.0f / 120) + line("kInv720", 1.0f / 720) +
          line("kInv5040", 1.0f / 5040) + R"(
-uniform ivec2 u_full, u_low;
-uniform int u_k, u_sx, u_sy, u_C;
-uniform uint u_n, u_ln;
 
 int floor_div(int a, int b) { return (a >= 0) ? a / b : -((-a + b - 1) / b); }
 float floor_vec(float x) {  // reproject::floor_vec
   const float t = float(int(x));
   return t > x ? t - 1.0 : t;
 }
-// gather_low_geometry's validity of low-resolution sample q: finite geometry at its full-resolution pixel and a
-// payload that is a sample (is_sample: finite and at most kMaxSampleMagnitude, as usable_sample in frame.cpp).
-bool low_valid(uint q) {
-  const uint lx = q % uint(u_low.x), ly = q / uint(u_low.x);
-  const uint g = (uint(u_k) * ly + uint(u_sy)) * uint(u_full.x) + uint(u_sx) + uint(u_k) * lx;
-  bool ok = is_finite_bits(gb[g]) && is_finite_bits(gb[u_n + g]) && is_finite_bits(gb[2u * u_n + g]) &&
-            is_finite_bits(gb[3u * u_n + g]);
-  for (int c = 0; c < u_C; ++c) ok = ok && is_sample(lowb[uint(c) * u_ln + q]);
-  return ok;
-}
-)";
+)" + std::string(sampling_grid_glsl());
 }
 
 // Listing 7.1 (drobot_upsample_row) for a full-resolution pixel from a coarse grid whose samples sit at
@@ -378,28 +361,18 @@ void main() {
 }
 )";
 
-class DrobotStateGpu final : public MethodState, public gpu::TimedKernel {
+class DrobotStateGpu final : public GpuHistoryState {
  public:
   DrobotStateGpu(std::shared_ptr<gpu::Context> ctx, std::vector<gpu::Program> programs, gpu::ImageBuffer counters,
                  const Geometry& g, bool refresh)
-      : ctx_(std::move(ctx)), prog_(std::move(programs)), counters_(std::move(counters)), g_(g), refresh_(refresh),
-        timer_(ctx_) {}
-
-  Image& run(const FrameContext& f, bool history, FrameStats& stats) override {
-    status_ = refresh_ ? run_refresh(f, history, stats) : run_cache(f, history, stats);
-    return result_;
-  }
-  Status run_status() const override { return status_; }
+      : GpuHistoryState(std::move(ctx), std::move(counters), g), prog_(std::move(programs)), refresh_(refresh) {}
 
   // DrobotState::save's planes.
   void save(Image& state) const override {
     if (out_[0].empty()) return;  // save() cannot report an error; load() names a missing plane
     const int C = int(g_.channels.size());
     if (refresh_) {
-      std::vector<float> plane(std::size_t(g_.W) * g_.H);
-      for (int c = 0; c < C; ++c)
-        if (out_[cur_].download(c, plane.data()))
-          put_plane(state, "history." + g_.channels[std::size_t(c)], plane.data(), g_.W, g_.H);
+      save_history(state);
       save_previous_geometry(prevg_, has_prev_id_, g_, state);
       return;
     }
@@ -421,12 +394,7 @@ class DrobotStateGpu final : public MethodState, public gpu::TimedKernel {
     cur_ = 1 - cur_;  // OutputPair::next()
     const int C = int(g_.channels.size());
     if (refresh_) {
-      std::vector<float> plane(std::size_t(g_.W) * g_.H);
-      for (int c = 0; c < C; ++c) {
-        if (Status s = get_plane(state, "history." + g_.channels[std::size_t(c)], plane.data(), g_.W, g_.H); !s)
-          return s;
-        if (Status s = out_[cur_].upload(c, plane.data()); !s) return s;
-      }
+      if (Status s = load_history(state); !s) return s;
       if (Status s = upload_previous_geometry(state, g_, prevg_, has_prev_id_); !s) return s;
       has_history_ = true;
       return Status::ok();
@@ -452,8 +420,6 @@ class DrobotStateGpu final : public MethodState, public gpu::TimedKernel {
     return Status::ok();
   }
 
-  gpu::KernelTiming last_timing() const override { return timing_; }
-
  private:
   enum { kGrid, kAccumulate, kFilter, kCacheUpsample, kRefresh };
 
@@ -464,18 +430,18 @@ class DrobotStateGpu final : public MethodState, public gpu::TimedKernel {
 
   Status allocate() {
     if (!out_[0].empty()) return Status::ok();
-    const int C = int(g_.channels.size());
-    auto make = [&](gpu::ImageBuffer& b, int w, int h, int planes) {
-      return gpu::ImageBuffer::create_cleared(ctx_, w, h, planes, b);
-    };
-    for (auto& b : out_)
-      if (Status s = make(b, g_.W, g_.H, C + 4); !s) return s;
-    if (refresh_) return make(prevg_, g_.W, g_.H, 2);
-    if (Status s = make(cg_, g_.lw, g_.lh, 8); !s) return s;
-    // Per parity C values, depth, frame count, id; then the filtered availability of this frame.
-    if (Status s = make(cache_, g_.lw, g_.lh, 2 * (C + 3) + 1); !s) return s;
-    if (Status s = make(cb_, g_.lw, g_.lh, C + 4); !s) return s;
-    return make(tmp_, g_.lw, g_.lh, C + 1);
+    const int C = int(g_.channels.size()), W = g_.W, H = g_.H, lw = g_.lw, lh = g_.lh;
+    if (refresh_)
+      return gpu::ImageBuffer::create_all_cleared(
+          ctx_, {{&out_[0], W, H, C + 4}, {&out_[1], W, H, C + 4}, {&prevg_, W, H, 2}});
+    return gpu::ImageBuffer::create_all_cleared(
+        ctx_, {{&out_[0], W, H, C + 4},
+               {&out_[1], W, H, C + 4},
+               {&cg_, lw, lh, 8},
+               // Per parity C values, depth, frame count, id; then the filtered availability of this frame.
+               {&cache_, lw, lh, 2 * (C + 3) + 1},
+               {&cb_, lw, lh, C + 4},
+               {&tmp_, lw, lh, C + 1}});
   }
 
   Status upload_table(const std::vector<float>& table) {
@@ -487,16 +453,6 @@ class DrobotStateGpu final : public MethodState, public gpu::TimedKernel {
     return tab_.upload(0, table.data());
   }
 
-  void set_common(const gpu::Program& prog, const FrameContext& f) const {
-    prog.set_int2("u_full", f.W, f.H);
-    prog.set_int2("u_low", f.lw, f.lh);
-    prog.set("u_k", f.grid.k);
-    prog.set("u_sx", f.grid.sx);
-    prog.set("u_sy", f.grid.sy);
-    prog.set("u_C", f.C);
-    prog.set("u_n", std::uint32_t(std::size_t(f.W) * f.H));
-    prog.set("u_ln", std::uint32_t(std::size_t(f.lw) * f.lh));
-  }
   void set_listing71(const gpu::Program& prog, const FrameContext& f, const DrobotOptions& o, int gsx, int gsy) const {
     prog.set("u_gsx", gsx);
     prog.set("u_gsy", gsy);
@@ -506,18 +462,8 @@ class DrobotStateGpu final : public MethodState, public gpu::TimedKernel {
     prog.set("u_pow32", int(o.normal_power == 32.0f));
   }
 
-  Status finish(const FrameContext& f, int debug_planes, const char* const* debug_names) {
-    if (result_.width() != f.W || result_.height() != f.H) result_ = Image(f.W, f.H);
-    for (int c = 0; c < f.C; ++c)
-      if (Status s = out_[cur_].download(c, result_, g_.channels[std::size_t(c)]); !s) return s;
-    for (int d = 0; d < 4; ++d) {
-      if (d < debug_planes && f.debug) {
-        if (Status s = out_[cur_].download(f.C + d, result_, debug_names[d]); !s) return s;
-      } else if (d < debug_planes) {
-        result_.remove_channel(debug_names[d]);
-      }
-    }
-    return Status::ok();
+  Status run_gpu(const FrameContext& f, bool history, FrameStats& stats) override {
+    return refresh_ ? run_refresh(f, history, stats) : run_cache(f, history, stats);
   }
 
   Status run_cache(const FrameContext& f, bool have_history, FrameStats& stats) {
@@ -559,12 +505,12 @@ class DrobotStateGpu final : public MethodState, public gpu::TimedKernel {
     timer_.start();
     const gpu::Program& g = prog_[kGrid];
     if (Status s = g.use(); !s) return s;
-    set_common(g, f);
+    set_sampling_grid_uniforms(g, f);
     if (Status s = g.dispatch(f.lw, f.lh); !s) return s;
     // Steps 3-5.
     const gpu::Program& a = prog_[kAccumulate];
     if (Status s = a.use(); !s) return s;
-    set_common(a, f);
+    set_sampling_grid_uniforms(a, f);
     a.set("u_history", int(history));
     a.set("u_use_ids", int(test.use_ids && f.id != nullptr));
     a.set("u_warped", int(f.prev_z != nullptr));
@@ -580,7 +526,7 @@ class DrobotStateGpu final : public MethodState, public gpu::TimedKernel {
     // Step 6: horizontal (CB -> tmp), then vertical (tmp -> this frame's cache values, the new HB; step 8).
     const gpu::Program& fp = prog_[kFilter];
     if (Status s = fp.use(); !s) return s;
-    set_common(fp, f);
+    set_sampling_grid_uniforms(fp, f);
     fp.set("u_amp", o.filter_amp);
     fp.set("u_z_base", cur_base + std::uint32_t(C) * ln);
     fp.set("u_strength_base", std::uint32_t(C + 3) * ln);
@@ -603,7 +549,7 @@ class DrobotStateGpu final : public MethodState, public gpu::TimedKernel {
     // Step 7.
     const gpu::Program& u = prog_[kCacheUpsample];
     if (Status s = u.use(); !s) return s;
-    set_common(u, f);
+    set_sampling_grid_uniforms(u, f);
     set_listing71(u, f, o, k / 2, k / 2);
     u.set("u_val_base", cur_base);
     u.set("u_avail", avail);
@@ -620,7 +566,7 @@ class DrobotStateGpu final : public MethodState, public gpu::TimedKernel {
                           (f.debug ? 4.0 * full : 0.0);
     static const char* const kNames[4] = {"debug.confidence", "debug.disocclusion", "debug.convergence",
                                           "debug.historyWeight"};
-    if (Status s = finish(f, 4, kNames); !s) return s;
+    if (Status s = download_result(f, kNames); !s) return s;
     has_history_ = true;
     has_cache_id_ = f.id != nullptr;
     std::uint32_t counts[4] = {};
@@ -649,7 +595,7 @@ class DrobotStateGpu final : public MethodState, public gpu::TimedKernel {
     timer_.start();
     const gpu::Program& r = prog_[kRefresh];
     if (Status s = r.use(); !s) return s;
-    set_common(r, f);
+    set_sampling_grid_uniforms(r, f);
     set_listing71(r, f, o, f.grid.sx, f.grid.sy);
     r.set("u_history", int(history));
     r.set("u_use_ids", int(test.use_ids && f.id != nullptr && has_prev_id_));
@@ -666,11 +612,8 @@ class DrobotStateGpu final : public MethodState, public gpu::TimedKernel {
     timing_.bytes_moved = 4 * full + f.C * low + f.C * full + 2 * full + full + 2 * (2 * full) + f.C * full +
                           (f.debug ? 3.0 * full : 0.0);  // drobot.cpp's streamed_bytes (refresh mode)
     static const char* const kNames[3] = {"debug.confidence", "debug.disocclusion", "debug.convergence"};
-    if (Status s = finish(f, 3, kNames); !s) return s;
-    if (Status s = prevg_.copy_plane(frame_.gb, 0, 0); !s) return s;  // PreviousGeometry::store
-    has_prev_id_ = f.id != nullptr;
-    if (has_prev_id_)
-      if (Status s = prevg_.copy_plane(frame_.gb, 7, 1); !s) return s;
+    if (Status s = download_result(f, kNames); !s) return s;
+    if (Status s = store_previous_geometry(f); !s) return s;
     has_history_ = true;
     std::uint32_t counts[4] = {};
     if (Status s = counters_.download(0, counts); !s) return s;
@@ -679,19 +622,10 @@ class DrobotStateGpu final : public MethodState, public gpu::TimedKernel {
     return Status::ok();
   }
 
-  std::shared_ptr<gpu::Context> ctx_;
   std::vector<gpu::Program> prog_;
-  gpu::ImageBuffer counters_;
-  Geometry g_;
   bool refresh_;
-  gpu::Timer timer_;
-  GpuFrame frame_;
-  gpu::ImageBuffer out_[2], prevg_, cg_, cache_, cb_, tmp_, tab_;
-  int cur_ = 0;
-  bool has_prev_id_ = false, has_cache_id_ = false, has_history_ = false;
-  Image result_;
-  Status status_;
-  gpu::KernelTiming timing_;
+  gpu::ImageBuffer cg_, cache_, cb_, tmp_, tab_;
+  bool has_cache_id_ = false, has_history_ = false;
 };
 
 }  // namespace
@@ -699,10 +633,7 @@ class DrobotStateGpu final : public MethodState, public gpu::TimedKernel {
 Expected<std::unique_ptr<MethodState>> make_drobot_state_gpu(std::shared_ptr<gpu::Context> context,
                                                              const Options& options, const Geometry& geometry) {
   if (Status s = gpu::Context::ensure(context); !s) return s.error();
-  auto floats = [](int binding, const char* name) {
-    const std::string b = std::to_string(binding), n = name;
-    return "layout(std430, binding = " + b + ") buffer " + n + "_F { float " + n + "[]; };\n";
-  };
+  const auto floats = gpu::glsl::float_storage;  // a float-only storage block
   const std::string consts = constants();
   const std::string gb = gpu::glsl::storage(0, "gb"), lowb = floats(1, "lowb"), outb = floats(2, "outb"),
                     hist = floats(3, "hist"), prevg = gpu::glsl::storage(4, "prevg"), cg = gpu::glsl::storage(5, "cg"),

@@ -7,8 +7,10 @@
 #include "temporal/gpu/buffer.h"
 #include "temporal/gpu/context.h"
 #include "temporal/gpu/program.h"
+#include "temporal/gpu/timer.h"
 
 #include <memory>
+#include <span>
 #include <string_view>
 
 namespace temporal::upsample {
@@ -55,11 +57,21 @@ std::unique_ptr<MethodState> gpu_implementation(const Options& options, const Ge
 // GLSL of the joint-bilateral weights (spatial_row / expanded_geometric_weights: the same operations in the same
 // order), shared by the upsampling kernels. Reads binding 0 `gb` (full-resolution planes: depth.Z 0, N.X/Y/Z 1-3)
 // and binding 1 `lowb` (the low-resolution payload, C planes of lw x lh). jb_weights(P) returns the four taps'
-// low-resolution offsets and their weights; jb_value(j, c) the payload value of a tap.
+// low-resolution offsets and their weights; jb_value(j, c) the payload value of a tap. Includes sampling_grid_glsl()
+// (below): a kernel that uses it declares neither.
 std::string_view joint_bilateral_glsl();
 
+// GLSL of the frame's sampling grid: the uniforms ivec2 u_full, u_low (full and low resolution); int u_k, u_sx,
+// u_sy (the factor and this frame's jitter offset), u_C (payload channels); uint u_n, u_ln (full- and
+// low-resolution plane sizes); and gather_low_geometry's validity of low-resolution sample q, `bool low_valid(uint
+// q)`: finite geometry at its full-resolution pixel and a payload that is a sample (is_sample: finite and at most
+// kMaxSampleMagnitude, as usable_sample in frame.cpp). low_valid reads `gb` and `lowb` (GpuFrame's bindings 0, 1).
+std::string_view sampling_grid_glsl();
+// Sets those uniforms from the frame.
+void set_sampling_grid_uniforms(const gpu::Program& program, const FrameContext& f);
+
 // Sets the uniforms joint_bilateral_glsl() reads from the frame (the constants computed on the host exactly as the
-// C++ kernels compute them).
+// C++ kernels compute them), set_sampling_grid_uniforms() included.
 void set_joint_bilateral_uniforms(const gpu::Program& program, const FrameContext& f);
 
 // A state file's previous depth (and ids, when it has them) into planes 0 and 1 of `prevg` (the C++ states'
@@ -79,6 +91,48 @@ struct GpuFrame {
     gb.bind(0);
     low.bind(1);
   }
+};
+
+// What the GPU states with a history (temporal, herzog, taau, drobot) share: the context and the counters their
+// kernels count into (binding 15), the frame's inputs, the two output parities of OutputPair (out_[cur_] this
+// frame's, the other the previous output) and the previous frame's geometry (prevg_: depth, ids), the result and
+// run()'s status (run() itself cannot return an error: the Upsampler asks run_status()), the kernel timing. A state
+// implements run_gpu().
+class GpuHistoryState : public MethodState, public gpu::TimedKernel {
+ public:
+  Image& run(const FrameContext& f, bool history, FrameStats& stats) final {
+    status_ = run_gpu(f, history, stats);
+    return result_;
+  }
+  Status run_status() const final { return status_; }
+  gpu::KernelTiming last_timing() const final { return timing_; }
+
+ protected:
+  GpuHistoryState(std::shared_ptr<gpu::Context> context, gpu::ImageBuffer counters, const Geometry& g)
+      : ctx_(std::move(context)), counters_(std::move(counters)), g_(g), timer_(ctx_) {}
+  virtual Status run_gpu(const FrameContext& f, bool history, FrameStats& stats) = 0;
+
+  // The state file's `history.<c>` planes from / into planes 0..C-1 of out_[cur_] (save() cannot report an error:
+  // a failed download leaves the plane out, and load() names it).
+  void save_history(Image& state) const;
+  Status load_history(const Image& state);
+  // PreviousGeometry::store: this frame's depth and ids (GpuFrame planes 0 and 7) become the previous frame's.
+  Status store_previous_geometry(const FrameContext& f);
+  // The frame's output into result_: planes 0..C-1 of out_[cur_] as the payload channels, then with f.debug planes
+  // C.. as `debug_names` (without f.debug those channels are removed from result_).
+  Status download_result(const FrameContext& f, std::span<const char* const> debug_names);
+
+  std::shared_ptr<gpu::Context> ctx_;
+  gpu::ImageBuffer counters_;
+  Geometry g_;
+  gpu::Timer timer_;
+  GpuFrame frame_;
+  gpu::ImageBuffer out_[2], prevg_;
+  int cur_ = 0;
+  bool has_prev_id_ = false;
+  Image result_;
+  Status status_;
+  gpu::KernelTiming timing_;
 };
 
 }  // namespace temporal::upsample

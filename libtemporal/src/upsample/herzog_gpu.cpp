@@ -33,11 +33,7 @@ namespace {
 
 // The constants of herzog.cpp and upsample_internal.h's fast_exp2, printed exactly (%.9g round-trips a float).
 std::string constants() {
-  auto line = [](const char* name, float v) {
-    char b[128];
-    std::snprintf(b, sizeof b, "const float %s = %.9g;\n", name, double(v));
-    return std::string(b);
-  };
+  const auto line = gpu::glsl::float_constant;  // "const float NAME = VALUE;", the float exactly
   return line("kMaxGradient", kMaxGradient) + line("kG0", kGradientWeights[0]) + line("kG1", kGradientWeights[1]) +
          line("kG2", kGradientWeights[2]) + line("kG3", kGradientWeights[3]) + line("kLn2", 0.69314718056f) +
          line("kInv6", 1.0f / 6) + line("kInv24", 1.0f / 24) + line("kInv120", 1.0f / 120) +
@@ -108,7 +104,7 @@ void main() {
     }
     // spatial_estimate_row: the four taps' geometric weights (expanded_geometric_weights), w~' with the sharp
     // kernel, then the adaptive kernel hat * 2^(ek log2 base) (eq. 3) and w~.
-    const int k = u_k, lw = u_low_size.x, lh = u_low_size.y;
+    const int k = u_k, lw = u_low.x, lh = u_low.y;
     const int x0 = floor_div(p.x - u_sx, k), y0 = floor_div(p.y - u_sy, k);
     const int dx = p.x - u_sx - k * x0, dy = p.y - u_sy - k * y0;
     const float cv0 = (x0 >= 0 && x0 < lw) ? 1.0 : 0.0, cv1 = (x0 + 1 >= 0 && x0 + 1 < lw) ? 1.0 : 0.0;
@@ -330,30 +326,22 @@ struct Programs {
   gpu::Program a, b, pyramid, low_pass, c;
 };
 
-class HerzogStateGpu final : public MethodState, public gpu::TimedKernel {
+class HerzogStateGpu final : public GpuHistoryState {
  public:
   HerzogStateGpu(std::shared_ptr<gpu::Context> ctx, Programs programs, gpu::ImageBuffer counters, const Geometry& g,
                  const HerzogOptions& ho)
-      : ctx_(std::move(ctx)), prog_(std::move(programs)), counters_(std::move(counters)), g_(g), timer_(ctx_) {
+      : GpuHistoryState(std::move(ctx), std::move(counters), g), prog_(std::move(programs)) {
     gs_ = std::max(1, ho.gradient_scale);  // fixed for the state's life (its layout: state_layout)
     GW_ = (g_.W + gs_ - 1) / gs_;
     GH_ = (g_.H + gs_ - 1) / gs_;
   }
 
-  Image& run(const FrameContext& f, bool history, FrameStats& stats) override {
-    status_ = run_gpu(f, history, stats);
-    return result_;
-  }
-  Status run_status() const override { return status_; }
-
   // The planes HerzogState::save writes, from the parity of the last frame.
   void save(Image& state) const override {
     // save() cannot report an error; a failed download leaves the plane out and load() names it.
     if (out_[0].empty()) return;
+    save_history(state);
     std::vector<float> plane(std::size_t(g_.W) * g_.H), cell(std::size_t(GW_) * GH_);
-    for (int c = 0; c < int(g_.channels.size()); ++c)
-      if (out_[cur_].download(c, plane.data()))
-        put_plane(state, "history." + g_.channels[std::size_t(c)], plane.data(), g_.W, g_.H);
     if (hw_.download(cur_, plane.data())) put_plane(state, "history.weight", plane.data(), g_.W, g_.H);
     for (int t = 0; t < 3; ++t)
       if (grid_.download(4 * cur_ + t, cell.data()))
@@ -365,12 +353,8 @@ class HerzogStateGpu final : public MethodState, public gpu::TimedKernel {
   Status load(const Image& state) override {
     if (Status s = allocate(); !s) return s;
     cur_ = 1 - cur_;  // as OutputPair::next(): what is loaded is the previous frame of the next run()
+    if (Status s = load_history(state); !s) return s;
     std::vector<float> plane(std::size_t(g_.W) * g_.H), cell(std::size_t(GW_) * GH_);
-    for (int c = 0; c < int(g_.channels.size()); ++c) {
-      if (Status s = get_plane(state, "history." + g_.channels[std::size_t(c)], plane.data(), g_.W, g_.H); !s)
-        return s;
-      if (Status s = out_[cur_].upload(c, plane.data()); !s) return s;
-    }
     if (Status s = get_plane(state, "history.weight", plane.data(), g_.W, g_.H); !s) return s;
     if (Status s = hw_.upload(cur_, plane.data()); !s) return s;
     for (int t = 0; t < 4; ++t) {
@@ -378,27 +362,23 @@ class HerzogStateGpu final : public MethodState, public gpu::TimedKernel {
       if (Status s = get_plane(state, name, cell.data(), GW_, GH_); !s) return s;
       if (Status s = grid_.upload(4 * cur_ + t, cell.data()); !s) return s;
     }
-    if (Status s = upload_previous_geometry(state, g_, prevg_, has_prev_id_); !s) return s;
-    return Status::ok();
+    return upload_previous_geometry(state, g_, prevg_, has_prev_id_);
   }
-
-  gpu::KernelTiming last_timing() const override { return timing_; }
 
  private:
   // The buffers of the state's geometry, initialised as HerzogState's constructor initialises its vectors (h_w 0,
   // the gradients kMaxGradient, w_f 0, the output 0).
   Status allocate() {
     if (!out_[0].empty()) return Status::ok();
-    const int C = int(g_.channels.size());
-    auto make = [&](gpu::ImageBuffer& b, int w, int h, int planes) {
-      return gpu::ImageBuffer::create_cleared(ctx_, w, h, planes, b);
-    };
-    for (auto& b : out_)
-      if (Status s = make(b, g_.W, g_.H, C + 6); !s) return s;
-    if (Status s = make(prevg_, g_.W, g_.H, 2); !s) return s;
-    if (Status s = make(scratch_, g_.W, g_.H, kScratchFixed + C); !s) return s;
-    if (Status s = make(hw_, g_.W, g_.H, 2); !s) return s;
-    if (Status s = make(grid_, GW_, GH_, kGridPlanes); !s) return s;
+    const int C = int(g_.channels.size()), W = g_.W, H = g_.H;
+    if (Status s = gpu::ImageBuffer::create_all_cleared(ctx_, {{&out_[0], W, H, C + 6},
+                                                               {&out_[1], W, H, C + 6},
+                                                               {&prevg_, W, H, 2},
+                                                               {&scratch_, W, H, kScratchFixed + C},
+                                                               {&hw_, W, H, 2},
+                                                               {&grid_, GW_, GH_, kGridPlanes}});
+        !s)
+      return s;
     const std::vector<float> max_gradient(std::size_t(GW_) * GH_, kMaxGradient);
     for (int par = 0; par < 2; ++par)
       for (int t = 0; t < 3; ++t)
@@ -457,7 +437,7 @@ class HerzogStateGpu final : public MethodState, public gpu::TimedKernel {
     return Status::ok();
   }
 
-  Status run_gpu(const FrameContext& f, bool history, FrameStats& stats) {
+  Status run_gpu(const FrameContext& f, bool history, FrameStats& stats) override {
     const HerzogOptions& ho = herzog_options(*f.options);
     if (Status s = allocate(); !s) return s;
     if (Status s = frame_.upload(ctx_, f, true); !s) return s;
@@ -566,22 +546,8 @@ class HerzogStateGpu final : public MethodState, public gpu::TimedKernel {
   // Downloads the output (and debug planes), keeps this frame's depth and ids as the previous frame's, and counts
   // the history pixels.
   Status read_back(const FrameContext& f, bool history, FrameStats& stats) {
-    const int C = f.C;
-    if (result_.width() != f.W || result_.height() != f.H) result_ = Image(f.W, f.H);
-    for (int c = 0; c < C; ++c)
-      if (Status s = out_[cur_].download(c, result_, g_.channels[std::size_t(c)]); !s) return s;
-    for (int d = 0; d < 6; ++d) {
-      if (f.debug) {
-        if (Status s = out_[cur_].download(C + d, result_, kDebugNames[d]); !s) return s;
-      } else {
-        result_.remove_channel(kDebugNames[d]);
-      }
-    }
-    // PreviousGeometry::store: this frame's depth and ids become the previous frame's.
-    if (Status s = prevg_.copy_plane(frame_.gb, 0, 0); !s) return s;
-    has_prev_id_ = f.id != nullptr;
-    if (has_prev_id_)
-      if (Status s = prevg_.copy_plane(frame_.gb, 7, 1); !s) return s;
+    if (Status s = download_result(f, kDebugNames); !s) return s;
+    if (Status s = store_previous_geometry(f); !s) return s;
     std::uint32_t counts[4] = {};
     if (Status s = counters_.download(0, counts); !s) return s;
     stats.history_pixels = history ? counts[0] : 0;
@@ -608,23 +574,13 @@ class HerzogStateGpu final : public MethodState, public gpu::TimedKernel {
     return a + b + pyramid + low_pass + c;
   }
 
-  std::shared_ptr<gpu::Context> ctx_;
   Programs prog_;
-  gpu::ImageBuffer counters_;
-  Geometry g_;
-  gpu::Timer timer_;
   int gs_ = 1, GW_ = 0, GH_ = 0;
-  GpuFrame frame_;
-  gpu::ImageBuffer out_[2], prevg_, scratch_, hw_, grid_, tables_;
+  gpu::ImageBuffer scratch_, hw_, grid_, tables_;
   std::vector<gpu::ImageBuffer> pyr_;
   std::vector<int> pyr_w_, pyr_h_;
   int l0_ = 0, nlev_ = 1;
   float frac_ = 0.0f;
-  int cur_ = 0;
-  bool has_prev_id_ = false;
-  Image result_;
-  Status status_;
-  gpu::KernelTiming timing_;
 };
 
 }  // namespace
@@ -638,10 +594,7 @@ Expected<std::unique_ptr<MethodState>> make_herzog_state_gpu(std::shared_ptr<gpu
   };
   // Only gb and prevg need their uint view (ids): one block for each other buffer keeps pass A at 12 storage blocks
   // (two views each would be 19; llvmpipe's GL_MAX_COMPUTE_SHADER_STORAGE_BLOCKS is 16).
-  auto floats = [](int binding, const char* name) {
-    const std::string b = std::to_string(binding), n = name;
-    return "layout(std430, binding = " + b + ") buffer " + n + "_F { float " + n + "[]; };\n";
-  };
+  const auto floats = gpu::glsl::float_storage;  // a float-only storage block
   const std::string s0 = gpu::glsl::storage(0, "gb"), s1 = floats(1, "lowb"), s2 = floats(2, "outb"),
                     s3 = floats(3, "hist"), s4 = gpu::glsl::storage(4, "prevg"), s5 = floats(5, "scr"),
                     s6 = floats(6, "hwb"), s7 = floats(7, "grid"), s8 = floats(8, "tab"), s9 = floats(9, "pyr"),

@@ -7,21 +7,15 @@
 #include "temporal/gpu/timer.h"
 
 #include <algorithm>
-#include <cstdio>
 #include <mutex>
 
 namespace temporal::upsample {
 
 std::string_view joint_bilateral_glsl() {
-  static const std::string text = [] {
-    char epsilon[64];
-    std::snprintf(epsilon, sizeof epsilon, "const float kKernelEpsilon = %.9g;\n", double(kKernelEpsilon));
-    return std::string(epsilon) + R"(
-uniform ivec2 u_low_size;
-uniform int u_k, u_sx, u_sy, u_C;
+  static const std::string text = gpu::glsl::float_constant("kKernelEpsilon", kKernelEpsilon) +
+                                  std::string(sampling_grid_glsl()) + R"(
 uniform float u_inv_k, u_inv_sn2, u_inv_sd2;
 uniform float u_frac[64];  // float(d) / float(k), d = 0..k-1
-uniform uint u_n, u_ln;    // full- and low-resolution plane sizes
 
 // std::max / std::min: (a < b) ? b : a, which returns `a` when b is NaN (the C++ kernels' NaN behaviour).
 float std_max(float a, float b) { return (a < b) ? b : a; }
@@ -35,20 +29,11 @@ float geometric_weight(float dot_, float dz) {
   return tn * tn * tn * td * td * td;
 }
 
-// gather_low_geometry's validity of a low-resolution sample (finite geometry and payload).
-bool low_valid(uint q) {
-  const uint lx = q % uint(u_low_size.x), ly = q / uint(u_low_size.x);
-  const uint g = (uint(u_k) * ly + uint(u_sy)) * uint(u_size.x) + uint(u_sx) + uint(u_k) * lx;
-  bool ok = is_finite_bits(gb[g]) && is_finite_bits(gb[u_n + g]) && is_finite_bits(gb[2u * u_n + g]) &&
-            is_finite_bits(gb[3u * u_n + g]);
-  for (int c = 0; c < u_C; ++c) ok = ok && is_sample(lowb[uint(c) * u_ln + q]);
-  return ok;
-}
 // A low-resolution sample: its full-resolution pixel's geometry, valid when that geometry and every payload
 // channel are finite (gather_low_geometry).
 float sample_weight_at(uint q, float zi, float ax, float ay, float az) {
-  const uint lx = q % uint(u_low_size.x), ly = q / uint(u_low_size.x);
-  const uint g = (uint(u_k) * ly + uint(u_sy)) * uint(u_size.x) + uint(u_sx) + uint(u_k) * lx;
+  const uint lx = q % uint(u_low.x), ly = q / uint(u_low.x);
+  const uint g = (uint(u_k) * ly + uint(u_sy)) * uint(u_full.x) + uint(u_sx) + uint(u_k) * lx;
   const float lz = gb[g], nx = gb[u_n + g], ny = gb[2u * u_n + g], nz = gb[3u * u_n + g];
   const float lv = low_valid(q) ? 1.0 : 0.0;
   const float dot_ = ax * nx + ay * ny + az * nz;
@@ -65,7 +50,7 @@ struct JB {
 
 // spatial_row's weights for pixel P (TapTable: taps x0 = floor((X - sx) / k), x0 + 1, clamped; existence 0/1).
 JB jb_weights(ivec2 P) {
-  const int k = u_k, lw = u_low_size.x, lh = u_low_size.y;
+  const int k = u_k, lw = u_low.x, lh = u_low.y;
   const int x0 = floor_div(P.x - u_sx, k), y0 = floor_div(P.y - u_sy, k);
   const int dx = P.x - u_sx - k * x0, dy = P.y - u_sy - k * y0;
   const float cv0 = (x0 >= 0 && x0 < lw) ? 1.0 : 0.0, cv1 = (x0 + 1 >= 0 && x0 + 1 < lw) ? 1.0 : 0.0;
@@ -102,26 +87,19 @@ float jb_value(JB j, int c) {
 }
 
 )";
-  }();
   return text;
 }
 
 void set_joint_bilateral_uniforms(const gpu::Program& program, const FrameContext& f) {
   const Options& o = *f.options;
   const int k = f.grid.k;
-  program.set("u_n", std::uint32_t(std::size_t(f.W) * f.H));
-  program.set("u_ln", std::uint32_t(std::size_t(f.lw) * f.lh));
-  program.set("u_k", k);
-  program.set("u_sx", f.grid.sx);
-  program.set("u_sy", f.grid.sy);
-  program.set("u_C", f.C);
+  set_sampling_grid_uniforms(program, f);
   program.set("u_inv_k", 1.0f / float(k));
   float frac[64] = {};
   for (int d = 0; d < k && d < 64; ++d) frac[d] = float(d) / float(k);
   program.set("u_frac", frac, 64);
   program.set("u_inv_sn2", 1.0f / (o.sigma_normal * o.sigma_normal));
   program.set("u_inv_sd2", 1.0f / (f.sigma_d * f.sigma_d));
-  program.set_int2("u_low_size", f.lw, f.lh);
 }
 
 Status upload_previous_geometry(const Image& state, const Geometry& g, gpu::ImageBuffer& prevg, bool& has_prev_id) {
@@ -172,6 +150,73 @@ Status GpuFrame::upload(const std::shared_ptr<gpu::Context>& context, const Fram
   for (int c = 0; c < f.C; ++c)
     if (Status s = low.upload(c, f.low[std::size_t(c)]); !s) return s;
   return Status::ok();
+}
+
+void GpuHistoryState::save_history(Image& state) const {
+  std::vector<float> plane(std::size_t(g_.W) * g_.H);
+  for (int c = 0; c < int(g_.channels.size()); ++c)
+    if (out_[cur_].download(c, plane.data()))
+      put_plane(state, "history." + g_.channels[std::size_t(c)], plane.data(), g_.W, g_.H);
+}
+
+Status GpuHistoryState::load_history(const Image& state) {
+  std::vector<float> plane(std::size_t(g_.W) * g_.H);
+  for (int c = 0; c < int(g_.channels.size()); ++c) {
+    if (Status s = get_plane(state, "history." + g_.channels[std::size_t(c)], plane.data(), g_.W, g_.H); !s)
+      return s;
+    if (Status s = out_[cur_].upload(c, plane.data()); !s) return s;
+  }
+  return Status::ok();
+}
+
+Status GpuHistoryState::store_previous_geometry(const FrameContext& f) {
+  if (Status s = prevg_.copy_plane(frame_.gb, 0, 0); !s) return s;
+  has_prev_id_ = f.id != nullptr;
+  if (has_prev_id_)
+    if (Status s = prevg_.copy_plane(frame_.gb, 7, 1); !s) return s;
+  return Status::ok();
+}
+
+Status GpuHistoryState::download_result(const FrameContext& f, std::span<const char* const> debug_names) {
+  if (result_.width() != f.W || result_.height() != f.H) result_ = Image(f.W, f.H);
+  for (int c = 0; c < f.C; ++c)
+    if (Status s = out_[cur_].download(c, result_, g_.channels[std::size_t(c)]); !s) return s;
+  for (std::size_t d = 0; d < debug_names.size(); ++d) {
+    if (f.debug) {
+      if (Status s = out_[cur_].download(f.C + int(d), result_, debug_names[d]); !s) return s;
+    } else {
+      result_.remove_channel(debug_names[d]);
+    }
+  }
+  return Status::ok();
+}
+
+std::string_view sampling_grid_glsl() {
+  return R"(
+uniform ivec2 u_full, u_low;
+uniform int u_k, u_sx, u_sy, u_C;
+uniform uint u_n, u_ln;
+
+bool low_valid(uint q) {
+  const uint lx = q % uint(u_low.x), ly = q / uint(u_low.x);
+  const uint g = (uint(u_k) * ly + uint(u_sy)) * uint(u_full.x) + uint(u_sx) + uint(u_k) * lx;
+  bool ok = is_finite_bits(gb[g]) && is_finite_bits(gb[u_n + g]) && is_finite_bits(gb[2u * u_n + g]) &&
+            is_finite_bits(gb[3u * u_n + g]);
+  for (int c = 0; c < u_C; ++c) ok = ok && is_sample(lowb[uint(c) * u_ln + q]);
+  return ok;
+}
+)";
+}
+
+void set_sampling_grid_uniforms(const gpu::Program& program, const FrameContext& f) {
+  program.set_int2("u_full", f.W, f.H);
+  program.set_int2("u_low", f.lw, f.lh);
+  program.set("u_k", f.grid.k);
+  program.set("u_sx", f.grid.sx);
+  program.set("u_sy", f.grid.sy);
+  program.set("u_C", f.C);
+  program.set("u_n", std::uint32_t(std::size_t(f.W) * f.H));
+  program.set("u_ln", std::uint32_t(std::size_t(f.lw) * f.lh));
 }
 
 Expected<std::shared_ptr<gpu::Context>> shared_gpu_context() {

@@ -24,31 +24,14 @@ namespace temporal::upsample {
 namespace {
 
 std::string constants() {
-  auto line = [](const char* name, float v) {
-    char b[128];
-    std::snprintf(b, sizeof b, "const float %s = %.9g;\n", name, double(v));
-    return std::string(b);
-  };
+  const auto line = gpu::glsl::float_constant;  // "const float NAME = VALUE;", the float exactly
   return line("kLanczosWeightScale", kLanczosWeightScale) + line("kMaxAccumulation", kMaxAccumulation) +
          line("kEpsilon", kEpsilon) + line("kRectifiedAccumulation", kRectifiedAccumulation) +
          line("kSimilarLuma", kSimilarLuma) + line("kFloatMax", std::numeric_limits<float>::max()) + R"(
-uniform ivec2 u_full, u_low;
-uniform int u_k, u_sx, u_sy, u_C;
-uniform uint u_n, u_ln;
 uniform float u_luma[16];
 uniform bool u_locks;
 
-// gather_low_geometry's validity of low-resolution sample q: finite geometry at its full-resolution pixel and a
-// payload that is a sample (is_sample: finite and at most kMaxSampleMagnitude, as usable_sample in frame.cpp).
-bool low_valid(uint q) {
-  const uint lx = q % uint(u_low.x), ly = q / uint(u_low.x);
-  const uint g = (uint(u_k) * ly + uint(u_sy)) * uint(u_full.x) + uint(u_sx) + uint(u_k) * lx;
-  bool ok = is_finite_bits(gb[g]) && is_finite_bits(gb[u_n + g]) && is_finite_bits(gb[2u * u_n + g]) &&
-            is_finite_bits(gb[3u * u_n + g]);
-  for (int c = 0; c < u_C; ++c) ok = ok && is_sample(lowb[uint(c) * u_ln + q]);
-  return ok;
-}
-)";
+)" + std::string(sampling_grid_glsl());
 }
 
 // L: dispatch lw x lh (u_size = the low resolution). lowl (6): plane 0 the luminance, plane 1 the thin features.
@@ -323,26 +306,17 @@ void main() {
 constexpr const char* kDebugNames[7] = {"debug.confidence", "debug.disocclusion", "debug.gradient", "debug.wf",
                                         "debug.historyWeight", "debug.convergence", "debug.lock"};
 
-class TaauStateGpu final : public MethodState, public gpu::TimedKernel {
+class TaauStateGpu final : public GpuHistoryState {
  public:
   TaauStateGpu(std::shared_ptr<gpu::Context> ctx, gpu::Program low, gpu::Program pixel, gpu::ImageBuffer counters,
                const Geometry& g)
-      : ctx_(std::move(ctx)), low_(std::move(low)), pixel_(std::move(pixel)), counters_(std::move(counters)), g_(g),
-        timer_(ctx_) {}
-
-  Image& run(const FrameContext& f, bool history, FrameStats& stats) override {
-    status_ = run_gpu(f, history, stats);
-    return result_;
-  }
-  Status run_status() const override { return status_; }
+      : GpuHistoryState(std::move(ctx), std::move(counters), g), low_(std::move(low)), pixel_(std::move(pixel)) {}
 
   // The planes TaauState::save writes, from the parity of the last frame.
   void save(Image& state) const override {
     if (out_[0].empty()) return;  // save() cannot report an error; load() names a missing plane
+    save_history(state);
     std::vector<float> plane(std::size_t(g_.W) * g_.H);
-    for (int c = 0; c < int(g_.channels.size()); ++c)
-      if (out_[cur_].download(c, plane.data()))
-        put_plane(state, "history." + g_.channels[std::size_t(c)], plane.data(), g_.W, g_.H);
     const char* names[3] = {"history.weight", "lock.lifetime", "lock.luma"};
     for (int q = 0; q < 3; ++q)
       if (st_.download(3 * cur_ + q, plane.data())) put_plane(state, names[q], plane.data(), g_.W, g_.H);
@@ -352,54 +326,37 @@ class TaauStateGpu final : public MethodState, public gpu::TimedKernel {
   Status load(const Image& state) override {
     if (Status s = allocate(); !s) return s;
     cur_ = 1 - cur_;  // OutputPair::next()
+    if (Status s = load_history(state); !s) return s;
     std::vector<float> plane(std::size_t(g_.W) * g_.H);
-    for (int c = 0; c < int(g_.channels.size()); ++c) {
-      if (Status s = get_plane(state, "history." + g_.channels[std::size_t(c)], plane.data(), g_.W, g_.H); !s)
-        return s;
-      if (Status s = out_[cur_].upload(c, plane.data()); !s) return s;
-    }
     const char* names[3] = {"history.weight", "lock.lifetime", "lock.luma"};
     for (int q = 0; q < 3; ++q) {
       if (Status s = get_plane(state, names[q], plane.data(), g_.W, g_.H); !s) return s;
       if (Status s = st_.upload(3 * cur_ + q, plane.data()); !s) return s;
     }
-    if (Status s = upload_previous_geometry(state, g_, prevg_, has_prev_id_); !s) return s;
-    return Status::ok();
+    return upload_previous_geometry(state, g_, prevg_, has_prev_id_);
   }
-
-  gpu::KernelTiming last_timing() const override { return timing_; }
 
  private:
   // TaauState's constructor: weights, locks and the outputs 0.
   Status allocate() {
     if (!out_[0].empty()) return Status::ok();
-    const int C = int(g_.channels.size());
-    auto make = [&](gpu::ImageBuffer& b, int w, int h, int planes) {
-      return gpu::ImageBuffer::create_cleared(ctx_, w, h, planes, b);
-    };
-    for (auto& b : out_)
-      if (Status s = make(b, g_.W, g_.H, C + 7); !s) return s;
-    if (Status s = make(prevg_, g_.W, g_.H, 2); !s) return s;
-    if (Status s = make(st_, g_.W, g_.H, 6); !s) return s;
-    return make(lowl_, g_.lw, g_.lh, 2);
+    const int C = int(g_.channels.size()), W = g_.W, H = g_.H;
+    return gpu::ImageBuffer::create_all_cleared(ctx_, {{&out_[0], W, H, C + 7},
+                                                       {&out_[1], W, H, C + 7},
+                                                       {&prevg_, W, H, 2},
+                                                       {&st_, W, H, 6},
+                                                       {&lowl_, g_.lw, g_.lh, 2}});
   }
 
   void set_common(const gpu::Program& prog, const FrameContext& f, const TaauOptions& to) const {
-    prog.set_int2("u_full", f.W, f.H);
-    prog.set_int2("u_low", f.lw, f.lh);
-    prog.set("u_k", f.grid.k);
-    prog.set("u_sx", f.grid.sx);
-    prog.set("u_sy", f.grid.sy);
-    prog.set("u_C", f.C);
-    prog.set("u_n", std::uint32_t(std::size_t(f.W) * f.H));
-    prog.set("u_ln", std::uint32_t(std::size_t(f.lw) * f.lh));
+    set_sampling_grid_uniforms(prog, f);
     float luma[16] = {};
     for (int c = 0; c < f.C && c < 16; ++c) luma[c] = f.luma[std::size_t(c)];
     prog.set("u_luma", luma, 16);
     prog.set("u_locks", int(to.locks));
   }
 
-  Status run_gpu(const FrameContext& f, bool history, FrameStats& stats) {
+  Status run_gpu(const FrameContext& f, bool history, FrameStats& stats) override {
     const TaauOptions& to = taau_options(*f.options);
     if (f.C > 16) return Error::usage("taau on the GPU takes at most 16 payload channels, not " + std::to_string(f.C));
     if (Status s = allocate(); !s) return s;
@@ -450,20 +407,8 @@ class TaauStateGpu final : public MethodState, public gpu::TimedKernel {
     timing_.bytes_moved = (C * low + 4 * low + 2 * low) + 4 * full + C * low + C * full + 2 * full + full +
                           2 * (2 * full) + C * full + 3 * 2 * full + 2 * low + (f.debug ? 7.0 * full : 0.0);
 
-    if (result_.width() != f.W || result_.height() != f.H) result_ = Image(f.W, f.H);
-    for (int c = 0; c < C; ++c)
-      if (Status s = out_[cur_].download(c, result_, g_.channels[std::size_t(c)]); !s) return s;
-    for (int d = 0; d < 7; ++d) {
-      if (f.debug) {
-        if (Status s = out_[cur_].download(C + d, result_, kDebugNames[d]); !s) return s;
-      } else {
-        result_.remove_channel(kDebugNames[d]);
-      }
-    }
-    if (Status s = prevg_.copy_plane(frame_.gb, 0, 0); !s) return s;  // PreviousGeometry::store
-    has_prev_id_ = f.id != nullptr;
-    if (has_prev_id_)
-      if (Status s = prevg_.copy_plane(frame_.gb, 7, 1); !s) return s;
+    if (Status s = download_result(f, kDebugNames); !s) return s;
+    if (Status s = store_previous_geometry(f); !s) return s;
     std::uint32_t counts[4] = {};
     if (Status s = counters_.download(0, counts); !s) return s;
     stats.history_pixels = history ? counts[0] : 0;
@@ -471,18 +416,8 @@ class TaauStateGpu final : public MethodState, public gpu::TimedKernel {
     return Status::ok();
   }
 
-  std::shared_ptr<gpu::Context> ctx_;
   gpu::Program low_, pixel_;
-  gpu::ImageBuffer counters_;
-  Geometry g_;
-  gpu::Timer timer_;
-  GpuFrame frame_;
-  gpu::ImageBuffer out_[2], prevg_, st_, lowl_;
-  int cur_ = 0;
-  bool has_prev_id_ = false;
-  Image result_;
-  Status status_;
-  gpu::KernelTiming timing_;
+  gpu::ImageBuffer st_, lowl_;
 };
 
 }  // namespace
@@ -490,10 +425,7 @@ class TaauStateGpu final : public MethodState, public gpu::TimedKernel {
 Expected<std::unique_ptr<MethodState>> make_taau_state_gpu(std::shared_ptr<gpu::Context> context, const Options&,
                                                            const Geometry& geometry) {
   if (Status s = gpu::Context::ensure(context); !s) return s.error();
-  auto floats = [](int binding, const char* name) {
-    const std::string b = std::to_string(binding), n = name;
-    return "layout(std430, binding = " + b + ") buffer " + n + "_F { float " + n + "[]; };\n";
-  };
+  const auto floats = gpu::glsl::float_storage;  // a float-only storage block
   const std::string consts = constants();
   const std::string s0 = gpu::glsl::storage(0, "gb"), s1 = floats(1, "lowb"), s2 = floats(2, "outb"),
                     s3 = floats(3, "hist"), s4 = gpu::glsl::storage(4, "prevg"), s5 = floats(5, "st"),

@@ -57,42 +57,24 @@ void main() {
 }
 )";
 
-class TemporalStateGpu final : public MethodState, public gpu::TimedKernel {
+class TemporalStateGpu final : public GpuHistoryState {
  public:
   TemporalStateGpu(std::shared_ptr<gpu::Context> ctx, gpu::Program program, gpu::ImageBuffer counters,
                    const Geometry& g)
-      : ctx_(std::move(ctx)), program_(std::move(program)), counters_(std::move(counters)), g_(g), timer_(ctx_) {}
-
-  Image& run(const FrameContext& f, bool history, FrameStats& stats) override {
-    status_ = run_gpu(f, history, stats);
-    return result_;
-  }
-  Status run_status() const override { return status_; }
+      : GpuHistoryState(std::move(ctx), std::move(counters), g), program_(std::move(program)) {}
 
   void save(Image& state) const override {
-    // save() cannot report an error; a failed download leaves the plane out and load() names it.
     if (!allocate_const_ok()) return;
-    std::vector<float> plane(std::size_t(g_.W) * g_.H);
-    for (int c = 0; c < int(g_.channels.size()); ++c)
-      if (out_[cur_].download(c, plane.data()))
-        put_plane(state, "history." + g_.channels[std::size_t(c)], plane.data(), g_.W, g_.H);
+    save_history(state);
     save_previous_geometry(prevg_, has_prev_id_, g_, state);
   }
 
   Status load(const Image& state) override {
     if (Status s = allocate(); !s) return s;
     cur_ = 1 - cur_;  // as OutputPair::next(): the loaded history is the previous output of the next run()
-    std::vector<float> plane(std::size_t(g_.W) * g_.H);
-    for (int c = 0; c < int(g_.channels.size()); ++c) {
-      if (Status s = get_plane(state, "history." + g_.channels[std::size_t(c)], plane.data(), g_.W, g_.H); !s)
-        return s;
-      if (Status s = out_[cur_].upload(c, plane.data()); !s) return s;
-    }
-    if (Status s = upload_previous_geometry(state, g_, prevg_, has_prev_id_); !s) return s;
-    return Status::ok();
+    if (Status s = load_history(state); !s) return s;
+    return upload_previous_geometry(state, g_, prevg_, has_prev_id_);
   }
-
-  gpu::KernelTiming last_timing() const override { return timing_; }
 
  private:
   bool allocate_const_ok() const { return !out_[0].empty() && !prevg_.empty(); }
@@ -100,18 +82,11 @@ class TemporalStateGpu final : public MethodState, public gpu::TimedKernel {
   Status allocate() {
     if (allocate_const_ok()) return Status::ok();
     const int planes = int(g_.channels.size()) + 2;
-    for (auto& b : out_) {
-      auto created = gpu::ImageBuffer::create(ctx_, g_.W, g_.H, planes);
-      if (!created) return created.error();
-      b = std::move(*created);
-    }
-    auto prev = gpu::ImageBuffer::create(ctx_, g_.W, g_.H, 2);
-    if (!prev) return prev.error();
-    prevg_ = std::move(*prev);
-    return Status::ok();
+    return gpu::ImageBuffer::create_all(
+        ctx_, {{&out_[0], g_.W, g_.H, planes}, {&out_[1], g_.W, g_.H, planes}, {&prevg_, g_.W, g_.H, 2}});
   }
 
-  Status run_gpu(const FrameContext& f, bool history, FrameStats& stats) {
+  Status run_gpu(const FrameContext& f, bool history, FrameStats& stats) override {
     if (Status s = allocate(); !s) return s;
     if (Status s = frame_.upload(ctx_, f, true); !s) return s;
     if (Status s = counters_.clear(0, 1); !s) return s;
@@ -142,18 +117,9 @@ class TemporalStateGpu final : public MethodState, public gpu::TimedKernel {
     timing_.bytes_moved = 4.0 * full + f.C * low + f.C * full + 2 * full + full + 2 * (2 * full) + f.C * full +
                           (f.debug ? 2.0 * full : 0.0);
 
-    if (result_.width() != f.W || result_.height() != f.H) result_ = Image(f.W, f.H);
-    for (int c = 0; c < f.C; ++c)
-      if (Status s = out_[cur_].download(c, result_, g_.channels[std::size_t(c)]); !s) return s;
-    if (f.debug) {
-      if (Status s = out_[cur_].download(f.C, result_, "debug.disocclusion"); !s) return s;
-      if (Status s = out_[cur_].download(f.C + 1, result_, "debug.confidence"); !s) return s;
-    }
-    // PreviousGeometry::store: this frame's depth and ids become the previous frame's.
-    if (Status s = prevg_.copy_plane(frame_.gb, 0, 0); !s) return s;
-    has_prev_id_ = f.id != nullptr;
-    if (has_prev_id_)
-      if (Status s = prevg_.copy_plane(frame_.gb, 7, 1); !s) return s;
+    static const char* const kDebugNames[2] = {"debug.disocclusion", "debug.confidence"};
+    if (Status s = download_result(f, kDebugNames); !s) return s;
+    if (Status s = store_previous_geometry(f); !s) return s;
     std::uint32_t counts[4] = {};
     if (Status s = counters_.download(0, counts); !s) return s;
     stats.hole_pixels = counts[0];
@@ -161,18 +127,7 @@ class TemporalStateGpu final : public MethodState, public gpu::TimedKernel {
     return Status::ok();
   }
 
-  std::shared_ptr<gpu::Context> ctx_;
   gpu::Program program_;
-  gpu::ImageBuffer counters_;
-  Geometry g_;
-  gpu::Timer timer_;
-  GpuFrame frame_;
-  gpu::ImageBuffer out_[2], prevg_;
-  int cur_ = 0;
-  bool has_prev_id_ = false;
-  Image result_;
-  Status status_;
-  gpu::KernelTiming timing_;
 };
 
 }  // namespace

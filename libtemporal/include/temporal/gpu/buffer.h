@@ -10,6 +10,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <initializer_list>
 #include <memory>
 #include <span>
 #include <string>
@@ -25,6 +26,16 @@ class ImageBuffer {
   // Makes `buffer` a new buffer like create()'s with every plane 0 (a state's histories before the first frame).
   static Status create_cleared(std::shared_ptr<Context> context, int width, int height, int planes,
                                ImageBuffer& buffer);
+  // One buffer of a set made together (create_all): where it goes and its size.
+  struct Shape {
+    ImageBuffer* buffer;
+    int width, height, planes;
+  };
+  // Makes each shape's buffer a new buffer like create()'s, all or none: on an error no buffer changed. The buffers
+  // a kernel needs for one frame size, (re)made together.
+  static Status create_all(const std::shared_ptr<Context>& context, std::initializer_list<Shape> shapes);
+  // The same with every plane 0 (create_cleared()): a state's buffers before its first frame.
+  static Status create_all_cleared(const std::shared_ptr<Context>& context, std::initializer_list<Shape> shapes);
   ~ImageBuffer();
   ImageBuffer(ImageBuffer&& other) noexcept;
   ImageBuffer& operator=(ImageBuffer&& other) noexcept;

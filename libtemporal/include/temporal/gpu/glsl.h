@@ -20,6 +20,14 @@ std::string_view prelude();
 // `name_u[]` as uint (ids), so one ImageBuffer holds both kinds of planes.
 std::string storage(int binding, const char* name);
 
+// Declares shader storage buffer `name` at `binding` as float only (`name[]`): one storage block where storage()
+// uses two, for a kernel near GL_MAX_COMPUTE_SHADER_STORAGE_BLOCKS (16 on llvmpipe) that reads no ids from it.
+std::string float_storage(int binding, const char* name);
+
+// "const float NAME = VALUE;" with VALUE printed with %.9g, which round-trips a float: a C++ constant in a kernel
+// with the same bits, so that the host code and the kernel cannot drift.
+std::string float_constant(const char* name, float value);
+
 // The GLSL version of temporal/core/reproject.h: the same rules and constants, one definition for every kernel.
 //   reproject_on_screen(f)                          the off-screen rule
 //   Taps reproject_taps(p, motion)                  reproject_row's taps: NaN / Inf / |m| >= 1e6 motion or off
