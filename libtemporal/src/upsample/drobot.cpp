@@ -24,6 +24,10 @@
 #include "temporal/core/parallel.h"
 
 #include <atomic>
+#include <cstdint>
+#if defined(__SSE2__)
+#include <immintrin.h>
+#endif
 
 namespace temporal::upsample {
 
