@@ -53,11 +53,12 @@ const HerzogOptions& herzog_options(const Options& o) { return method_options<He
 namespace {
 
 // Asks Linux to back the 2 MiB-aligned part of [p, p + bytes) with transparent huge pages: MADV_HUGEPAGE for the
-// pages faulted in later, MADV_COLLAPSE (Linux 6.1; an error before) for those already there. herzog reads and
-// writes about 15 full-resolution planes per frame besides the G-buffer; at 4 KiB pages that is ~25000 pages per
-// frame at 1280x1024, and each page's first touch in a frame missed the TLB (a nested page walk in a virtual
-// machine). With the host's THP mode "madvise" only the regions that ask get huge pages. Only speed depends on
-// it: errors (no THP, no free huge page, another OS) are ignored.
+// pages faulted in later, MADV_COLLAPSE (Linux 6.1; an error before) for those already there. herzog reads or
+// writes 12 full-resolution planes of its own per frame besides the G-buffer's 8; at 4 KiB pages that is ~25000
+// pages per frame at 1280x1024, far more than the TLB holds, so each page's first touch in a frame is a page walk
+// (a nested one in a virtual machine; docs/upsample-st.md, "Issue 27: herzog's second pass"). With the host's THP
+// mode "madvise" only the regions that ask get huge pages. Only speed depends on it: errors (no THP, no free huge
+// page, another OS) are ignored.
 [[maybe_unused]] void advise_huge_pages(const void* p, std::size_t bytes) {
 #if defined(__linux__) && defined(MADV_HUGEPAGE)
   constexpr std::uintptr_t kHuge = std::uintptr_t(2) << 20;
