@@ -9,6 +9,8 @@
 #include "temporal/core/isa.h"
 #include "temporal/core/parallel.h"
 
+#include <bit>
+#include <cstring>
 #include <limits>
 
 namespace temporal::reproject {
@@ -21,36 +23,6 @@ void HistoryRow::resize(int W) {
   aligned.resize(W);
 }
 
-void build_segments(HistoryRow& h, int W) {
-  h.segments.clear();
-  const int* __restrict off = h.offset.data();
-  const int* __restrict al = h.aligned.data();
-  int gather_start = -1, X = 0;
-  while (X < W) {
-    const int base = off[X];
-    int E = X;
-    if (al[X]) {
-      while (E + 16 <= W) {  // whole blocks first (a reduction the compiler vectorises)
-        int all = 1;
-        for (int i = 0; i < 16; ++i) all &= int(off[E + i] == base) & al[E + i];
-        if (!all) break;
-        E += 16;
-      }
-      while (E < W && off[E] == base && al[E]) ++E;
-    }
-    if (E - X >= 16) {
-      if (gather_start >= 0) h.segments.push_back({gather_start, X, -1});
-      gather_start = -1;
-      h.segments.push_back({X, E, base});
-      X = E;
-    } else {
-      if (gather_start < 0) gather_start = X;
-      X = std::max(E, X + 1);
-    }
-  }
-  if (gather_start >= 0) h.segments.push_back({gather_start, W, -1});
-}
-
 namespace {
 
 // The kernel copies, one per instruction set (temporal/core/isa.h). The bilinear sums w0 p0 + w1 p1 + ... may
@@ -61,16 +33,17 @@ namespace {
 struct Kernels {
   void (*reproject)(const Frames&, int, HistoryRow&);
   void (*gather)(const HistoryRow&, const float* const*, float* const*, int, int);
+  void (*segments)(HistoryRow&, int);
 };
 
 const Kernels& kernels() {
 #if TEMPORAL_ISA_DISPATCH
-  static constexpr Kernels table[3] = {{v2::reproject_row_copy, v2::gather_row_copy},
-                                       {v3::reproject_row_copy, v3::gather_row_copy},
-                                       {v4::reproject_row_copy, v4::gather_row_copy}};
+  static constexpr Kernels table[3] = {{v2::reproject_row_copy, v2::gather_row_copy, v2::build_segments_copy},
+                                       {v3::reproject_row_copy, v3::gather_row_copy, v3::build_segments_copy},
+                                       {v4::reproject_row_copy, v4::gather_row_copy, v4::build_segments_copy}};
   return table[int(isa::active())];  // Level::V2, V3, V4 are 0, 1, 2
 #else
-  static constexpr Kernels table{native::reproject_row_copy, native::gather_row_copy};
+  static constexpr Kernels table{native::reproject_row_copy, native::gather_row_copy, native::build_segments_copy};
   return table;
 #endif
 }
@@ -81,6 +54,8 @@ void reproject_row(const Frames& frames, int y, HistoryRow& h) {
   h.resize(frames.width);
   kernels().reproject(frames, y, h);
 }
+
+void build_segments(HistoryRow& h, int width) { kernels().segments(h, width); }
 
 void gather_row(const HistoryRow& h, const float* const* prev, float* const* out, int n, int width) {
   kernels().gather(h, prev, out, n, width);

@@ -4,7 +4,7 @@
 // scenes with a moving object and per-frame G-buffers, debug layers on, k = 4, 3 (odd width) and 2 (gradient
 // scale 4)) and writes every output float to FILE (`write FILE`), or compares against FILE (`check FILE`), printing
 // the largest absolute and relative differences per variant ("max abs 0": bit-identical) and, for a variant that
-// differs, per scene and output channel (payload or debug layer).
+// differs, per scene and output channel (payload or debug layer) with the PSNR against the stored run.
 #include "synthetic.h"
 #include "upsample_variants.h"
 
@@ -174,23 +174,33 @@ int main(int argc, char** argv) {
     if (differing) std::printf("  (%zu values differ, the first at float %zu of %zu)", differing, first, std::size_t(n));
     std::printf("\n");
     if (!differing) continue;
-    // Per scene and channel: the largest difference (absolute; relative to max(1, |reference|)).
-    std::vector<std::pair<std::string, std::pair<double, double>>> per;
+    // Per scene and channel: the largest difference (absolute; relative to max(1, |reference|)) and the PSNR of
+    // the output against the reference, 10 log10(peak^2 / MSE) with peak the largest |reference| of the channel.
+    struct Diff {
+      double max_abs = 0, max_rel = 0, sq = 0, peak = 0;
+      std::size_t n = 0;
+    };
+    std::vector<std::pair<std::string, Diff>> per;
     for (const Segment& sg : segments[m]) {
       const std::string key = std::string(kScenes[sg.scene]) + " " + sg.channel;
       auto it = std::find_if(per.begin(), per.end(), [&](const auto& e) { return e.first == key; });
-      if (it == per.end()) it = per.insert(per.end(), {key, {0.0, 0.0}});
+      if (it == per.end()) it = per.insert(per.end(), {key, Diff{}});
+      Diff& e = it->second;
       for (std::size_t i = sg.begin; i < sg.end; ++i) {
         const float x = results[m][i], y = ref[i];
         if (std::isnan(x) || std::isnan(y)) continue;
         const double d = std::abs(double(x) - double(y));
-        it->second.first = std::max(it->second.first, d);
-        it->second.second = std::max(it->second.second, d / std::max(1.0, std::abs(double(y))));
+        e.max_abs = std::max(e.max_abs, d);
+        e.max_rel = std::max(e.max_rel, d / std::max(1.0, std::abs(double(y))));
+        e.sq += d * d;
+        e.peak = std::max(e.peak, std::abs(double(y)));
+        ++e.n;
       }
     }
-    for (const auto& [key, d] : per)
-      if (d.first > 0)
-        std::printf("    %-36s max abs %.3g  max rel %.3g\n", key.c_str(), d.first, d.second);
+    for (const auto& [key, e] : per)
+      if (e.max_abs > 0)
+        std::printf("    %-36s max abs %.3g  max rel %.3g  PSNR %.1f dB\n", key.c_str(), e.max_abs, e.max_rel,
+                    10.0 * std::log10(e.peak * e.peak / (e.sq / double(e.n))));
   }
   return bad ? 4 : 0;
 }

@@ -174,6 +174,7 @@ struct HistoryRow {
   };
   std::vector<Segment> segments;
   std::vector<int> offset, aligned;  // scratch: q0 - x, and 1 where the taps form the aligned block
+  std::vector<std::uint8_t> breaks;  // scratch of build_segments: 1 where a run of equal aligned offsets ends
   void resize(int W);
 };
 
