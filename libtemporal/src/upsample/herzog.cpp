@@ -75,19 +75,6 @@ namespace {
 // The frame code's copies, one per instruction set (temporal/core/isa.h); a state runs the copy of the level
 // active when it was made. v3 and v4 may contract multiply-adds into FMAs (v2 has none) outside the row kernels
 // compiled with fp-contract=off, so v2's output can differ from theirs in the last bits.
-// Whether a copy's target has FMA: kernels that must round as the compiler's contraction did elsewhere write
-// their multiply-adds out with std::fma there (a plain multiply and add in v2, which has none). The preprocessor
-// cannot tell (GCC's C++ front end reads the macros before the target pragmas apply), so each copy's namespace
-// gets a constant.
-#if TEMPORAL_ISA_DISPATCH
-namespace v2 { constexpr bool kCopyHasFma = false; }
-namespace v3 { constexpr bool kCopyHasFma = true; }
-namespace v4 { constexpr bool kCopyHasFma = true; }
-#elif defined(__FMA__)
-namespace native { constexpr bool kCopyHasFma = true; }
-#else
-namespace native { constexpr bool kCopyHasFma = false; }
-#endif
 #define TEMPORAL_ISA_FILE "herzog_impl.inc"
 #include "temporal/core/isa_copies.inc"
 
