@@ -34,16 +34,19 @@ struct Kernels {
   void (*reproject)(const Frames&, int, HistoryRow&);
   void (*gather)(const HistoryRow&, const float* const*, float* const*, int, int);
   void (*segments)(HistoryRow&, int);
+  void (*reproject_gather)(const Frames&, int, HistoryRow&, const float* const*, float* const*, int);
 };
 
 const Kernels& kernels() {
 #if TEMPORAL_ISA_DISPATCH
-  static constexpr Kernels table[3] = {{v2::reproject_row_copy, v2::gather_row_copy, v2::build_segments_copy},
-                                       {v3::reproject_row_copy, v3::gather_row_copy, v3::build_segments_copy},
-                                       {v4::reproject_row_copy, v4::gather_row_copy, v4::build_segments_copy}};
+  static constexpr Kernels table[3] = {
+      {v2::reproject_row_copy, v2::gather_row_copy, v2::build_segments_copy, v2::reproject_gather_row_copy},
+      {v3::reproject_row_copy, v3::gather_row_copy, v3::build_segments_copy, v3::reproject_gather_row_copy},
+      {v4::reproject_row_copy, v4::gather_row_copy, v4::build_segments_copy, v4::reproject_gather_row_copy}};
   return table[int(isa::active())];  // Level::V2, V3, V4 are 0, 1, 2
 #else
-  static constexpr Kernels table{native::reproject_row_copy, native::gather_row_copy, native::build_segments_copy};
+  static constexpr Kernels table{native::reproject_row_copy, native::gather_row_copy, native::build_segments_copy,
+                                 native::reproject_gather_row_copy};
   return table;
 #endif
 }
@@ -59,6 +62,17 @@ void build_segments(HistoryRow& h, int width) { kernels().segments(h, width); }
 
 void gather_row(const HistoryRow& h, const float* const* prev, float* const* out, int n, int width) {
   kernels().gather(h, prev, out, n, width);
+}
+
+void reproject_gather_row(const Frames& frames, int y, HistoryRow& h, const float* const* prev, float* const* out,
+                          int n) {
+  if (n > 4) {  // the fused loop holds up to four planes
+    reproject_row(frames, y, h);
+    gather_row(h, prev, out, n, frames.width);
+    return;
+  }
+  h.resize(frames.width);
+  kernels().reproject_gather(frames, y, h, prev, out, n);
 }
 
 void warp_planes(const Frames& frames, std::span<const float* const> previous, std::span<float* const> out) {

@@ -88,7 +88,7 @@ struct PreviousGeometry {
 // frame's G-buffer, the disocclusion settings of the options. The expected previous depth is the warped depth
 // prevDepth.Z when the frame has it (seed 000 section 3.2), else the current depth.
 using reproject::HistoryRow;
-inline void history_row(const FrameContext& f, const PreviousGeometry& prev, int Y, HistoryRow& h) {
+inline reproject::Frames history_frames(const FrameContext& f, const PreviousGeometry& prev) {
   reproject::Frames fr;
   fr.width = f.W;
   fr.height = f.H;
@@ -99,7 +99,16 @@ inline void history_row(const FrameContext& f, const PreviousGeometry& prev, int
   fr.prev_id = prev.id.empty() ? nullptr : prev.id.data();
   fr.test = f.options->surface_test();
   reproject::expect_depth(fr, f.z, f.prev_z, f.options->warped_depth_tolerance);
-  reproject::reproject_row(fr, Y, h);
+  return fr;
+}
+inline void history_row(const FrameContext& f, const PreviousGeometry& prev, int Y, HistoryRow& h) {
+  reproject::reproject_row(history_frames(f, prev), Y, h);
+}
+// history_row and the gather of n previous-frame planes src into dst in one pass (reproject::reproject_gather_row:
+// the same values; h.w holds the weights of the gather runs only).
+inline void history_gather_row(const FrameContext& f, const PreviousGeometry& prev, int Y, HistoryRow& h,
+                               const float* const* src, float* const* dst, int n) {
+  reproject::reproject_gather_row(history_frames(f, prev), Y, h, src, dst, n);
 }
 
 // The geometry (z, N, validity) and payload of one low-resolution row, expanded to full-resolution columns:

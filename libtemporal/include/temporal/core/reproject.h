@@ -214,6 +214,13 @@ void build_segments(HistoryRow& h, int width);
 // (0 on a miss: callers test h.hit).
 void gather_row(const HistoryRow& h, const float* const* prev, float* const* out, int n, int width);
 
+// reproject_row, then gather_row of n planes (1..16), in one pass over the row: the same values in out and h.hit.
+// Up to four planes, the aligned runs (HistoryRow::segments) test and gather in one loop that never stores their
+// weights: h.q and h.w then hold the taps of the gather runs only, so a caller that needs the weights of every
+// pixel (to gather more planes later) calls the two steps instead. More than four planes: the two steps.
+void reproject_gather_row(const Frames& frames, int y, HistoryRow& h, const float* const* prev, float* const* out,
+                          int n);
+
 // --- Whole planes (metrics) --------------------------------------------------------------------------------
 
 // out[k] = previous[k] fetched for every pixel with the rules above, NaN where the fetch is a miss (off screen or
