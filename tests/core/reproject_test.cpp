@@ -2,6 +2,8 @@
 // disocclusion test and the row kernel, on hand-made images with hand-computed values.
 #include "temporal/core/reproject.h"
 
+#include "temporal/core/isa.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -166,4 +168,90 @@ TEST(Reproject, WarpedDepthKeepsAnApproachingSurfaceAndStillFindsDisocclusions) 
   const rp::SurfaceTest t{rp::kWarpedDepthTolerance, true};
   EXPECT_TRUE(rp::same_surface(10.0f, 1, 10.0f * (1.0f + 0.99f * rp::kWarpedDepthTolerance), 1, t));
   EXPECT_FALSE(rp::same_surface(10.0f, 1, 10.0f * (1.0f + 2.0f * rp::kWarpedDepthTolerance), 1, t));
+}
+
+// reproject_gather_row (the taps' test and the gather in one loop on aligned runs) against reproject_row then
+// gather_row, bit for bit, at every instruction-set level this CPU runs: hit flags and gathered values for 1 to 5
+// planes (5: the two-step fallback) and the four depth / id settings, on a row mixing a pan (aligned runs of 16
+// pixels and more), per-pixel motion (gather runs), NaN and off-screen motion, and depth and id edges.
+TEST(Reproject, GatherRowInOnePassEqualsTheTwoSteps) {
+  namespace isa = temporal::isa;
+  const int W = 96, H = 24;
+  const std::size_t N = std::size_t(W) * H;
+  std::vector<float> mx(N), my(N), z(N), pz(N);
+  std::vector<std::uint32_t> id(N), pid(N);
+  std::vector<std::vector<float>> planes(5, std::vector<float>(N));
+  std::uint32_t seed = 12345;
+  auto rnd = [&seed] {  // [0, 1), deterministic
+    seed = seed * 1664525u + 1013904223u;
+    return float(seed >> 8) / float(1u << 24);
+  };
+  for (int y = 0; y < H; ++y)
+    for (int x = 0; x < W; ++x) {
+      const std::size_t i = std::size_t(y) * W + x;
+      if (x < 40) {  // a pan: one offset, aligned
+        mx[i] = 1.25f;
+        my[i] = -0.5f;
+      } else if (x < 70) {  // per-pixel motion: gather runs
+        mx[i] = 6.0f * rnd() - 3.0f;
+        my[i] = 4.0f * rnd() - 2.0f;
+      } else {  // a still region with a few non-finite or off-screen motions
+        mx[i] = x % 11 == 0 ? NAN : (x % 13 == 0 ? 1e7f : 0.0f);
+        my[i] = x % 17 == 0 ? float(H) : 0.0f;
+      }
+      z[i] = 10.0f + (x > 60 ? 5.0f : 0.0f) + 0.01f * rnd();
+      pz[i] = 10.0f + (x > 58 ? 5.0f : 0.0f) + 0.01f * rnd();
+      id[i] = x > 80 ? 2u : 1u;
+      pid[i] = x > 82 ? 2u : 1u;
+      for (auto& p : planes) p[i] = rnd();
+    }
+  std::vector<isa::Level> levels;
+  for (const isa::Level l : {isa::Level::V2, isa::Level::V3, isa::Level::V4})
+    if (isa::supported(l)) levels.push_back(l);
+  if (levels.empty()) levels.push_back(isa::active());  // a build with one copy
+  for (const isa::Level level : levels) {
+    isa::ScopedLevel scoped(level);
+    for (int mode = 0; mode < 4; ++mode) {
+      rp::Frames fr;
+      fr.width = W;
+      fr.height = H;
+      fr.motion_x = mx.data();
+      fr.motion_y = my.data();
+      if (mode & 1) {
+        fr.z = z.data();
+        fr.prev_z = pz.data();
+      }
+      if (mode & 2) {
+        fr.id = id.data();
+        fr.prev_id = pid.data();
+      }
+      for (int n = 1; n <= 5; ++n) {
+        const float* prev[5];
+        for (int i = 0; i < 5; ++i) prev[i] = planes[std::size_t(i)].data();
+        std::vector<float> a(std::size_t(n) * W), b(std::size_t(n) * W);
+        float* oa[5];
+        float* ob[5];
+        for (int i = 0; i < n; ++i) {
+          oa[i] = a.data() + std::size_t(i) * W;
+          ob[i] = b.data() + std::size_t(i) * W;
+        }
+        rp::HistoryRow ha, hb;
+        bool gather_run = false, aligned_run = false;
+        for (int y = 0; y < H; ++y) {
+          rp::reproject_row(fr, y, ha);
+          rp::gather_row(ha, prev, oa, n, W);
+          rp::reproject_gather_row(fr, y, hb, prev, ob, n);
+          for (const auto& sg : hb.segments) (sg.base >= 0 ? aligned_run : gather_run) = true;
+          for (int x = 0; x < W; ++x) {
+            ASSERT_EQ(ha.hit[x], hb.hit[x]) << isa::name(level) << " mode " << mode << " n " << n << " y " << y
+                                            << " x " << x;
+            for (int i = 0; i < n; ++i)
+              ASSERT_EQ(oa[i][x], ob[i][x]) << isa::name(level) << " mode " << mode << " n " << n << " plane " << i
+                                            << " y " << y << " x " << x;
+          }
+        }
+        EXPECT_TRUE(aligned_run && gather_run);  // both kinds of run were exercised
+      }
+    }
+  }
 }
