@@ -90,34 +90,19 @@ const std::vector<Variant>& variants() {
 
 TEST(DrobotGpu, MatchesTheCppMethod) {
   TEMPORAL_GPU_CONTEXT_OR_SKIP(ctx);
-  for (bool warped : {false, true})
-    for (bool debug : {false, true}) {
-      SCOPED_TRACE(::testing::Message() << "warped " << warped << " debug " << debug);
-      const test::StateComparison r = compare(ctx, options_with(nullptr), warped, debug);
-      expect_agreement(r);
-      RecordProperty(std::string("max_abs_") + (warped ? "w" : "") + (debug ? "d" : ""),
-                     (::testing::Message() << r.colour.max_abs << " psnr " << r.colour.psnr).GetString());
-    }
+  test::expect_agreement_in_every_mode(
+      [&](bool warped, bool debug) { return compare(ctx, options_with(nullptr), warped, debug); }, expect_agreement);
 }
 
 TEST(DrobotGpu, MatchesTheCppMethodForEveryOption) {
   TEMPORAL_GPU_CONTEXT_OR_SKIP(ctx);
-  Image defaults;
-  for (const Variant& v : variants()) {
-    SCOPED_TRACE(v.name);
-    const test::StateComparison r = compare(ctx, options_with(v.set), true, true);
-    expect_agreement(r);
-    // Each variant's option reaches the C++ method and changes its output.
-    if (!v.set) {
-      defaults = r.last_cpu;
-    } else {
-      EXPECT_GT(test::agreement(r.last_cpu, defaults, kRgb).max_abs, 1e-4);
-    }
-    RecordProperty(std::string("max_abs_") + v.name,
-                   (::testing::Message() << r.colour.max_abs << " psnr " << r.colour.psnr << " confidence "
-                                         << r.debug[0] << " convergence " << r.debug[1] << " frames "
-                                         << r.debug[2]).GetString());
-  }
+  test::expect_every_variant_agrees(
+      "drobot", variants(), [&](const Options& o) { return compare(ctx, o, true, true); },
+      [](const Variant&, const test::StateComparison& r) { expect_agreement(r); }, kRgb,
+      [](const test::StateComparison& r) {
+        return (::testing::Message() << " confidence " << r.debug[0] << " convergence " << r.debug[1] << " frames "
+                                     << r.debug[2]).GetString();
+      });
 }
 
 // Without ids (--no-ids) the disocclusion test is the depth test alone.
@@ -147,7 +132,7 @@ TEST(DrobotGpu, LoadNamesAMissingPlane) {
   EXPECT_NE(error.find("cache.G"), std::string::npos) << error;
 }
 
-// The registry's "gpu" implementation of herzog (what --device gpu picks): the same kernels on the shared context.
+// The registry's "gpu" implementation of drobot (what --device gpu picks): the same kernels on the shared context.
 TEST(DrobotGpu, IsRegisteredAsTheGpuImplementation) {
   TEMPORAL_GPU_CONTEXT_OR_SKIP(ctx);
   const test::RegisteredComparison r =

@@ -77,33 +77,19 @@ const std::vector<Variant>& variants() {
 
 TEST(HerzogGpu, MatchesTheCppMethod) {
   TEMPORAL_GPU_CONTEXT_OR_SKIP(ctx);
-  for (bool warped : {false, true})
-    for (bool debug : {false, true}) {
-      SCOPED_TRACE(::testing::Message() << "warped " << warped << " debug " << debug);
-      const test::StateComparison r = compare(ctx, options_with(nullptr), warped, debug);
-      expect_agreement(r);
-      RecordProperty(std::string("max_abs_") + (warped ? "w" : "") + (debug ? "d" : ""),
-                     (::testing::Message() << r.colour.max_abs << " psnr " << r.colour.psnr).GetString());
-    }
+  test::expect_agreement_in_every_mode(
+      [&](bool warped, bool debug) { return compare(ctx, options_with(nullptr), warped, debug); }, expect_agreement);
 }
 
 TEST(HerzogGpu, MatchesTheCppMethodForEveryOption) {
   TEMPORAL_GPU_CONTEXT_OR_SKIP(ctx);
-  Image defaults;
-  for (const Variant& v : variants()) {
-    SCOPED_TRACE(v.name);
-    const test::StateComparison r = compare(ctx, options_with(v.set), true, true);
-    expect_agreement(r);
-    // Each variant's option reaches the C++ method and changes its output (else the comparison tests nothing new).
-    if (!v.set)
-      defaults = r.last_cpu;
-    else
-      EXPECT_GT(test::agreement(r.last_cpu, defaults, kRgb).max_abs, 1e-4);
-    RecordProperty(std::string("max_abs_") + v.name,
-                   (::testing::Message() << r.colour.max_abs << " psnr " << r.colour.psnr << " debug rel "
-                                         << std::max({r.debug[0], r.debug[1], r.debug[2]}) << " abs "
-                                         << std::max(r.debug[3], r.debug[4])).GetString());
-  }
+  test::expect_every_variant_agrees(
+      "herzog", variants(), [&](const Options& o) { return compare(ctx, o, true, true); },
+      [](const Variant&, const test::StateComparison& r) { expect_agreement(r); }, kRgb,
+      [](const test::StateComparison& r) {
+        return (::testing::Message() << " debug rel " << std::max({r.debug[0], r.debug[1], r.debug[2]}) << " abs "
+                                     << std::max(r.debug[3], r.debug[4])).GetString();
+      });
 }
 
 // Without ids (--no-ids) the disocclusion test is the depth test alone.

@@ -94,39 +94,28 @@ const std::vector<Variant>& variants() {
 
 TEST(TaauGpu, MatchesTheCppMethod) {
   TEMPORAL_GPU_CONTEXT_OR_SKIP(ctx);
-  for (bool warped : {false, true})
-    for (bool debug : {false, true}) {
-      SCOPED_TRACE(::testing::Message() << "warped " << warped << " debug " << debug);
-      const Comparison r = compare(ctx, options_with(nullptr), warped, debug);
-      expect_agreement(r);
-      RecordProperty(std::string("max_abs_") + (warped ? "w" : "") + (debug ? "d" : ""),
-                     (::testing::Message() << r.colour.max_abs << " psnr " << r.colour.psnr).GetString());
-    }
+  test::expect_agreement_in_every_mode(
+      [&](bool warped, bool debug) { return compare(ctx, options_with(nullptr), warped, debug); }, expect_agreement);
 }
 
 TEST(TaauGpu, MatchesTheCppMethodForEveryOption) {
   TEMPORAL_GPU_CONTEXT_OR_SKIP(ctx);
-  Image defaults;
-  for (const Variant& v : variants()) {
-    SCOPED_TRACE(v.name);
-    const Comparison r = compare(ctx, options_with(v.set), true, true);
-    expect_agreement(r);
-    if (std::string(v.name) != "no-locks") {
-      EXPECT_GT(r.locked_pixels, 0u);  // the thin features lock pixels
-    }
-    // Each variant's option reaches the C++ method and changes its output or its locks (a lock here is found again
-    // only a jitter cycle later, so it never reaches the lifetime above 1 that protects a history: the colour of
-    // --no-locks is the same, its debug.lock is not).
-    if (!v.set) {
-      defaults = r.last_cpu;
-    } else {
-      EXPECT_GT(test::agreement(r.last_cpu, defaults, {"R", "G", "B", "debug.lock"}).max_abs, 1e-4);
-    }
-    RecordProperty(std::string("max_abs_") + v.name,
-                   (::testing::Message() << r.colour.max_abs << " psnr " << r.colour.psnr << " gradient "
-                                         << r.debug[3] << " wf " << r.debug[4] << " weight " << r.debug[1]
-                                         << " lock " << r.debug[5]).GetString());
-  }
+  // Each variant's option changes the C++ method's output or its locks (a lock here is found again only a jitter
+  // cycle later, so it never reaches the lifetime above 1 that protects a history: the colour of --no-locks is the
+  // same, its debug.lock is not).
+  test::expect_every_variant_agrees(
+      "taau", variants(), [&](const Options& o) { return compare(ctx, o, true, true); },
+      [](const Variant& v, const Comparison& r) {
+        expect_agreement(r);
+        if (std::string(v.name) != "no-locks") {
+          EXPECT_GT(r.locked_pixels, 0u);  // the thin features lock pixels
+        }
+      },
+      {"R", "G", "B", "debug.lock"},
+      [](const Comparison& r) {
+        return (::testing::Message() << " gradient " << r.debug[3] << " wf " << r.debug[4] << " weight "
+                                     << r.debug[1] << " lock " << r.debug[5]).GetString();
+      });
 }
 
 // Without ids (--no-ids) the disocclusion test is the depth test alone.
@@ -158,7 +147,7 @@ TEST(TaauGpu, LoadNamesAMissingPlane) {
   EXPECT_NE(error.find("history.weight"), std::string::npos) << error;
 }
 
-// The registry's "gpu" implementation of herzog (what --device gpu picks): the same kernels on the shared context.
+// The registry's "gpu" implementation of taau (what --device gpu picks): the same kernels on the shared context.
 TEST(TaauGpu, IsRegisteredAsTheGpuImplementation) {
   TEMPORAL_GPU_CONTEXT_OR_SKIP(ctx);
   const test::RegisteredComparison r =

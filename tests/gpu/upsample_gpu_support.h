@@ -2,7 +2,8 @@
 // drobot_gpu_test.cpp, upsample_render_gpu_test.cpp): the synthetic sequence, a method's options and C++ state,
 // and the comparisons each of them makes between a method's C++ state (the reference of record) and its GPU state:
 // over a sequence (compare_states, compare_method) and the bounds that comparison is held to
-// (expect_state_agreement), after a state file moved between the devices (resume_on_the_other_device,
+// (expect_state_agreement), in every mode and for every option variant (expect_agreement_in_every_mode,
+// expect_every_variant_agrees), after a state file moved between the devices (resume_on_the_other_device,
 // expect_resumes_on_either_device), through the registry's implementations (compare_registered), and what load()
 // says of a state file that lacks a plane (load_error_with_only).
 #pragma once
@@ -178,6 +179,47 @@ inline void expect_state_agreement(const StateComparison& r, double max_abs, dou
     EXPECT_LE(r.debug[d], debug_bounds[d].bound) << debug_bounds[d].name;
   EXPECT_GT(r.history_pixels, 0u);  // the sequence reprojects history ...
   EXPECT_GT(r.misses, 0u);          // ... and has disocclusions
+}
+
+// A method's MatchesTheCppMethod: its defaults without and with the warped depth, without and with the debug planes,
+// `compare(warped, debug)` (the method's compare_method) held to `expect` (its expect_state_agreement); the measured
+// max |GPU - CPU| and PSNR recorded as the test property max_abs_<w><d> (w: warped, d: debug).
+template <class Compare, class Expect>
+void expect_agreement_in_every_mode(Compare compare, Expect expect) {
+  for (bool warped : {false, true})
+    for (bool debug : {false, true}) {
+      SCOPED_TRACE(::testing::Message() << "warped " << warped << " debug " << debug);
+      const auto r = compare(warped, debug);
+      expect(r);
+      ::testing::Test::RecordProperty(std::string("max_abs_") + (warped ? "w" : "") + (debug ? "d" : ""),
+                                      (::testing::Message() << r.colour.max_abs << " psnr " << r.colour.psnr)
+                                          .GetString());
+    }
+}
+
+// A method's MatchesTheCppMethodForEveryOption: each variant's options (options_with(method, v.set)) compared with
+// warped depth and debug planes, `compare(options)`, and held to `expect(variant, comparison)`; and each variant's
+// option reaches the C++ method: its last output differs from the defaults' (the first variant, set empty) by more
+// than 1e-4 in one of `changed` (else the comparison tests nothing new). The measured figures, max |GPU - CPU|, PSNR
+// and what `figures(comparison)` adds (the debug planes' worst differences), recorded as the test property
+// max_abs_<variant>.
+template <class OwnOptions, class Compare, class Expect, class Figures>
+void expect_every_variant_agrees(const char* method, const std::vector<OptionVariant<OwnOptions>>& variants,
+                                 Compare compare, Expect expect, const std::vector<std::string>& changed,
+                                 Figures figures) {
+  Image defaults;
+  for (const OptionVariant<OwnOptions>& v : variants) {
+    SCOPED_TRACE(v.name);
+    const auto r = compare(options_with<OwnOptions>(method, v.set));
+    expect(v, r);
+    if (!v.set)
+      defaults = r.last_cpu;
+    else
+      EXPECT_GT(agreement(r.last_cpu, defaults, changed).max_abs, 1e-4);
+    ::testing::Test::RecordProperty(
+        std::string("max_abs_") + v.name,
+        (::testing::Message() << r.colour.max_abs << " psnr " << r.colour.psnr << figures(r)).GetString());
+  }
 }
 
 // A state's planes in a state file (the same whichever device wrote them): float planes and the id plane.

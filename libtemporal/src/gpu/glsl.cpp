@@ -237,4 +237,11 @@ void from_box(float b[BOX_C], out float v[BOX_C]) {
 )";
 }
 
+std::string_view std_min_max() {
+  return R"(
+float min_(float a, float b) { return b < a ? b : a; }
+float max_(float a, float b) { return a < b ? b : a; }
+)";
+}
+
 }  // namespace temporal::gpu::glsl

@@ -1,12 +1,8 @@
 // `blend` (blend.cpp) as a GLSL compute kernel: one dispatch per in-between slot, the same expression.
-#include "method_common.h"
-#include "temporal/gpu/buffer.h"
+#include "gpu_slot_method.h"
 #include "temporal/gpu/glsl.h"
 #include "temporal/gpu/program.h"
-#include "temporal/gpu/timer.h"
 #include "temporal/morph/gpu_methods.h"
-
-#include <algorithm>
 
 namespace temporal::morph {
 namespace {
@@ -26,20 +22,14 @@ void main() {
 }
 )";
 
-class BlendGpu final : public MorphMethod, public gpu::TimedKernel {
+class BlendGpu final : public GpuSlotMethod {
  public:
   BlendGpu(std::shared_ptr<gpu::Context> ctx, gpu::Program program)
-      : ctx_(std::move(ctx)), program_(std::move(program)), timer_(ctx_) {}
-  void run(const Image& color, const Image*, const Image* next, std::vector<Image>& out, MorphTimings& t) override {
-    const auto t0 = std::chrono::steady_clock::now();
-    status_ = run_gpu(color, next ? *next : color, out);
-    t.morph_ms = ms_since(t0);
-  }
-  Status run_status() const override { return status_; }
-  gpu::KernelTiming last_timing() const override { return timing_; }
+      : GpuSlotMethod(std::move(ctx)), program_(std::move(program)) {}
 
  private:
-  Status run_gpu(const Image& color, const Image& next, std::vector<Image>& out) {
+  Status run_gpu(const Image& color, const Image*, const Image* next_frame, std::vector<Image>& out) override {
+    const Image& next = next_frame ? *next_frame : color;
     const int w = color.width(), h = color.height();
     const std::size_t np = color.pixel_count();
     if (frames_.width() != w || frames_.height() != h)
@@ -47,11 +37,9 @@ class BlendGpu final : public MorphMethod, public gpu::TimedKernel {
     for (int c = 0; c < 3; ++c) {
       if (Status s = frames_.upload(c, color, kRGB[c]); !s) return s;
       if (Status s = frames_.upload(3 + c, next, kRGB[c]); !s) return s;
-      std::copy(color.plane(kRGB[c]), color.plane(kRGB[c]) + np, out[0].plane(kRGB[c]));
     }
+    begin_slots(color, out);
     const int n = int(out.size());
-    timing_ = {};
-    timing_.clock = timer_.clock();
     for (int k = 1; k < n; ++k) {
       if (Status s = program_.use(); !s) return s;
       program_.set("u_n", std::uint32_t(np));
@@ -62,18 +50,13 @@ class BlendGpu final : public MorphMethod, public gpu::TimedKernel {
       if (Status s = program_.dispatch(w, h); !s) return s;
       timing_.kernel_ms += timer_.stop_ms();
       timing_.bytes_moved += 9.0 * double(np) * 4.0;  // two frames read, one slot written
-      for (int c = 0; c < 3; ++c)
-        if (Status s = slot_.download(c, out[std::size_t(k)].plane(kRGB[c])); !s) return s;
+      if (Status s = download_slot(slot_, out[std::size_t(k)]); !s) return s;
     }
     return Status::ok();
   }
 
-  std::shared_ptr<gpu::Context> ctx_;
   gpu::Program program_;
-  gpu::Timer timer_;
   gpu::ImageBuffer frames_, slot_;
-  Status status_;
-  gpu::KernelTiming timing_;
 };
 
 }  // namespace

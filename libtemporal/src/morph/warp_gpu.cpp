@@ -3,11 +3,9 @@
 // is taken in two 32-bit passes: the smallest depth bits per target (atomicMin), then the smallest source index
 // among the sources with exactly those depth bits (atomicMin). The lexicographic minimum of (depth, index) is the
 // minimum of the 64-bit key, so the winner is the same source pixel.
-#include "method_common.h"
-#include "temporal/gpu/buffer.h"
+#include "gpu_slot_method.h"
 #include "temporal/gpu/glsl.h"
 #include "temporal/gpu/program.h"
-#include "temporal/gpu/timer.h"
 #include "temporal/morph/gpu_methods.h"
 
 #include <algorithm>
@@ -57,24 +55,23 @@ void main() {
 }
 )";
 
-class WarpGpu final : public MorphMethod, public gpu::TimedKernel {
+class WarpGpu final : public GpuSlotMethod {
  public:
   WarpGpu(std::shared_ptr<gpu::Context> ctx, gpu::Program program, bool debug_layers)
-      : ctx_(std::move(ctx)), program_(std::move(program)), timer_(ctx_), debug_layers_(debug_layers) {}
-  void run(const Image& color, const Image* gbuffer, const Image*, std::vector<Image>& out, MorphTimings& t) override {
-    const auto t0 = std::chrono::steady_clock::now();
-    status_ = run_gpu(color, *gbuffer, out);
+      : GpuSlotMethod(std::move(ctx)), program_(std::move(program)), debug_layers_(debug_layers) {}
+
+ private:
+  Status run_gpu(const Image& color, const Image* gbuffer, const Image*, std::vector<Image>& out) override {
+    const Status s = splat(color, *gbuffer, out);
+    // warp has no debug layer of its own: they are 0 (MorphMethod::run), whatever the kernels did.
     const std::size_t np = color.pixel_count();
     if (debug_layers_)
       for (auto& o : out)
         for (const char* ch : kMorphDebugLayers) std::fill(o.plane(ch), o.plane(ch) + np, 0.0f);
-    t.morph_ms = ms_since(t0);
+    return s;
   }
-  Status run_status() const override { return status_; }
-  gpu::KernelTiming last_timing() const override { return timing_; }
 
- private:
-  Status run_gpu(const Image& color, const Image& gbuffer, std::vector<Image>& out) {
+  Status splat(const Image& color, const Image& gbuffer, std::vector<Image>& out) {
     const int w = color.width(), h = color.height();
     const std::size_t np = color.pixel_count();
     if (src_.width() != w || src_.height() != h) {
@@ -85,10 +82,8 @@ class WarpGpu final : public MorphMethod, public gpu::TimedKernel {
     const char* names[6] = {"R", "G", "B", "motion.X", "motion.Y", "depth.Z"};
     for (int p = 0; p < 6; ++p)
       if (Status s = src_.upload(p, p < 3 ? color : gbuffer, names[p]); !s) return s;
-    for (int c = 0; c < 3; ++c) std::copy(color.plane(kRGB[c]), color.plane(kRGB[c]) + np, out[0].plane(kRGB[c]));
+    begin_slots(color, out);
     const int n = int(out.size());
-    timing_ = {};
-    timing_.clock = timer_.clock();
     for (int k = 1; k < n; ++k) {
       // Both key planes empty (all bits set), as warp.cpp fills its buffer with kEmpty.
       if (Status s = keys_.upload(0, empty_.data()); !s) return s;
@@ -107,20 +102,15 @@ class WarpGpu final : public MorphMethod, public gpu::TimedKernel {
       timing_.kernel_ms += timer_.stop_ms();
       // Motion and depth read twice (two splat passes), keys written and read, the colour gathered and written.
       timing_.bytes_moved += (2.0 * 3.0 + 2.0 * 2.0 + 3.0 + 3.0) * double(np) * 4.0;
-      for (int c = 0; c < 3; ++c)
-        if (Status s = slot_.download(c, out[std::size_t(k)].plane(kRGB[c])); !s) return s;
+      if (Status s = download_slot(slot_, out[std::size_t(k)]); !s) return s;
     }
     return Status::ok();
   }
 
-  std::shared_ptr<gpu::Context> ctx_;
   gpu::Program program_;
-  gpu::Timer timer_;
   bool debug_layers_;
   gpu::ImageBuffer src_, keys_, slot_;
   std::vector<std::uint32_t> empty_;
-  Status status_;
-  gpu::KernelTiming timing_;
 };
 
 }  // namespace

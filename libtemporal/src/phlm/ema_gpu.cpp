@@ -1,11 +1,6 @@
 // The EMA filter (ema.cpp) as one GLSL compute kernel: the same reprojection (the gpu stage's GLSL version of
 // core/reproject.h), the same eq. 1, the same state planes (history.<c>, history.depth, history.id).
-#include "filter_common.h"
 #include "gpu_history.h"
-#include "temporal/gpu/buffer.h"
-#include "temporal/gpu/glsl.h"
-#include "temporal/gpu/program.h"
-#include "temporal/gpu/timer.h"
 #include "temporal/phlm/gpu_filters.h"
 
 #include <algorithm>
@@ -70,28 +65,24 @@ void main() {
 }
 )";
 
-class EmaFilterGpu final : public FrameFilter, public gpu::TimedKernel {
+class EmaFilterGpu final : public detail::HistoryGpuFilter {
  public:
+  // src_: the colour planes, motion, depth, the warped depth and id (5 more); hist_ / next_: the history planes,
+  // history.depth, history.id and next_'s debug plane (3 more).
   EmaFilterGpu(std::shared_ptr<gpu::Context> ctx, EmaParams params, gpu::Program program, gpu::ImageBuffer counters)
-      : ctx_(std::move(ctx)), params_(params), program_(std::move(program)), counters_(std::move(counters)),
-        timer_(ctx_) {}
+      : HistoryGpuFilter(std::move(ctx), std::move(counters), 5, 3), params_(params), program_(std::move(program)) {}
 
   Status process(const FilterInput& in, Image& output, FilterStats* stats) override {
     if (Status s = validate_filter_input(in); !s) return s;
     const int channels = int(in.channels.size());
     const int w = in.color->width(), h = in.color->height();
-    const bool same = have_state_ && channels == channels_ && hist_.width() == w && hist_.height() == h;
+    const bool same = continues_history(channels, w, h);
     if (!same) {
       if (Status s = allocate(channels, w, h); !s) return s;
       has_depth_ = has_id_ = false;  // a fresh history (detail::allocate_history) has no G-buffer planes
     }
     const int C = channels;
-    for (int c = 0; c < C; ++c)
-      if (Status s = src_.upload(c, *in.color, in.channels[std::size_t(c)]); !s) return s;
-    if (in.motion_x) {
-      if (Status s = src_.upload(C, in.motion_x); !s) return s;
-      if (Status s = src_.upload(C + 1, in.motion_y); !s) return s;
-    }
+    if (Status s = upload_colour(in, src_, true); !s) return s;
     if (in.depth)
       if (Status s = src_.upload(C + 2, in.depth); !s) return s;
     if (in.prev_depth)
@@ -119,23 +110,15 @@ class EmaFilterGpu final : public FrameFilter, public gpu::TimedKernel {
     src_.bind(0);
     hist_.bind(1);
     next_.bind(2);
-    counters_.bind(15);
-    timer_.start();
-    if (Status s = program_.dispatch(w, h); !s) return s;
-    timing_.kernel_ms = timer_.stop_ms();
-    timing_.clock = timer_.clock();
+    if (Status s = timed([&] { return program_.dispatch(w, h); }); !s) return s;
     // Each plane read or written once: colour in and out, motion, depth (+ warped), id, the history planes read.
     const double plane = double(src_.pixel_count()) * 4.0;
     double planes = 2.0 * C + (in.motion_x ? 2 : 0) + (in.depth ? 2 : 0) + (in.prev_depth && use_depth ? 1 : 0) +
                     (in.id ? 2 : 0) + (same ? C : 0) + (use_depth ? 1 : 0) + (use_id ? 1 : 0) + (in.debug ? 1 : 0);
     timing_.bytes_moved = planes * plane;
 
-    float* out[3] = {};
-    detail::prepare_output(in, output, out);
-    for (int c = 0; c < C; ++c)
-      if (Status s = next_.download(c, out[c]); !s) return s;
-    if (in.debug)
-      if (Status s = next_.download(C + 2, output.add_channel("debug.reject")); !s) return s;
+    static const char* const kDebugNames[1] = {"debug.reject"};
+    if (Status s = download_output(in, output, next_, C + 2, kDebugNames); !s) return s;
     std::swap(hist_, next_);
     has_depth_ = in.depth != nullptr;
     has_id_ = in.id != nullptr;
@@ -159,10 +142,7 @@ class EmaFilterGpu final : public FrameFilter, public gpu::TimedKernel {
   }
 
   Status set_state(const Image& state, int channels) override {
-    Image history, next;
-    if (Status s = detail::load_history(state, channels, "ema", history, next); !s) return s;
-    if (Status s = allocate(channels, state.width(), state.height()); !s) return s;
-    if (Status s = detail::upload_history(history, channels, hist_); !s) return s;
+    if (Status s = restore_history(state, channels, "ema"); !s) return s;
     has_depth_ = state.plane("history.depth") != nullptr;
     has_id_ = state.uint_plane("history.id") != nullptr;
     if (has_depth_)
@@ -173,25 +153,10 @@ class EmaFilterGpu final : public FrameFilter, public gpu::TimedKernel {
     return Status::ok();
   }
 
-  gpu::KernelTiming last_timing() const override { return timing_; }
-
  private:
-  Status allocate(int channels, int w, int h) {
-    channels_ = channels;
-    if (src_.width() == w && src_.height() == h && src_.planes() == channels + 5) return Status::ok();
-    return gpu::ImageBuffer::create_all(
-        ctx_, {{&src_, w, h, channels + 5}, {&hist_, w, h, channels + 3}, {&next_, w, h, channels + 3}});
-  }
-
-  std::shared_ptr<gpu::Context> ctx_;
   EmaParams params_;
   gpu::Program program_;
-  gpu::ImageBuffer counters_;
-  gpu::Timer timer_;
-  gpu::ImageBuffer src_, hist_, next_;
-  int channels_ = 0;
-  bool have_state_ = false, has_depth_ = false, has_id_ = false;
-  gpu::KernelTiming timing_;
+  bool has_depth_ = false, has_id_ = false;
 };
 
 }  // namespace

@@ -1,11 +1,7 @@
 // FXAA 3.11 "PC quality" (fxaa.cpp) as two GLSL compute kernels: the perceptual luma and validity planes, then the
 // per-pixel edge test, edge-end search and final fetch, statement for statement as fxaa.cpp (the search uses the
 // gpu stage's GLSL bilinear fetch, reproject::bilinear's taps and weights).
-#include "filter_common.h"
-#include "temporal/gpu/buffer.h"
-#include "temporal/gpu/glsl.h"
-#include "temporal/gpu/program.h"
-#include "temporal/gpu/timer.h"
+#include "gpu_filter.h"
 #include "temporal/phlm/fxaa.h"
 #include "temporal/phlm/gpu_filters.h"
 
@@ -180,12 +176,12 @@ void main() {
 }
 )";
 
-class FxaaFilterGpu final : public FrameFilter, public gpu::TimedKernel {
+class FxaaFilterGpu final : public detail::GpuFilter {
  public:
   FxaaFilterGpu(std::shared_ptr<gpu::Context> ctx, FxaaParams params, gpu::Program luma, gpu::Program fxaa,
                 gpu::ImageBuffer counters)
-      : ctx_(std::move(ctx)), params_(params), luma_(std::move(luma)), fxaa_(std::move(fxaa)),
-        counters_(std::move(counters)), timer_(ctx_) {}
+      : GpuFilter(std::move(ctx), std::move(counters)), params_(params), luma_(std::move(luma)),
+        fxaa_(std::move(fxaa)) {}
 
   Status process(const FilterInput& in, Image& output, FilterStats* stats) override {
     if (Status s = validate_filter_input(in); !s) return s;
@@ -195,34 +191,29 @@ class FxaaFilterGpu final : public FrameFilter, public gpu::TimedKernel {
       if (Status s = gpu::ImageBuffer::create_all(ctx_, {{&src_, w, h, C}, {&work_, w, h, 2}, {&out_, w, h, C + 1}});
           !s)
         return s;
-    for (int c = 0; c < C; ++c)
-      if (Status s = src_.upload(c, *in.color, in.channels[std::size_t(c)]); !s) return s;
+    if (Status s = upload_colour(in, src_, false); !s) return s;
     if (Status s = counters_.clear(0, 1); !s) return s;
     src_.bind(0);
     work_.bind(1);
     out_.bind(2);
-    counters_.bind(15);
-    timer_.start();
-    for (const gpu::Program* program : {&luma_, &fxaa_}) {
-      if (Status s = program->use(); !s) return s;
-      program->set("u_n", std::uint32_t(src_.pixel_count()));
-      program->set("u_channels", C);
-      program->set("u_debug", int(in.debug));
-      program->set("u_subpix", params_.subpix);
-      program->set("u_edge_threshold", params_.edge_threshold);
-      program->set("u_edge_threshold_min", params_.edge_threshold_min);
-      if (Status s = program->dispatch(w, h); !s) return s;
-    }
-    timing_.kernel_ms = timer_.stop_ms();
-    timing_.clock = timer_.clock();
+    auto dispatch = [&]() -> Status {
+      for (const gpu::Program* program : {&luma_, &fxaa_}) {
+        if (Status s = program->use(); !s) return s;
+        program->set("u_n", std::uint32_t(src_.pixel_count()));
+        program->set("u_channels", C);
+        program->set("u_debug", int(in.debug));
+        program->set("u_subpix", params_.subpix);
+        program->set("u_edge_threshold", params_.edge_threshold);
+        program->set("u_edge_threshold_min", params_.edge_threshold_min);
+        if (Status s = program->dispatch(w, h); !s) return s;
+      }
+      return Status::ok();
+    };
+    if (Status s = timed(dispatch); !s) return s;
     // Colour read, luma and validity written and read, the output written (+ debug).
     timing_.bytes_moved = double(src_.pixel_count()) * 4.0 * (C + 4 + C + (in.debug ? 1 : 0));
-    float* out[3] = {};
-    detail::prepare_output(in, output, out);
-    for (int c = 0; c < C; ++c)
-      if (Status s = out_.download(c, out[c]); !s) return s;
-    if (in.debug)
-      if (Status s = out_.download(C, output.add_channel("debug.edge")); !s) return s;
+    static const char* const kDebugNames[1] = {"debug.edge"};
+    if (Status s = download_output(in, output, out_, C, kDebugNames); !s) return s;
     if (stats) {
       std::uint32_t counts[4] = {};
       if (Status s = counters_.download(0, counts); !s) return s;
@@ -236,16 +227,11 @@ class FxaaFilterGpu final : public FrameFilter, public gpu::TimedKernel {
   Status set_state(const Image& state, int channels) override {
     return FxaaFilter(params_).set_state(state, channels);  // the C++ filter's usage error
   }
-  gpu::KernelTiming last_timing() const override { return timing_; }
 
  private:
-  std::shared_ptr<gpu::Context> ctx_;
   FxaaParams params_;
   gpu::Program luma_, fxaa_;
-  gpu::ImageBuffer counters_;
-  gpu::Timer timer_;
   gpu::ImageBuffer src_, work_, out_;
-  gpu::KernelTiming timing_;
 };
 
 }  // namespace

@@ -4,11 +4,7 @@
 // its ray clip and reset, the RLS update and the prediction, statement for statement. The models are planar on the
 // GPU (plane k = element k of phlm.cpp's record, the order of PhlmFilter::state_channel_names), so the state file
 // is the same; saved_state() adds the covariance planes through the C++ filter, as PhlmFilter::saved_state does.
-#include "filter_common.h"
-#include "temporal/gpu/buffer.h"
-#include "temporal/gpu/glsl.h"
-#include "temporal/gpu/program.h"
-#include "temporal/gpu/timer.h"
+#include "gpu_filter.h"
 #include "temporal/phlm/gpu_filters.h"
 #include "temporal/phlm/phlm.h"
 #include "temporal/phlm/rls.h"
@@ -32,8 +28,6 @@ uniform int u_fetch;  // 0 bilinear, 1 nearest, 2 Catmull-Rom
 uniform float u_p0, u_trace_max, u_a, u_b, u_lambda;
 #define PL(k) (uint(k) * u_n)
 
-float min_(float a, float b) { return b < a ? b : a; }
-float max_(float a, float b) { return a < b ? b : a; }
 float luma(float v[C]) {
 #if PHLM_C == 3
   return 0.25 * v[0] + 0.5 * v[1] + 0.25 * v[2];
@@ -325,11 +319,11 @@ void main() {
 }
 )";
 
-class PhlmFilterGpu final : public FrameFilter, public gpu::TimedKernel {
+class PhlmFilterGpu final : public detail::GpuFilter {
  public:
   PhlmFilterGpu(std::shared_ptr<gpu::Context> ctx, PhlmParams params, gpu::Program programs[2],
                 gpu::ImageBuffer counters)
-      : ctx_(std::move(ctx)), params_(std::move(params)), counters_(std::move(counters)), timer_(ctx_) {
+      : GpuFilter(std::move(ctx), std::move(counters)), params_(std::move(params)) {
     programs_[0] = std::move(programs[0]);
     programs_[1] = std::move(programs[1]);
   }
@@ -341,12 +335,7 @@ class PhlmFilterGpu final : public FrameFilter, public gpu::TimedKernel {
     const bool same = have_state_ && C == channels_ && state_[0].width() == w && state_[0].height() == h;
     if (!same)
       if (Status s = allocate(C, w, h); !s) return s;
-    for (int c = 0; c < C; ++c)
-      if (Status s = src_.upload(c, *in.color, in.channels[std::size_t(c)]); !s) return s;
-    if (in.motion_x) {
-      if (Status s = src_.upload(C, in.motion_x); !s) return s;
-      if (Status s = src_.upload(C + 1, in.motion_y); !s) return s;
-    }
+    if (Status s = upload_colour(in, src_, true); !s) return s;
     if (Status s = counters_.clear(0, 1); !s) return s;
     const int n = C + 1;
     const gpu::Program& program = programs_[C == 3 ? 1 : 0];
@@ -370,24 +359,15 @@ class PhlmFilterGpu final : public FrameFilter, public gpu::TimedKernel {
     state_[cur_].bind(1);
     state_[1 - cur_].bind(2);
     out_.bind(3);
-    counters_.bind(15);
-    timer_.start();
-    if (Status s = program.dispatch(w, h); !s) return s;
-    timing_.kernel_ms = timer_.stop_ms();
-    timing_.clock = timer_.clock();
+    if (Status s = timed([&] { return program.dispatch(w, h); }); !s) return s;
     // Colour and motion read, the models read and written once each (26 floats per pixel for RGB), output written.
     const int k = phlm_state_floats(C);
     timing_.bytes_moved = double(src_.pixel_count()) * 4.0 *
                           (C + (in.motion_x ? 2 : 0) + (same ? k : 0) + k + C + (in.debug ? 3 + C : 0));
 
-    float* out[3] = {};
-    detail::prepare_output(in, output, out);
-    for (int c = 0; c < C; ++c)
-      if (Status s = out_.download(c, out[c]); !s) return s;
+    static const char* const kDebugNames[3] = {"debug.alpha", "debug.reset", "debug.traceP"};
+    if (Status s = download_output(in, output, out_, C, kDebugNames); !s) return s;
     if (in.debug) {
-      const char* names[3] = {"debug.alpha", "debug.reset", "debug.traceP"};
-      for (int d = 0; d < 3; ++d)
-        if (Status s = out_.download(C + d, output.add_channel(names[d])); !s) return s;
       for (int c = 0; c < C; ++c) {
         const std::string name =
             C == 3 ? "debug.feature" + std::string(detail::channel_suffix(3, c)) : std::string("debug.feature");
@@ -436,7 +416,6 @@ class PhlmFilterGpu final : public FrameFilter, public gpu::TimedKernel {
   std::string stats_text(const FilterStats& stats) const override {
     return ", max trace(P) " + std::to_string(stats.max_trace_p);
   }
-  gpu::KernelTiming last_timing() const override { return timing_; }
 
   HistoryFetch fetch_ = HistoryFetch::Bilinear;
 
@@ -451,15 +430,11 @@ class PhlmFilterGpu final : public FrameFilter, public gpu::TimedKernel {
                                                {&out_, w, h, 2 * channels + 3}});
   }
 
-  std::shared_ptr<gpu::Context> ctx_;
   PhlmParams params_;
   gpu::Program programs_[2];  // 1 and 3 channels
-  gpu::ImageBuffer counters_;
-  gpu::Timer timer_;
   gpu::ImageBuffer src_, state_[2], out_;
   int cur_ = 0, channels_ = 0;
   bool have_state_ = false;
-  gpu::KernelTiming timing_;
 };
 
 }  // namespace
@@ -474,16 +449,14 @@ Expected<std::unique_ptr<FrameFilter>> make_phlm_filter_gpu(std::shared_ptr<gpu:
   if (!fetch) return fetch.error();
   if (Status s = gpu::Context::ensure(context); !s) return s.error();
   gpu::Program programs[2];
-  for (int k = 0; k < 2; ++k) {
-    const std::string define = std::string("#define PHLM_C ") + (k == 0 ? "1" : "3") + "\n#define BOX_C PHLM_C\n";
-    auto program = gpu::Program::compile(
-        context, k == 0 ? "phlm (1 channel)" : "phlm (3 channels)",
-        {gpu::glsl::prelude(), define, gpu::glsl::storage(0, "src"), gpu::glsl::storage(1, "prev"),
-         gpu::glsl::storage(2, "nxt"), gpu::glsl::storage(3, "outb"), gpu::glsl::ycgco_box(), kPhlmDecl,
-         gpu::glsl::reproject(), kPhlmMain});
-    if (!program) return program.error();
-    programs[k] = std::move(*program);
-  }
+  if (Status s = detail::compile_per_channel_count(
+          context, "phlm", "PHLM_C",
+          {gpu::glsl::storage(0, "src"), gpu::glsl::storage(1, "prev"), gpu::glsl::storage(2, "nxt"),
+           gpu::glsl::storage(3, "outb"), gpu::glsl::ycgco_box(), gpu::glsl::std_min_max(), kPhlmDecl,
+           gpu::glsl::reproject(), kPhlmMain},
+          programs);
+      !s)
+    return s.error();
   auto counters = gpu::ImageBuffer::create(context, 4, 1, 1);
   if (!counters) return counters.error();
   auto filter = std::make_unique<PhlmFilterGpu>(std::move(context), std::move(params), programs, std::move(*counters));

@@ -3,12 +3,7 @@
 // history through the gpu stage's GLSL reprojection, clipping in YCgCo, luminance-weighted blend), the same state
 // (history.<c>). The reconstruction weights exp(-k d^2) are computed on the host with std::exp as in taa.cpp, so
 // no GPU exp enters the result.
-#include "filter_common.h"
 #include "gpu_history.h"
-#include "temporal/gpu/buffer.h"
-#include "temporal/gpu/glsl.h"
-#include "temporal/gpu/program.h"
-#include "temporal/gpu/timer.h"
 #include "temporal/phlm/gpu_filters.h"
 
 #include <cmath>
@@ -26,10 +21,6 @@ uniform int u_fetch;  // 0 Catmull-Rom, 1 bilinear, 2 nearest
 uniform float u_alpha, u_gamma;
 uniform float u_weight[9];
 #define PLANE(p) (uint(p) * u_n)
-
-// taa.cpp's min_ / max_ (plain comparisons).
-float min_(float a, float b) { return b < a ? b : a; }
-float max_(float a, float b) { return a < b ? b : a; }
 )";
 
 constexpr const char* kTaaMain = R"(
@@ -170,11 +161,13 @@ void main() {
 }
 )";
 
-class TaaFilterGpu final : public FrameFilter, public gpu::TimedKernel {
+class TaaFilterGpu final : public detail::HistoryGpuFilter {
  public:
+  // src_: the colour planes, motion and depth (3 more); hist_ / next_: the history planes and next_'s four debug
+  // planes (4 more).
   TaaFilterGpu(std::shared_ptr<gpu::Context> ctx, TaaParams params, detail::TaaConfig cfg, gpu::Program programs[2],
                gpu::ImageBuffer counters)
-      : ctx_(std::move(ctx)), params_(std::move(params)), cfg_(cfg), counters_(std::move(counters)), timer_(ctx_) {
+      : HistoryGpuFilter(std::move(ctx), std::move(counters), 3, 4), params_(std::move(params)), cfg_(cfg) {
     programs_[0] = std::move(programs[0]);
     programs_[1] = std::move(programs[1]);
   }
@@ -184,15 +177,10 @@ class TaaFilterGpu final : public FrameFilter, public gpu::TimedKernel {
     if (Status s = detail::check_taa_input(cfg_, in); !s) return s;
     const int C = int(in.channels.size());
     const int w = in.color->width(), h = in.color->height();
-    const bool same = have_state_ && C == channels_ && hist_.width() == w && hist_.height() == h;
+    const bool same = continues_history(C, w, h);
     if (!same)
       if (Status s = allocate(C, w, h); !s) return s;
-    for (int c = 0; c < C; ++c)
-      if (Status s = src_.upload(c, *in.color, in.channels[std::size_t(c)]); !s) return s;
-    if (in.motion_x) {
-      if (Status s = src_.upload(C, in.motion_x); !s) return s;
-      if (Status s = src_.upload(C + 1, in.motion_y); !s) return s;
-    }
+    if (Status s = upload_colour(in, src_, true); !s) return s;
     const bool dilate = cfg_.velocity == TaaVelocity::Nearest && in.motion_x && in.depth;
     if (dilate)
       if (Status s = src_.upload(C + 2, in.depth); !s) return s;
@@ -221,26 +209,16 @@ class TaaFilterGpu final : public FrameFilter, public gpu::TimedKernel {
     src_.bind(0);
     hist_.bind(1);
     next_.bind(2);
-    counters_.bind(15);
-    timer_.start();
-    if (Status s = program.dispatch(w, h); !s) return s;
-    timing_.kernel_ms = timer_.stop_ms();
-    timing_.clock = timer_.clock();
+    if (Status s = timed([&] { return program.dispatch(w, h); }); !s) return s;
     // Each plane read or written once: colour in, motion, depth, history in, result out (+ debug planes).
     const double plane = double(src_.pixel_count()) * 4.0;
     const double planes =
         C + (in.motion_x ? 2 : 0) + (dilate ? 1 : 0) + (same && !in.reset ? C : 0) + C + (in.debug ? 4 : 0);
     timing_.bytes_moved = planes * plane;
 
-    float* out[3] = {};
-    detail::prepare_output(in, output, out);
-    for (int c = 0; c < C; ++c)
-      if (Status s = next_.download(c, out[c]); !s) return s;
-    if (in.debug) {
-      const char* names[4] = {"debug.clip", "debug.noHistory", "debug.velocity.X", "debug.velocity.Y"};
-      for (int k = 0; k < 4; ++k)
-        if (Status s = next_.download(C + k, output.add_channel(names[k])); !s) return s;
-    }
+    static const char* const kDebugNames[4] = {"debug.clip", "debug.noHistory", "debug.velocity.X",
+                                               "debug.velocity.Y"};
+    if (Status s = download_output(in, output, next_, C, kDebugNames); !s) return s;
     std::swap(hist_, next_);
     have_state_ = true;
     if (stats) {
@@ -260,34 +238,15 @@ class TaaFilterGpu final : public FrameFilter, public gpu::TimedKernel {
   }
 
   Status set_state(const Image& state, int channels) override {
-    Image history, next;
-    if (Status s = detail::load_history(state, channels, "taa", history, next); !s) return s;
-    if (Status s = allocate(channels, state.width(), state.height()); !s) return s;
-    if (Status s = detail::upload_history(history, channels, hist_); !s) return s;
+    if (Status s = restore_history(state, channels, "taa"); !s) return s;
     have_state_ = true;
     return Status::ok();
   }
 
-  gpu::KernelTiming last_timing() const override { return timing_; }
-
  private:
-  Status allocate(int channels, int w, int h) {
-    channels_ = channels;
-    if (src_.width() == w && src_.height() == h && src_.planes() == channels + 3) return Status::ok();
-    return gpu::ImageBuffer::create_all(
-        ctx_, {{&src_, w, h, channels + 3}, {&hist_, w, h, channels + 4}, {&next_, w, h, channels + 4}});
-  }
-
-  std::shared_ptr<gpu::Context> ctx_;
   TaaParams params_;
   detail::TaaConfig cfg_;
   gpu::Program programs_[2];  // 1 and 3 channels
-  gpu::ImageBuffer counters_;
-  gpu::Timer timer_;
-  gpu::ImageBuffer src_, hist_, next_;
-  int channels_ = 0;
-  bool have_state_ = false;
-  gpu::KernelTiming timing_;
 };
 
 }  // namespace
@@ -297,15 +256,14 @@ Expected<std::unique_ptr<FrameFilter>> make_taa_filter_gpu(std::shared_ptr<gpu::
   if (!cfg) return cfg.error();
   if (Status s = gpu::Context::ensure(context); !s) return s.error();
   gpu::Program programs[2];
-  for (int k = 0; k < 2; ++k) {
-    const std::string define = std::string("#define TAA_C ") + (k == 0 ? "1" : "3") + "\n#define BOX_C TAA_C\n";
-    auto program = gpu::Program::compile(
-        context, k == 0 ? "taa (1 channel)" : "taa (3 channels)",
-        {gpu::glsl::prelude(), define, gpu::glsl::storage(0, "src"), gpu::glsl::storage(1, "hist"),
-         gpu::glsl::storage(2, "nxt"), gpu::glsl::ycgco_box(), kTaaKernel, gpu::glsl::reproject(), kTaaMain});
-    if (!program) return program.error();
-    programs[k] = std::move(*program);
-  }
+  if (Status s = detail::compile_per_channel_count(
+          context, "taa", "TAA_C",
+          {gpu::glsl::storage(0, "src"), gpu::glsl::storage(1, "hist"), gpu::glsl::storage(2, "nxt"),
+           gpu::glsl::ycgco_box(), gpu::glsl::std_min_max(), kTaaKernel, gpu::glsl::reproject(),
+           kTaaMain},
+          programs);
+      !s)
+    return s.error();
   auto counters = gpu::ImageBuffer::create(context, 4, 1, 1);
   if (!counters) return counters.error();
   return std::unique_ptr<FrameFilter>(

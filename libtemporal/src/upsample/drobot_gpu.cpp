@@ -381,8 +381,8 @@ class DrobotStateGpu final : public GpuHistoryState {
     for (int c = 0; c < C; ++c)
       if (filtered_value_download(c, plane.data()))
         put_plane(state, "cache." + g_.channels[std::size_t(c)], plane.data(), g_.lw, g_.lh);
-    if (cache_.download(b + C, plane.data())) put_plane(state, "cache.depth", plane.data(), g_.lw, g_.lh);
-    if (cache_.download(b + C + 1, plane.data())) put_plane(state, "cache.frames", plane.data(), g_.lw, g_.lh);
+    save_plane(cache_, b + C, state, "cache.depth");
+    save_plane(cache_, b + C + 1, state, "cache.frames");
     if (has_cache_id_) {
       std::vector<std::uint32_t> ids(plane.size());
       if (cache_.download(b + C + 2, ids.data())) put_uint_plane(state, "cache.id", ids.data(), g_.lw, g_.lh);
@@ -399,19 +399,13 @@ class DrobotStateGpu final : public GpuHistoryState {
       has_history_ = true;
       return Status::ok();
     }
-    std::vector<float> plane(std::size_t(g_.lw) * g_.lh);
     const int b = (C + 3) * cur_;
-    for (int c = 0; c < C; ++c) {
-      if (Status s = get_plane(state, "cache." + g_.channels[std::size_t(c)], plane.data(), g_.lw, g_.lh); !s)
-        return s;
-      if (Status s = cache_.upload(b + c, plane.data()); !s) return s;
-    }
-    if (Status s = get_plane(state, "cache.depth", plane.data(), g_.lw, g_.lh); !s) return s;
-    if (Status s = cache_.upload(b + C, plane.data()); !s) return s;
-    if (Status s = get_plane(state, "cache.frames", plane.data(), g_.lw, g_.lh); !s) return s;
-    if (Status s = cache_.upload(b + C + 1, plane.data()); !s) return s;
+    for (int c = 0; c < C; ++c)
+      if (Status s = load_plane(state, "cache." + g_.channels[std::size_t(c)], cache_, b + c); !s) return s;
+    if (Status s = load_plane(state, "cache.depth", cache_, b + C); !s) return s;
+    if (Status s = load_plane(state, "cache.frames", cache_, b + C + 1); !s) return s;
     // DrobotState::load clears the ids when the state has none; the next run() zero-fills them (its resize).
-    std::vector<std::uint32_t> ids(plane.size(), 0u);
+    std::vector<std::uint32_t> ids(std::size_t(g_.lw) * g_.lh, 0u);
     has_cache_id_ = state.uint_plane("cache.id") != nullptr;
     if (has_cache_id_)
       if (Status s = get_uint_plane(state, "cache.id", ids.data(), g_.lw, g_.lh); !s) return s;
@@ -583,13 +577,9 @@ class DrobotStateGpu final : public GpuHistoryState {
     if (Status s = counters_.clear(0, 1); !s) return s;
     if (Status s = upload_table(drobot_bilinear_table(f.grid.k)); !s) return s;
     cur_ = 1 - cur_;
-    const int prv = 1 - cur_;
     const bool history = have_history && has_history_;
     const reproject::SurfaceTest test = f.options->surface_test();
-    frame_.bind();
-    out_[cur_].bind(2);
-    out_[prv].bind(3);
-    prevg_.bind(4);
+    bind_history_buffers();
     tab_.bind(10);
     counters_.bind(15);
     timer_.start();

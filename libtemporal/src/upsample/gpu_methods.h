@@ -74,6 +74,16 @@ void set_sampling_grid_uniforms(const gpu::Program& program, const FrameContext&
 // C++ kernels compute them), set_sampling_grid_uniforms() included.
 void set_joint_bilateral_uniforms(const gpu::Program& program, const FrameContext& f);
 
+// Sets `uniform float u_luma[16]`, the luminance weights of the payload channels (FrameContext::luma), 0 past f.C:
+// the kernels that take a luminance of the payload (herzog's eq. 8 gradient, taau's locks) declare it so.
+void set_luma_uniform(const gpu::Program& program, const FrameContext& f);
+
+// A state file's plane and the GPU buffer that holds it between frames: plane `p` of `buffer` (its width x height)
+// into the state as `name` (put_plane; save() cannot report an error: a failed download leaves the plane out, and
+// load() names it), and back (get_plane: an Input error names a missing plane).
+void save_plane(const gpu::ImageBuffer& buffer, int p, Image& state, const std::string& name);
+Status load_plane(const Image& state, const std::string& name, gpu::ImageBuffer& buffer, int p);
+
 // A state file's previous depth (and ids, when it has them) into planes 0 and 1 of `prevg` (the C++ states'
 // PreviousGeometry, read by get_previous); `has_prev_id` says whether the ids were there.
 Status upload_previous_geometry(const Image& state, const Geometry& g, gpu::ImageBuffer& prevg, bool& has_prev_id);
@@ -116,11 +126,25 @@ class GpuHistoryState : public MethodState, public gpu::TimedKernel {
   // a failed download leaves the plane out, and load() names it).
   void save_history(Image& state) const;
   Status load_history(const Image& state);
+  // Binds the buffers every history kernel reads and writes at the bindings its GLSL declares: the frame (GpuFrame:
+  // 0, 1), this frame's output out_[cur_] (2), the previous output (3, the history) and the previous geometry
+  // prevg_ (4).
+  void bind_history_buffers() const {
+    frame_.bind();
+    out_[cur_].bind(2);
+    out_[1 - cur_].bind(3);
+    prevg_.bind(4);
+  }
   // PreviousGeometry::store: this frame's depth and ids (GpuFrame planes 0 and 7) become the previous frame's.
   Status store_previous_geometry(const FrameContext& f);
   // The frame's output into result_: planes 0..C-1 of out_[cur_] as the payload channels, then with f.debug planes
   // C.. as `debug_names` (without f.debug those channels are removed from result_).
   Status download_result(const FrameContext& f, std::span<const char* const> debug_names);
+  // The end of a frame whose kernels count in counter 0 the pixels that took their history (herzog, taau; temporal's
+  // and drobot's kernels count otherwise): the output (download_result), this frame's geometry kept
+  // (store_previous_geometry), and the FrameStats: every other pixel a hole, every pixel without `history`.
+  Status finish_frame(const FrameContext& f, bool history, std::span<const char* const> debug_names,
+                      FrameStats& stats);
 
   std::shared_ptr<gpu::Context> ctx_;
   gpu::ImageBuffer counters_;

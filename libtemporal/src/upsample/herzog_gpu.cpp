@@ -341,12 +341,8 @@ class HerzogStateGpu final : public GpuHistoryState {
     // save() cannot report an error; a failed download leaves the plane out and load() names it.
     if (out_[0].empty()) return;
     save_history(state);
-    std::vector<float> plane(std::size_t(g_.W) * g_.H), cell(std::size_t(GW_) * GH_);
-    if (hw_.download(cur_, plane.data())) put_plane(state, "history.weight", plane.data(), g_.W, g_.H);
-    for (int t = 0; t < 3; ++t)
-      if (grid_.download(4 * cur_ + t, cell.data()))
-        put_plane(state, "gradient.t" + std::to_string(t + 1), cell.data(), GW_, GH_);
-    if (grid_.download(4 * cur_ + 3, cell.data())) put_plane(state, "gradient.wf", cell.data(), GW_, GH_);
+    save_plane(hw_, cur_, state, "history.weight");
+    for (int t = 0; t < 4; ++t) save_plane(grid_, 4 * cur_ + t, state, grid_plane_name(t));
     save_previous_geometry(prevg_, has_prev_id_, g_, state);
   }
 
@@ -354,18 +350,18 @@ class HerzogStateGpu final : public GpuHistoryState {
     if (Status s = allocate(); !s) return s;
     cur_ = 1 - cur_;  // as OutputPair::next(): what is loaded is the previous frame of the next run()
     if (Status s = load_history(state); !s) return s;
-    std::vector<float> plane(std::size_t(g_.W) * g_.H), cell(std::size_t(GW_) * GH_);
-    if (Status s = get_plane(state, "history.weight", plane.data(), g_.W, g_.H); !s) return s;
-    if (Status s = hw_.upload(cur_, plane.data()); !s) return s;
-    for (int t = 0; t < 4; ++t) {
-      const std::string name = t < 3 ? "gradient.t" + std::to_string(t + 1) : "gradient.wf";
-      if (Status s = get_plane(state, name, cell.data(), GW_, GH_); !s) return s;
-      if (Status s = grid_.upload(4 * cur_ + t, cell.data()); !s) return s;
-    }
+    if (Status s = load_plane(state, "history.weight", hw_, cur_); !s) return s;
+    for (int t = 0; t < 4; ++t)
+      if (Status s = load_plane(state, grid_plane_name(t), grid_, 4 * cur_ + t); !s) return s;
     return upload_previous_geometry(state, g_, prevg_, has_prev_id_);
   }
 
  private:
+  // The state file's name of plane t of a parity of grid_: the three gradients, then w_f.
+  static std::string grid_plane_name(int t) {
+    return t < 3 ? "gradient.t" + std::to_string(t + 1) : "gradient.wf";
+  }
+
   // The buffers of the state's geometry, initialised as HerzogState's constructor initialises its vectors (h_w 0,
   // the gradients kMaxGradient, w_f 0, the output 0).
   Status allocate() {
@@ -452,13 +448,8 @@ class HerzogStateGpu final : public GpuHistoryState {
     const bool use_ids = test.use_ids && f.id && has_prev_id_;
     const float max_hw = ho.max_history_weight > 0 ? ho.max_history_weight : 2.0f * float(k * k);
     const std::uint32_t n = std::uint32_t(std::size_t(f.W) * f.H), gn = std::uint32_t(std::size_t(GW_) * GH_);
-    float luma[16] = {};
-    for (int c = 0; c < C && c < 16; ++c) luma[c] = f.luma[std::size_t(c)];
 
-    frame_.bind();
-    out_[cur_].bind(2);
-    out_[prv].bind(3);
-    prevg_.bind(4);
+    bind_history_buffers();
     scratch_.bind(5);
     hw_.bind(6);
     grid_.bind(7);
@@ -483,7 +474,7 @@ class HerzogStateGpu final : public GpuHistoryState {
     prog_.a.set("u_gn", gn);
     prog_.a.set("u_wf_prv", std::uint32_t(4 * prv + 3) * gn);
     prog_.a.set("u_hw_prv", std::uint32_t(prv) * n);
-    prog_.a.set("u_luma", luma, 16);
+    set_luma_uniform(prog_.a, f);
     if (Status s = prog_.a.dispatch(f.W, f.H); !s) return s;
     // Pass B: the temporal filter into pyramid level 0.
     pyr_[0].bind(9);
@@ -540,19 +531,7 @@ class HerzogStateGpu final : public GpuHistoryState {
     timing_.clock = timer_.clock();
     timing_.bytes_moved = bytes_moved(f);
 
-    return read_back(f, history, stats);
-  }
-
-  // Downloads the output (and debug planes), keeps this frame's depth and ids as the previous frame's, and counts
-  // the history pixels.
-  Status read_back(const FrameContext& f, bool history, FrameStats& stats) {
-    if (Status s = download_result(f, kDebugNames); !s) return s;
-    if (Status s = store_previous_geometry(f); !s) return s;
-    std::uint32_t counts[4] = {};
-    if (Status s = counters_.download(0, counts); !s) return s;
-    stats.history_pixels = history ? counts[0] : 0;
-    stats.hole_pixels = std::size_t(f.W) * f.H - stats.history_pixels;
-    return Status::ok();
+    return finish_frame(f, history, kDebugNames, stats);
   }
 
   // Every plane each dispatch reads or writes, counted once per dispatch (the scratch planes make a round trip

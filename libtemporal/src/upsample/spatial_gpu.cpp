@@ -152,20 +152,25 @@ Status GpuFrame::upload(const std::shared_ptr<gpu::Context>& context, const Fram
   return Status::ok();
 }
 
+void save_plane(const gpu::ImageBuffer& buffer, int p, Image& state, const std::string& name) {
+  std::vector<float> plane(buffer.pixel_count());
+  if (buffer.download(p, plane.data())) put_plane(state, name, plane.data(), buffer.width(), buffer.height());
+}
+
+Status load_plane(const Image& state, const std::string& name, gpu::ImageBuffer& buffer, int p) {
+  std::vector<float> plane(buffer.pixel_count());
+  if (Status s = get_plane(state, name, plane.data(), buffer.width(), buffer.height()); !s) return s;
+  return buffer.upload(p, plane.data());
+}
+
 void GpuHistoryState::save_history(Image& state) const {
-  std::vector<float> plane(std::size_t(g_.W) * g_.H);
   for (int c = 0; c < int(g_.channels.size()); ++c)
-    if (out_[cur_].download(c, plane.data()))
-      put_plane(state, "history." + g_.channels[std::size_t(c)], plane.data(), g_.W, g_.H);
+    save_plane(out_[cur_], c, state, "history." + g_.channels[std::size_t(c)]);
 }
 
 Status GpuHistoryState::load_history(const Image& state) {
-  std::vector<float> plane(std::size_t(g_.W) * g_.H);
-  for (int c = 0; c < int(g_.channels.size()); ++c) {
-    if (Status s = get_plane(state, "history." + g_.channels[std::size_t(c)], plane.data(), g_.W, g_.H); !s)
-      return s;
-    if (Status s = out_[cur_].upload(c, plane.data()); !s) return s;
-  }
+  for (int c = 0; c < int(g_.channels.size()); ++c)
+    if (Status s = load_plane(state, "history." + g_.channels[std::size_t(c)], out_[cur_], c); !s) return s;
   return Status::ok();
 }
 
@@ -188,6 +193,17 @@ Status GpuHistoryState::download_result(const FrameContext& f, std::span<const c
       result_.remove_channel(debug_names[d]);
     }
   }
+  return Status::ok();
+}
+
+Status GpuHistoryState::finish_frame(const FrameContext& f, bool history, std::span<const char* const> debug_names,
+                                     FrameStats& stats) {
+  if (Status s = download_result(f, debug_names); !s) return s;
+  if (Status s = store_previous_geometry(f); !s) return s;
+  std::uint32_t counts[4] = {};
+  if (Status s = counters_.download(0, counts); !s) return s;
+  stats.history_pixels = history ? counts[0] : 0;
+  stats.hole_pixels = std::size_t(f.W) * f.H - stats.history_pixels;
   return Status::ok();
 }
 
@@ -217,6 +233,12 @@ void set_sampling_grid_uniforms(const gpu::Program& program, const FrameContext&
   program.set("u_C", f.C);
   program.set("u_n", std::uint32_t(std::size_t(f.W) * f.H));
   program.set("u_ln", std::uint32_t(std::size_t(f.lw) * f.lh));
+}
+
+void set_luma_uniform(const gpu::Program& program, const FrameContext& f) {
+  float luma[16] = {};
+  for (int c = 0; c < f.C && c < 16; ++c) luma[c] = f.luma[std::size_t(c)];
+  program.set("u_luma", luma, 16);
 }
 
 Expected<std::shared_ptr<gpu::Context>> shared_gpu_context() {

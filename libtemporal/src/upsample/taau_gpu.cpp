@@ -303,6 +303,8 @@ void main() {
 }
 )";
 
+// The state file's names of the planes of a parity of st_ (TaauState::save's).
+constexpr const char* kStateNames[3] = {"history.weight", "lock.lifetime", "lock.luma"};
 constexpr const char* kDebugNames[7] = {"debug.confidence", "debug.disocclusion", "debug.gradient", "debug.wf",
                                         "debug.historyWeight", "debug.convergence", "debug.lock"};
 
@@ -316,10 +318,7 @@ class TaauStateGpu final : public GpuHistoryState {
   void save(Image& state) const override {
     if (out_[0].empty()) return;  // save() cannot report an error; load() names a missing plane
     save_history(state);
-    std::vector<float> plane(std::size_t(g_.W) * g_.H);
-    const char* names[3] = {"history.weight", "lock.lifetime", "lock.luma"};
-    for (int q = 0; q < 3; ++q)
-      if (st_.download(3 * cur_ + q, plane.data())) put_plane(state, names[q], plane.data(), g_.W, g_.H);
+    for (int q = 0; q < 3; ++q) save_plane(st_, 3 * cur_ + q, state, kStateNames[q]);
     save_previous_geometry(prevg_, has_prev_id_, g_, state);
   }
 
@@ -327,12 +326,8 @@ class TaauStateGpu final : public GpuHistoryState {
     if (Status s = allocate(); !s) return s;
     cur_ = 1 - cur_;  // OutputPair::next()
     if (Status s = load_history(state); !s) return s;
-    std::vector<float> plane(std::size_t(g_.W) * g_.H);
-    const char* names[3] = {"history.weight", "lock.lifetime", "lock.luma"};
-    for (int q = 0; q < 3; ++q) {
-      if (Status s = get_plane(state, names[q], plane.data(), g_.W, g_.H); !s) return s;
-      if (Status s = st_.upload(3 * cur_ + q, plane.data()); !s) return s;
-    }
+    for (int q = 0; q < 3; ++q)
+      if (Status s = load_plane(state, kStateNames[q], st_, 3 * cur_ + q); !s) return s;
     return upload_previous_geometry(state, g_, prevg_, has_prev_id_);
   }
 
@@ -350,9 +345,7 @@ class TaauStateGpu final : public GpuHistoryState {
 
   void set_common(const gpu::Program& prog, const FrameContext& f, const TaauOptions& to) const {
     set_sampling_grid_uniforms(prog, f);
-    float luma[16] = {};
-    for (int c = 0; c < f.C && c < 16; ++c) luma[c] = f.luma[std::size_t(c)];
-    prog.set("u_luma", luma, 16);
+    set_luma_uniform(prog, f);
     prog.set("u_locks", int(to.locks));
   }
 
@@ -370,10 +363,7 @@ class TaauStateGpu final : public GpuHistoryState {
     const TaauConstants constants = taau_constants(f.grid.k);
     const std::uint32_t n = std::uint32_t(std::size_t(f.W) * f.H);
 
-    frame_.bind();
-    out_[cur_].bind(2);
-    out_[prv].bind(3);
-    prevg_.bind(4);
+    bind_history_buffers();
     st_.bind(5);
     lowl_.bind(6);
     counters_.bind(15);
@@ -407,13 +397,7 @@ class TaauStateGpu final : public GpuHistoryState {
     timing_.bytes_moved = (C * low + 4 * low + 2 * low) + 4 * full + C * low + C * full + 2 * full + full +
                           2 * (2 * full) + C * full + 3 * 2 * full + 2 * low + (f.debug ? 7.0 * full : 0.0);
 
-    if (Status s = download_result(f, kDebugNames); !s) return s;
-    if (Status s = store_previous_geometry(f); !s) return s;
-    std::uint32_t counts[4] = {};
-    if (Status s = counters_.download(0, counts); !s) return s;
-    stats.history_pixels = history ? counts[0] : 0;
-    stats.hole_pixels = std::size_t(f.W) * f.H - stats.history_pixels;
-    return Status::ok();
+    return finish_frame(f, history, kDebugNames, stats);
   }
 
   gpu::Program low_, pixel_;

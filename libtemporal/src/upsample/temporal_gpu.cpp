@@ -103,10 +103,7 @@ class TemporalStateGpu final : public GpuHistoryState {
     program_.set("u_debug", int(f.debug));
     program_.set("u_tol", test.depth_tolerance);
     program_.set("u_warped_tol", o.warped_depth_tolerance);
-    frame_.bind();
-    out_[cur_].bind(2);
-    out_[1 - cur_].bind(3);
-    prevg_.bind(4);
+    bind_history_buffers();
     counters_.bind(15);
     timer_.start();
     if (Status s = program_.dispatch(f.W, f.H); !s) return s;

@@ -49,4 +49,9 @@ std::string_view reproject();
 // value itself for one. The box space of phlm's box test and taa's clipping.
 std::string_view ycgco_box();
 
+// float min_(a, b) and float max_(a, b): std::min and std::max to the letter (b < a ? b : a and a < b ? b : a), for
+// the kernels whose C++ reference takes them where an operand can be NaN (taa's clipping, phlm's box): the result
+// is then the first operand, as in C++, which GLSL's min and max do not promise.
+std::string_view std_min_max();
+
 }  // namespace temporal::gpu::glsl
