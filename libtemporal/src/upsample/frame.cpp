@@ -66,6 +66,20 @@ void drop_unusable(const float* __restrict low, float* __restrict valid, int lw)
 }
 }  // namespace
 
+void gather_low_geometry_row(const FrameContext& f, int y, float* lz, float* lnx, float* lny, float* lnz,
+                             float* valid) {
+  const int k = f.grid.k;
+  const std::size_t g = std::size_t(k * y + f.grid.sy) * f.W + f.grid.sx, i = std::size_t(y) * f.lw;
+  const float *z = f.z + g, *nx = f.nx + g, *ny = f.ny + g, *nz = f.nz + g;
+  if (k == 4)
+    gather_low_row<4>(z, nx, ny, nz, lz, lnx, lny, lnz, valid, f.lw, k);
+  else if (k == 2)
+    gather_low_row<2>(z, nx, ny, nz, lz, lnx, lny, lnz, valid, f.lw, k);
+  else
+    gather_low_row<0>(z, nx, ny, nz, lz, lnx, lny, lnz, valid, f.lw, k);
+  for (int c = 0; c < f.C; ++c) drop_unusable(f.low[c] + i, valid, f.lw);
+}
+
 void gather_low_geometry(FrameContext& f) {
   const std::size_t n = std::size_t(f.lw) * f.lh;
   f.lz.resize(n);
@@ -73,22 +87,17 @@ void gather_low_geometry(FrameContext& f) {
   f.lny.resize(n);
   f.lnz.resize(n);
   f.lvalid.resize(n);
-  const int k = f.grid.k;
   parallel_rows(f.lh, [&](int y0, int y1) {
     for (int y = y0; y < y1; ++y) {
-      const std::size_t g = std::size_t(k * y + f.grid.sy) * f.W + f.grid.sx, i = std::size_t(y) * f.lw;
-      const float *z = f.z + g, *nx = f.nx + g, *ny = f.ny + g, *nz = f.nz + g;
-      float *lz = f.lz.data() + i, *lnx = f.lnx.data() + i, *lny = f.lny.data() + i, *lnz = f.lnz.data() + i;
-      float* valid = f.lvalid.data() + i;
-      if (k == 4)
-        gather_low_row<4>(z, nx, ny, nz, lz, lnx, lny, lnz, valid, f.lw, k);
-      else if (k == 2)
-        gather_low_row<2>(z, nx, ny, nz, lz, lnx, lny, lnz, valid, f.lw, k);
-      else
-        gather_low_row<0>(z, nx, ny, nz, lz, lnx, lny, lnz, valid, f.lw, k);
-      for (int c = 0; c < f.C; ++c) drop_unusable(f.low[c] + i, valid, f.lw);
+      const std::size_t i = std::size_t(y) * f.lw;
+      gather_low_geometry_row(f, y, f.lz.data() + i, f.lnx.data() + i, f.lny.data() + i, f.lnz.data() + i,
+                              f.lvalid.data() + i);
     }
   });
+}
+
+void clear_low_geometry(FrameContext& f) {
+  for (auto* v : {&f.lz, &f.lnx, &f.lny, &f.lnz, &f.lvalid}) v->clear();
 }
 
 void spatial_row(const FrameContext& f, int Y, float* const* out, float* wsum, int X0, int X1) {
