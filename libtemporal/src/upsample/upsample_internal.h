@@ -77,11 +77,6 @@ struct FrameContext {
 
 // Fills the sample geometry of `f` (lz .. lvalid) from its G-buffer and payload planes.
 void gather_low_geometry(FrameContext& f);
-// Low-resolution row y of the same (lw values per plane, into the given rows): what gather_low_geometry writes at
-// row y, bit for bit, for a method that reads the sample geometry of one row at a time and gathers it in its own
-// row pass, while the row's other planes are in cache (MethodState::gathers_low_geometry).
-void gather_low_geometry_row(const FrameContext& f, int y, float* lz, float* lnx, float* lny, float* lnz,
-                             float* valid);
 // Empties the sample geometry of `f` (a method that gathers its own: nothing reads stale rows of an earlier frame).
 void clear_low_geometry(FrameContext& f);
 
