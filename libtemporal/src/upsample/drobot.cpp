@@ -25,6 +25,7 @@
 
 #include <atomic>
 #include <cstdint>
+#include <limits>
 #if defined(__SSE2__)
 #include <immintrin.h>
 #endif

@@ -39,31 +39,7 @@ void TapTable::build(int full, int low, int k, int s) {
 }
 
 namespace {
-// One row of gather_low_geometry: the G-buffer at pixels (k x + sx, row) for x < lw, K the stride k (0: any k, read
-// at run time). With K a constant the strided loads vectorise (shuffles of contiguous loads); the validity test is
-// |v| <= FLT_MAX (std::isfinite, which GCC keeps scalar) combined with & instead of &&, and one loop per channel.
-template <int K>
-void gather_low_row(const float* __restrict z, const float* __restrict nx, const float* __restrict ny,
-                    const float* __restrict nz, float* __restrict lz, float* __restrict lnx, float* __restrict lny,
-                    float* __restrict lnz, float* __restrict valid, int lw, int k_runtime) {
-  const int k = K > 0 ? K : k_runtime;
-  constexpr float kMax = std::numeric_limits<float>::max();
-  for (int x = 0; x < lw; ++x) {
-    const float a = z[k * x], b = nx[k * x], c = ny[k * x], d = nz[k * x];
-    lz[x] = a;
-    lnx[x] = b;
-    lny[x] = c;
-    lnz[x] = d;
-    // A sample with a non-finite payload or geometry is no sample (its weight becomes 0).
-    const bool ok = (std::abs(a) <= kMax) & (std::abs(b) <= kMax) & (std::abs(c) <= kMax) & (std::abs(d) <= kMax);
-    valid[x] = ok ? 1.0f : 0.0f;
-  }
-}
-// So is a payload past kMaxSampleMagnitude (temporal/core/image.h: squared and accumulated, it would overflow;
-// usable_sample is false for NaN too).
-void drop_unusable(const float* __restrict low, float* __restrict valid, int lw) {
-  for (int x = 0; x < lw; ++x) valid[x] = usable_sample(low[x]) ? valid[x] : 0.0f;
-}
+#include "low_geometry_row.inc"
 }  // namespace
 
 void gather_low_geometry(FrameContext& f) {
@@ -73,22 +49,17 @@ void gather_low_geometry(FrameContext& f) {
   f.lny.resize(n);
   f.lnz.resize(n);
   f.lvalid.resize(n);
-  const int k = f.grid.k;
   parallel_rows(f.lh, [&](int y0, int y1) {
     for (int y = y0; y < y1; ++y) {
-      const std::size_t g = std::size_t(k * y + f.grid.sy) * f.W + f.grid.sx, i = std::size_t(y) * f.lw;
-      const float *z = f.z + g, *nx = f.nx + g, *ny = f.ny + g, *nz = f.nz + g;
-      float *lz = f.lz.data() + i, *lnx = f.lnx.data() + i, *lny = f.lny.data() + i, *lnz = f.lnz.data() + i;
-      float* valid = f.lvalid.data() + i;
-      if (k == 4)
-        gather_low_row<4>(z, nx, ny, nz, lz, lnx, lny, lnz, valid, f.lw, k);
-      else if (k == 2)
-        gather_low_row<2>(z, nx, ny, nz, lz, lnx, lny, lnz, valid, f.lw, k);
-      else
-        gather_low_row<0>(z, nx, ny, nz, lz, lnx, lny, lnz, valid, f.lw, k);
-      for (int c = 0; c < f.C; ++c) drop_unusable(f.low[c] + i, valid, f.lw);
+      const std::size_t i = std::size_t(y) * f.lw;
+      low_geometry_row(f, y, f.lz.data() + i, f.lnx.data() + i, f.lny.data() + i, f.lnz.data() + i,
+                       f.lvalid.data() + i);
     }
   });
+}
+
+void clear_low_geometry(FrameContext& f) {
+  for (auto* v : {&f.lz, &f.lnx, &f.lny, &f.lnz, &f.lvalid}) v->clear();
 }
 
 void spatial_row(const FrameContext& f, int Y, float* const* out, float* wsum, int X0, int X1) {

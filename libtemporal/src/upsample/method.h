@@ -32,6 +32,11 @@ class MethodState {
   // the payload channels, plus debug.* layers when f.debug. `history` is false when every history must be ignored
   // (first frame, cut). Fills stats.hole_pixels and stats.history_pixels.
   virtual Image& run(const FrameContext& f, bool history, FrameStats& stats) = 0;
+  // Whether run() gathers this frame's sample geometry itself, row by row inside its own row pass
+  // (low_geometry_row.inc), instead of reading f.lz .. f.lvalid: Upsampler::process then skips its whole-frame
+  // gather_low_geometry and leaves those planes empty. A pass of its own over the G-buffer rows of the samples
+  // waited on memory (drobot: 5 % of a two-thread frame, docs/upsample-st.md).
+  virtual bool gathers_low_geometry() const { return false; }
   // Whether the last run() succeeded: the C++ states cannot fail; a GPU state (gpu_methods.h) reports a driver
   // error here (its output is then undefined), and the Upsampler returns it.
   virtual Status run_status() const { return Status::ok(); }

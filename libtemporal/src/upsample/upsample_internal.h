@@ -69,13 +69,16 @@ struct FrameContext {
   const Options* options = nullptr;
   bool debug = false;        // add the debug.* layers
   // This frame's samples: tap tables of the jittered grid and the geometry (z, N) of each low-resolution sample
-  // at its full-resolution pixel, with its validity (0 for a non-finite payload or geometry).
+  // at its full-resolution pixel, with its validity (0 for a non-finite payload or geometry). Empty when the
+  // method's state gathers its sample geometry itself, row by row (MethodState::gathers_low_geometry).
   TapTable cols, rows;
   std::vector<float> lz, lnx, lny, lnz, lvalid;
 };
 
 // Fills the sample geometry of `f` (lz .. lvalid) from its G-buffer and payload planes.
 void gather_low_geometry(FrameContext& f);
+// Empties the sample geometry of `f` (a method that gathers its own: nothing reads stale rows of an earlier frame).
+void clear_low_geometry(FrameContext& f);
 
 // Depth and ids of the previous frame, for the disocclusion test of the history fetch.
 struct PreviousGeometry {

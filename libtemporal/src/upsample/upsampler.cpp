@@ -341,7 +341,10 @@ Expected<Image*> Upsampler::process(const Image& gbuffer, const Image& low, std:
   stats.history_reset = !u.have_history;
   for (int c = 0; c < u.f.C; ++c) stats.non_finite_input += count_non_finite({u.f.low[c], std::size_t(u.f.lw) * u.f.lh});
   if (u.options.demodulate) u.demodulate_low();
-  gather_low_geometry(u.f);
+  if (u.state->gathers_low_geometry())
+    clear_low_geometry(u.f);
+  else
+    gather_low_geometry(u.f);
   Image* result = &u.state->run(u.f, u.have_history, stats);
   if (Status s = u.state->run_status(); !s) return s.error();
   u.have_history = true;
