@@ -255,3 +255,72 @@ TEST(Reproject, GatherRowInOnePassEqualsTheTwoSteps) {
     }
   }
 }
+
+// reproject_gather_row finds its aligned runs 16 pixels at a time and extends them pixel by pixel at their ends
+// (reproject_kernels.inc, block_segments): a run that starts inside a block after per-pixel motion keeps its first
+// pixels, and a run whose offset is negative (motion to the left on the top row: base = x0 - X < 0) is gathered.
+// The segments are checked, and the values against reproject_row then gather_row, bit for bit.
+TEST(Reproject, GatherRowRunsStartInsideABlockAndNegativeOffsetsGather) {
+  namespace isa = temporal::isa;
+  const int W = 80, H = 6, X0 = 20;  // the pan starts at column 20, inside the block [16, 32)
+  const std::size_t N = std::size_t(W) * H;
+  std::vector<float> mx(N), my(N), z(N, 10.0f), pz(N, 10.0f);
+  std::vector<std::vector<float>> planes(4, std::vector<float>(N));
+  std::uint32_t seed = 777;
+  auto rnd = [&seed] {
+    seed = seed * 1664525u + 1013904223u;
+    return float(seed >> 8) / float(1u << 24);
+  };
+  for (int y = 0; y < H; ++y)
+    for (int x = 0; x < W; ++x) {
+      const std::size_t i = std::size_t(y) * W + x;
+      mx[i] = x < X0 ? 6.0f * rnd() - 3.0f : -2.0f;  // x0 = X - 2 on the pan: aligned, offset y W - 2
+      // y0 = y - 1 left of the pan (never the pan's offset, and off the image on row 0), y0 = y on it
+      my[i] = x < X0 ? -0.5f - 0.5f * rnd() : 0.25f;
+      for (auto& p : planes) p[i] = rnd();
+    }
+  std::vector<isa::Level> levels;
+  for (const isa::Level l : {isa::Level::V2, isa::Level::V3, isa::Level::V4})
+    if (isa::supported(l)) levels.push_back(l);
+  if (levels.empty()) levels.push_back(isa::active());
+  for (const isa::Level level : levels) {
+    isa::ScopedLevel scoped(level);
+    rp::Frames fr;
+    fr.width = W;
+    fr.height = H;
+    fr.motion_x = mx.data();
+    fr.motion_y = my.data();
+    fr.z = z.data();
+    fr.prev_z = pz.data();
+    const float* prev[4] = {planes[0].data(), planes[1].data(), planes[2].data(), planes[3].data()};
+    std::vector<float> a(4 * std::size_t(W)), b(4 * std::size_t(W));
+    float* oa[4];
+    float* ob[4];
+    for (int i = 0; i < 4; ++i) {
+      oa[i] = a.data() + std::size_t(i) * W;
+      ob[i] = b.data() + std::size_t(i) * W;
+    }
+    for (int y = 0; y < H - 1; ++y) {  // the last row's taps leave the image (y0 + 1 = H): no aligned run there
+      rp::HistoryRow ha, hb;
+      rp::reproject_row(fr, y, ha);
+      rp::gather_row(ha, prev, oa, 4, W);
+      rp::reproject_gather_row(fr, y, hb, prev, ob, 4);
+      std::vector<rp::HistoryRow::Segment> aligned;
+      for (const auto& sg : hb.segments)
+        if (sg.base >= 0) aligned.push_back(sg);
+      if (y == 0) {
+        EXPECT_TRUE(aligned.empty()) << isa::name(level);  // offset -2: gathered
+      } else {
+        ASSERT_EQ(aligned.size(), 1u) << isa::name(level) << " y " << y;
+        EXPECT_EQ(aligned[0].x0, X0) << isa::name(level) << " y " << y;
+        EXPECT_EQ(aligned[0].x1, W) << isa::name(level) << " y " << y;
+        EXPECT_EQ(aligned[0].base, y * W - 2) << isa::name(level) << " y " << y;
+      }
+      for (int x = 0; x < W; ++x) {
+        ASSERT_EQ(ha.hit[x], hb.hit[x]) << isa::name(level) << " y " << y << " x " << x;
+        for (int i = 0; i < 4; ++i)
+          ASSERT_EQ(oa[i][x], ob[i][x]) << isa::name(level) << " y " << y << " plane " << i << " x " << x;
+      }
+    }
+  }
+}

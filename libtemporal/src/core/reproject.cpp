@@ -9,6 +9,10 @@
 #include "temporal/core/isa.h"
 #include "temporal/core/parallel.h"
 
+#if defined(__x86_64__) || defined(__i386__)
+#include <immintrin.h>
+#endif
+
 #include <bit>
 #include <cstring>
 #include <limits>

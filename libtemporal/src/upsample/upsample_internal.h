@@ -209,6 +209,9 @@ inline float sample_weight(float zi, float ax, float ay, float az, float lx, flo
 // Always inlined: its callers are the per-instruction-set copies of spatial and herzog (temporal/core/isa.h), and
 // GCC, which found it too large to inline, called the one out-of-line copy, compiled for the baseline (SSE4.2):
 // 41 % of spatial's time at AVX-512 against 30 % in a -march=native build.
+// kLower = false: the upper taps' weights only (g10 and g11 are not written), for a caller whose image kernel is
+// zero on the lower taps of the whole row (herzog's rows on the low-resolution sample row, HerzogFrame::lower_zero).
+template <bool kLower = true>
 [[gnu::always_inline]] inline void expanded_geometric_weights(const FrameContext& f, float inv_sn2, float inv_sd2,
                                        int Y, const float* e0, const float* e1, std::size_t es,
                                        float* __restrict g00, float* __restrict g01, float* __restrict g10,
@@ -239,8 +242,10 @@ inline float sample_weight(float zi, float ax, float ay, float az, float lx, flo
     const float zi = z[X], ax = nx[X], ay = ny[X], az = nz[X];
     g00[X] = sample_weight(zi, ax, ay, az, x00[X], y00[X], n00[X], z00[X], v00[X], inv_sn2, inv_sd2) * cv0[X] * vy0;
     g01[X] = sample_weight(zi, ax, ay, az, x01[X], y01[X], n01[X], z01[X], v01[X], inv_sn2, inv_sd2) * cv1[X] * vy0;
-    g10[X] = sample_weight(zi, ax, ay, az, x10[X], y10[X], n10[X], z10[X], v10[X], inv_sn2, inv_sd2) * cv0[X] * vy1;
-    g11[X] = sample_weight(zi, ax, ay, az, x11[X], y11[X], n11[X], z11[X], v11[X], inv_sn2, inv_sd2) * cv1[X] * vy1;
+    if constexpr (kLower) {
+      g10[X] = sample_weight(zi, ax, ay, az, x10[X], y10[X], n10[X], z10[X], v10[X], inv_sn2, inv_sd2) * cv0[X] * vy1;
+      g11[X] = sample_weight(zi, ax, ay, az, x11[X], y11[X], n11[X], z11[X], v11[X], inv_sn2, inv_sd2) * cv1[X] * vy1;
+    }
   }
 }
 
