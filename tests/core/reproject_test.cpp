@@ -60,6 +60,18 @@ TEST(Reproject, SameSurfaceIsRelativeToTheLargerDepth) {
 }
 
 namespace {
+
+// The kernel copies this CPU runs (v2 first), or the one active copy in a build with one copy (TEMPORAL_NATIVE): the
+// levels at which the row kernels' tests compare paths bit for bit.
+std::vector<temporal::isa::Level> levels_here() {
+  namespace isa = temporal::isa;
+  std::vector<isa::Level> levels;
+  for (const isa::Level l : {isa::Level::V2, isa::Level::V3, isa::Level::V4})
+    if (isa::supported(l)) levels.push_back(l);
+  if (levels.empty()) levels.push_back(isa::active());
+  return levels;
+}
+
 // A 6x4 previous frame: depth 10 on the left half (id 1), 20 on the right half (id 2); values = x + 10 y.
 struct Prev {
   int w = 6, h = 4;
@@ -205,11 +217,7 @@ TEST(Reproject, GatherRowInOnePassEqualsTheTwoSteps) {
       pid[i] = x > 82 ? 2u : 1u;
       for (auto& p : planes) p[i] = rnd();
     }
-  std::vector<isa::Level> levels;
-  for (const isa::Level l : {isa::Level::V2, isa::Level::V3, isa::Level::V4})
-    if (isa::supported(l)) levels.push_back(l);
-  if (levels.empty()) levels.push_back(isa::active());  // a build with one copy
-  for (const isa::Level level : levels) {
+  for (const isa::Level level : levels_here()) {
     isa::ScopedLevel scoped(level);
     for (int mode = 0; mode < 4; ++mode) {
       rp::Frames fr;
@@ -279,11 +287,7 @@ TEST(Reproject, GatherRowRunsStartInsideABlockAndNegativeOffsetsGather) {
       my[i] = x < X0 ? -0.5f - 0.5f * rnd() : 0.25f;
       for (auto& p : planes) p[i] = rnd();
     }
-  std::vector<isa::Level> levels;
-  for (const isa::Level l : {isa::Level::V2, isa::Level::V3, isa::Level::V4})
-    if (isa::supported(l)) levels.push_back(l);
-  if (levels.empty()) levels.push_back(isa::active());
-  for (const isa::Level level : levels) {
+  for (const isa::Level level : levels_here()) {
     isa::ScopedLevel scoped(level);
     rp::Frames fr;
     fr.width = W;
