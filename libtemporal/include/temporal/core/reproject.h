@@ -210,11 +210,11 @@ void reproject_row(const Frames& frames, int y, HistoryRow& h);
 // Exposed for kernels that build their own q (herzog's gradient cells).
 void build_segments(HistoryRow& h, int width);
 
-// Gathers n (1..16) previous-frame planes with the taps of `h` into out[i][0..W): out = sum_j w[j] prev[q[j]]
-// (0 on a miss: callers test h.hit).
+// Gathers n >= 1 previous-frame planes (four at a time) with the taps of `h` into out[i][0..W):
+// out = sum_j w[j] prev[q[j]] (0 on a miss: callers test h.hit).
 void gather_row(const HistoryRow& h, const float* const* prev, float* const* out, int n, int width);
 
-// reproject_row, then gather_row of n planes (1..16), in one pass over the row: the same values in out and h.hit.
+// reproject_row, then gather_row of n >= 1 planes, in one pass over the row: the same values in out and h.hit.
 // Up to four planes, the aligned runs (HistoryRow::segments) test and gather in one loop that never stores their
 // weights: h.q and h.w then hold the taps of the gather runs only, so a caller that needs the weights of every
 // pixel (to gather more planes later) calls the two steps instead. More than four planes: the two steps. Its runs
