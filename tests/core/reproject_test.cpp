@@ -264,9 +264,10 @@ TEST(Reproject, GatherRowInOnePassEqualsTheTwoSteps) {
   }
 }
 
-// reproject_gather_row finds its aligned runs 16 pixels at a time and extends them pixel by pixel at their ends
-// (reproject_kernels.inc, block_segments): a run that starts inside a block after per-pixel motion keeps its first
-// pixels, and a run whose offset is negative (motion to the left on the top row: base = x0 - X < 0) is gathered.
+// reproject_gather_row finds its aligned runs 16 pixels at a time (reproject_kernels.inc, block_segments; in the v3
+// and v4 copies one vector at a time, verified_runs) and extends them pixel by pixel at their ends: a run that
+// starts inside a block after per-pixel motion keeps its first pixels, and a run whose offset is negative (motion
+// to the left on the top row: base = x0 - X < 0) is gathered.
 // The segments are checked, and the values against reproject_row then gather_row, bit for bit.
 TEST(Reproject, GatherRowRunsStartInsideABlockAndNegativeOffsetsGather) {
   namespace isa = temporal::isa;

@@ -218,8 +218,9 @@ void gather_row(const HistoryRow& h, const float* const* prev, float* const* out
 // Up to four planes, the aligned runs (HistoryRow::segments) test and gather in one loop that never stores their
 // weights: h.q and h.w then hold the taps of the gather runs only, so a caller that needs the weights of every
 // pixel (to gather more planes later) calls the two steps instead. More than four planes: the two steps. Its runs
-// are found 16 pixels at a time (reproject_kernels.inc, block_segments), so h.segments may split the row
-// differently from build_segments; the values do not depend on the split.
+// are found 16 pixels at a time (reproject_kernels.inc, block_segments; in the v3 and v4 copies one vector of 8 or
+// 16 pixels at a time while they are fetched, verified_runs), so h.segments may split the row differently from
+// build_segments; the values do not depend on the split.
 void reproject_gather_row(const Frames& frames, int y, HistoryRow& h, const float* const* prev, float* const* out,
                           int n);
 
