@@ -75,7 +75,12 @@ void reproject_gather_row(const Frames& frames, int y, HistoryRow& h, const floa
     gather_row(h, prev, out, n, frames.width);
     return;
   }
-  h.resize(frames.width);
+  // Only when a row changed size: HistoryRow::resize is eleven vector resizes, ~160 instructions a row at v3 even
+  // when nothing changes (callgrind, issue 27's sixth herzog pass); herzog calls this once per row.
+  const std::size_t W = std::size_t(frames.width);
+  bool sized = h.hit.size() == W && h.offset.size() == W && h.aligned.size() == W;
+  for (int j = 0; j < 4; ++j) sized = sized && h.q[j].size() == W && h.w[j].size() == W;
+  if (!sized) h.resize(frames.width);
   kernels().reproject_gather(frames, y, h, prev, out, n);
 }
 
