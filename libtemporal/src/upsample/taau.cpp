@@ -41,6 +41,7 @@
 #include <bit>
 #include <cmath>
 #include <cstdint>
+#include <cwchar>
 #include <limits>
 
 namespace temporal::upsample {
