@@ -215,3 +215,23 @@ TEST(UpsampleReference, SyntheticScenes) {
     }
   }
 }
+
+TEST(UpsampleReference, DrobotWavefrontBands) {
+  // drobot's cache mode runs a frame as a wavefront in bands of 32 cache rows (run_cache: the cache update, Listing
+  // 7.3's vertical pass 4 rows behind it and the full rows behind that), the rows around the bands' edges in two
+  // later phases; the sizes above have at most 32 cache rows, one band. Tall frames: 69 cache rows (bands of 32, 32
+  // and 5, the last shorter than the filter's reach on both sides), 33 (a last band of one row) and 37 at k = 3. A
+  // full row upsampled before its cache rows were filtered, or an edge row left out, reads the frame before last's
+  // cache (the ping-pong buffer) and differs by 1e-3 to 1.
+  struct Size {
+    int W, H, k;
+  };
+  for (const Size s : {Size{40, 276, 4}, Size{40, 132, 4}, Size{36, 111, 3}}) {
+    const auto frames = random_sequence(s.W, s.H, s.k, 8, unsigned(s.H));
+    auto o = up::make_options("drobot", {});
+    ASSERT_TRUE(o.has_value()) << o.error().message;
+    const double d = max_difference(*o, frames);
+    std::printf("drobot %dx%d k=%d: max |fast - plain| = %.3g\n", s.W, s.H, s.k, d);
+    EXPECT_LE(d, tolerance("drobot")) << s.W << "x" << s.H << ", k = " << s.k;
+  }
+}

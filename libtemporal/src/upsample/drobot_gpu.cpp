@@ -2,10 +2,10 @@
 // and the same state planes (cache mode: cache.<c>, cache.depth, cache.frames, cache.id; refresh mode: history.<c>,
 // prev.depth, prev.id), so that a state file written by either device resumes on the other.
 //  cache mode (section 7.2): G (low resolution) the cache grid, one sample per k x k block at its centre
-//    (build_cache_grid); A (low resolution) steps 3-5, Listing 7.2 on the shared GLSL reprojection in the cache grid
+//    (cache_grid_row); A (low resolution) steps 3-5, Listing 7.2 on the shared GLSL reprojection in the cache grid
 //    with the exponential history and its running convergence (accumulate_cache_row); F twice (low resolution)
-//    step 6, Listing 7.3 horizontal then vertical (bilateral_pass); U (full resolution) step 7, Listing 7.1 from
-//    the block centres (drobot_upsample_row, upsample_cache).
+//    step 6, Listing 7.3 horizontal then vertical (bilateral_row); U (full resolution) step 7, Listing 7.1 from
+//    the block centres (drobot_upsample_row, CacheUpsample::row). (The C++ runs them as one wavefront, run_cache.)
 //  refresh mode (Figure 7.12): R (full resolution) Listing 7.1 from this frame's samples, the sample itself where
 //    the pixel was shaded, else the history blended by Listing 7.2's confidence (refresh_row).
 // What can differ from the C++: multiply-adds contracted into FMAs differently by the driver and GCC, and for a
@@ -468,7 +468,7 @@ class DrobotStateGpu final : public GpuHistoryState {
     if (Status s = frame_.upload(ctx_, f, true); !s) return s;
     if (Status s = counters_.clear(0, 1); !s) return s;
     const int k = f.grid.k, C = f.C;
-    // build_cache_grid's table of the block centres.
+    // prepare_cache_grid's table of the block centres.
     const float off = (k % 2 == 0) ? 0.5f : 0.0f;
     std::vector<float> table(std::size_t(k) * k * 4);
     for (int dy = 0; dy < k; ++dy)
