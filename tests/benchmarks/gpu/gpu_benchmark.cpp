@@ -24,6 +24,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <map>
 #include <random>
 #include <utility>
@@ -299,20 +300,28 @@ void BM_Warp(benchmark::State& state) { run_morph(state, make_warp_method_gpu); 
 // factor 3, the size of its 5.6-7 ms for two in-between frames.
 void BM_Didyk(benchmark::State& state) { run_morph(state, make_didyk_method_gpu); }
 
+// The manual time is the kernels' time only; each iteration also uploads the inputs and reads the outputs back on
+// the host. On a hardware GPU the kernels take ~0.01-0.1 ms against tens of ms of host work, so Google Benchmark's
+// default (iterate until the kernels add up to min_time) runs for minutes per row. GPU_BENCH_ITERATIONS=N fixes the
+// iteration count of every method row (the copy rows, which have no host work, keep the default).
+void fixed_iterations(benchmark::internal::Benchmark* b) {
+  if (const char* n = std::getenv("GPU_BENCH_ITERATIONS"); n && std::atoll(n) > 0) b->Iterations(std::atoll(n));
+}
+
 BENCHMARK(BM_Copy)->Args({1920, 1080})->Args({1280, 1024})->Args({1024, 1024})->Args({480, 270})->Args({320, 256})
     ->Args({256, 256})->UseManualTime()->Unit(benchmark::kMillisecond);
-BENCHMARK(BM_Ema)->Args({1920, 1080})->Args({480, 270})->UseManualTime()->Unit(benchmark::kMillisecond);
-BENCHMARK(BM_Taa)->Args({1920, 1080})->Args({480, 270})->UseManualTime()->Unit(benchmark::kMillisecond);
-BENCHMARK(BM_Phlm)->Args({1920, 1080})->Args({480, 270})->UseManualTime()->Unit(benchmark::kMillisecond);
-BENCHMARK(BM_Fxaa)->Args({1920, 1080})->Args({480, 270})->UseManualTime()->Unit(benchmark::kMillisecond);
-BENCHMARK(BM_Spatial)->Args({1280, 1024})->Args({320, 256})->UseManualTime()->Unit(benchmark::kMillisecond);
-BENCHMARK(BM_Temporal)->Args({1280, 1024})->Args({320, 256})->UseManualTime()->Unit(benchmark::kMillisecond);
-BENCHMARK(BM_Herzog)->Args({1280, 1024})->Args({320, 256})->UseManualTime()->Unit(benchmark::kMillisecond);
-BENCHMARK(BM_Taau)->Args({1280, 1024})->Args({320, 256})->UseManualTime()->Unit(benchmark::kMillisecond);
-BENCHMARK(BM_Drobot)->Args({1280, 1024})->Args({320, 256})->UseManualTime()->Unit(benchmark::kMillisecond);
-BENCHMARK(BM_Blend)->Args({1024, 1024})->Args({256, 256})->UseManualTime()->Unit(benchmark::kMillisecond);
-BENCHMARK(BM_Warp)->Args({1024, 1024})->Args({256, 256})->UseManualTime()->Unit(benchmark::kMillisecond);
-BENCHMARK(BM_Didyk)->Args({1024, 1024})->Args({256, 256})->UseManualTime()->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_Ema)->Args({1920, 1080})->Args({480, 270})->Apply(fixed_iterations)->UseManualTime()->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_Taa)->Args({1920, 1080})->Args({480, 270})->Apply(fixed_iterations)->UseManualTime()->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_Phlm)->Args({1920, 1080})->Args({480, 270})->Apply(fixed_iterations)->UseManualTime()->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_Fxaa)->Args({1920, 1080})->Args({480, 270})->Apply(fixed_iterations)->UseManualTime()->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_Spatial)->Args({1280, 1024})->Args({320, 256})->Apply(fixed_iterations)->UseManualTime()->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_Temporal)->Args({1280, 1024})->Args({320, 256})->Apply(fixed_iterations)->UseManualTime()->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_Herzog)->Args({1280, 1024})->Args({320, 256})->Apply(fixed_iterations)->UseManualTime()->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_Taau)->Args({1280, 1024})->Args({320, 256})->Apply(fixed_iterations)->UseManualTime()->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_Drobot)->Args({1280, 1024})->Args({320, 256})->Apply(fixed_iterations)->UseManualTime()->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_Blend)->Args({1024, 1024})->Args({256, 256})->Apply(fixed_iterations)->UseManualTime()->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_Warp)->Args({1024, 1024})->Args({256, 256})->Apply(fixed_iterations)->UseManualTime()->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_Didyk)->Args({1024, 1024})->Args({256, 256})->Apply(fixed_iterations)->UseManualTime()->Unit(benchmark::kMillisecond);
 
 }  // namespace
 
