@@ -124,6 +124,21 @@ void from_box(inout float v[TAAU_C]) {
   }
 }
 
+// The low-resolution sample (lx, ly) of gather_samples' 3x3 around the nearest one: false where it lies outside the
+// image or is invalid; else its squared distance to the output pixel p in output pixels / k, and its payload in the
+// box space. Both passes over the samples call it, so they see the same values.
+bool box_sample(ivec2 p, int lx, int ly, out float d2, out float v[TAAU_C]) {
+  if (ly < 0 || ly >= u_low.y || lx < 0 || lx >= u_low.x) return false;
+  const uint s = uint(ly * u_low.x + lx);
+  if (!low_valid(s)) return false;
+  const float inv_k = 1.0 / float(u_k);
+  const float ox = float(u_k * lx + u_sx - p.x) * inv_k, oy = float(u_k * ly + u_sy - p.y) * inv_k;
+  d2 = ox * ox + oy * oy;
+  for (int c = 0; c < TAAU_C; ++c) v[c] = lowb[uint(c) * u_ln + s];
+  to_box(v);
+  return true;
+}
+
 // FSR 2's Lanczos2ApproxSq (taau.cpp lanczos2_approx_sq).
 float lanczos2_approx_sq(float x2) {
   x2 = min(x2, 4.0);
@@ -153,7 +168,6 @@ void main() {
     const int yn = clamp(floor_div(2 * (p.y - u_sy) + k, 2 * k), 0, lh - 1);
     const float bias = hit ? u_bias_history : 1.0;
     const float curve = -2.0 - min(1.0, velocity / 50.0);  // fRectificationCurveBias
-    const float inv_k = 1.0 / float(k);
     float sum[TAAU_C], bsum[TAAU_C], bsq[TAAU_C], lo[TAAU_C], hi[TAAU_C];
     for (int c = 0; c < C; ++c) {
       sum[c] = 0.0;
@@ -164,21 +178,12 @@ void main() {
     }
     float wsum = 0.0, bw = 0.0;
     int samples = 0;
-    for (int dy = -1; dy <= 1; ++dy) {
-      const int ly = yn + dy;
-      if (ly < 0 || ly >= lh) continue;
+    for (int dy = -1; dy <= 1; ++dy)
       for (int dx = -1; dx <= 1; ++dx) {
-        const int lx = xn + dx;
-        if (lx < 0 || lx >= lw) continue;
-        const uint s = uint(ly * lw + lx);
-        if (!low_valid(s)) continue;
-        const float ox = float(k * lx + u_sx - p.x) * inv_k, oy = float(k * ly + u_sy - p.y) * inv_k;
-        const float d2 = ox * ox + oy * oy;
+        float d2, v[TAAU_C];
+        if (!box_sample(p, xn + dx, yn + dy, d2, v)) continue;
         const float wl = lanczos2_approx_sq(d2 * bias * bias);
         const float wb = exp(curve * d2);
-        float v[TAAU_C];
-        for (int c = 0; c < C; ++c) v[c] = lowb[uint(c) * u_ln + s];
-        to_box(v);
         for (int c = 0; c < C; ++c) {
           sum[c] += wl * v[c];
           bsum[c] += wb * v[c];
@@ -189,30 +194,19 @@ void main() {
         bw += wb;
         ++samples;
       }
-    }
     // The variance's second pass over the same samples in the same order (taau.cpp keeps them; here each sample is
     // read and its box weight computed again, the same operations on the same values, instead of an array indexed
     // by the sample count, which a compiler can only place in local memory).
-    for (int dy = -1; dy <= 1; ++dy) {
-      const int ly = yn + dy;
-      if (ly < 0 || ly >= lh) continue;
+    for (int dy = -1; dy <= 1; ++dy)
       for (int dx = -1; dx <= 1; ++dx) {
-        const int lx = xn + dx;
-        if (lx < 0 || lx >= lw) continue;
-        const uint s = uint(ly * lw + lx);
-        if (!low_valid(s)) continue;
-        const float ox = float(k * lx + u_sx - p.x) * inv_k, oy = float(k * ly + u_sy - p.y) * inv_k;
-        const float d2 = ox * ox + oy * oy;
+        float d2, v[TAAU_C];
+        if (!box_sample(p, xn + dx, yn + dy, d2, v)) continue;
         const float wb = exp(curve * d2);
-        float v[TAAU_C];
-        for (int c = 0; c < C; ++c) v[c] = lowb[uint(c) * u_ln + s];
-        to_box(v);
         for (int c = 0; c < C; ++c) {
           const float d = v[c] - bsum[c] / bw;
           bsq[c] += wb * d * d;
         }
       }
-    }
     // The history in the box space (step 1's colour filter: Catmull-Rom where the four bilinear taps were kept).
     float hv[TAAU_C];
     for (int c = 0; c < C; ++c) hv[c] = hit ? REPROJECT_GATHER(hist, uint(c) * u_n, t) : 0.0;
