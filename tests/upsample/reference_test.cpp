@@ -10,8 +10,10 @@
 #include "temporal/upsample/upsample.h"
 
 #include <gtest/gtest.h>
+#include <tbb/task_arena.h>
 
 #include <cmath>
+#include <cstring>
 #include <cstdio>
 #include <limits>
 #include <random>
@@ -233,5 +235,43 @@ TEST(UpsampleReference, DrobotWavefrontBands) {
     const double d = max_difference(*o, frames);
     std::printf("drobot %dx%d k=%d: max |fast - plain| = %.3g\n", s.W, s.H, s.k, d);
     EXPECT_LE(d, tolerance("drobot")) << s.W << "x" << s.H << ", k = " << s.k;
+  }
+}
+
+TEST(UpsampleReference, ChunksFollowTheThreadCount) {
+  // herzog walks chunks of gradient rows and drobot's cache mode bands of cache rows in parallel, sized by the task
+  // arena's threads (temporal::rows_per_chunk: 64 gradient rows, 32 cache rows, down to 16 where fewer would leave
+  // threads idle). At 40x276, k = 4 (138 gradient rows, 69 cache rows) one thread gets chunks of 64 and bands of 32,
+  // sixteen threads chunks and bands of 16, so other rows fall on the edges and go to the later phases. The output
+  // must be the same bits, and the small bands must still match the plain implementation.
+  const auto frames = random_sequence(40, 276, 4, 8, 276u);
+  const std::vector<std::string> rgb = {"R", "G", "B"};
+  for (const char* method : {"herzog", "drobot"}) {
+    auto o = up::make_options(method, {});
+    ASSERT_TRUE(o.has_value()) << o.error().message;
+    auto run = [&](int threads) {
+      std::vector<Image> out;
+      tbb::task_arena arena(threads);
+      arena.execute([&] {
+        up::Upsampler u(*o);
+        for (const Frame& f : frames) {
+          auto a = u.process(f.gbuffer, f.low, rgb, false);
+          ASSERT_TRUE(a.has_value()) << a.error().message;
+          out.push_back(**a);
+        }
+      });
+      return out;
+    };
+    const std::vector<Image> one = run(1), sixteen = run(16);
+    ASSERT_EQ(one.size(), frames.size());
+    ASSERT_EQ(sixteen.size(), frames.size());
+    for (std::size_t t = 0; t < frames.size(); ++t)
+      for (const auto& c : rgb)
+        EXPECT_EQ(std::memcmp(one[t].plane(c), sixteen[t].plane(c), one[t].pixel_count() * sizeof(float)), 0)
+            << method << " frame " << t << " " << c;
+    double d = 0;
+    tbb::task_arena(16).execute([&] { d = max_difference(*o, frames); });
+    std::printf("%s 40x276 k=4, 16 threads: max |fast - plain| = %.3g\n", method, d);
+    EXPECT_LE(d, tolerance(method)) << method;
   }
 }

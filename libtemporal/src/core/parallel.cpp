@@ -2,6 +2,9 @@
 
 #include <tbb/global_control.h>
 #include <tbb/info.h>
+#include <tbb/task_arena.h>
+
+#include <algorithm>
 
 namespace temporal {
 
@@ -17,6 +20,13 @@ ThreadLimit::~ThreadLimit() = default;
 
 int max_threads() {
   return int(tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism));
+}
+
+int rows_per_chunk(int rows, int preferred, int smallest, int align) {
+  const int threads = std::max(1, std::min(max_threads(), tbb::this_task_arena::max_concurrency()));
+  const int wanted = std::clamp(rows / (2 * threads), std::min(smallest, preferred), preferred);
+  const int a = std::max(1, align);
+  return std::max(a, (wanted + a - 1) / a * a);
 }
 
 }  // namespace temporal

@@ -13,7 +13,9 @@
 #include "temporal/upsample/upsample.h"
 
 #include <benchmark/benchmark.h>
+#include <tbb/task_arena.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -78,17 +80,31 @@ int variant_index(const char* n) {
   return 0;
 }
 
+// UPSAMPLE_BENCH_ARENA=N runs BM_Upsample inside a task arena of N threads: herzog and drobot size their chunks of
+// rows for N threads (temporal::rows_per_chunk), while only the machine's cores run them. On a 2-core machine N = 16
+// shows what the smaller chunks of a 16-core machine cost in work (their extra edge rows), not their parallel speed.
+int bench_arena() {
+  const char* n = std::getenv("UPSAMPLE_BENCH_ARENA");
+  return n ? std::max(0, std::atoi(n)) : 0;
+}
+
 void BM_Upsample(benchmark::State& state) {
   const int m = int(state.range(0));
   const Inputs& in = inputs();
-  up::Upsampler u(options(m));
-  std::size_t t = 0;
-  for (int i = 0; i < 2 * kK * kK; ++i)  // warm the histories and buffers
-    (void)u.process(in.gbuffer, in.low[t++ % in.low.size()], kRGB, false);
-  for (auto _ : state) {
-    auto r = u.process(in.gbuffer, in.low[t++ % in.low.size()], kRGB, false);
-    benchmark::DoNotOptimize(r);
-  }
+  auto body = [&] {
+    up::Upsampler u(options(m));
+    std::size_t t = 0;
+    for (int i = 0; i < 2 * kK * kK; ++i)  // warm the histories and buffers
+      (void)u.process(in.gbuffer, in.low[t++ % in.low.size()], kRGB, false);
+    for (auto _ : state) {
+      auto r = u.process(in.gbuffer, in.low[t++ % in.low.size()], kRGB, false);
+      benchmark::DoNotOptimize(r);
+    }
+  };
+  if (const int n = bench_arena(); n > 0)
+    tbb::task_arena(n).execute(body);
+  else
+    body();
   state.SetLabel(name(m));
   const std::size_t bytes = up::Upsampler::streamed_bytes(options(m), kW, kH, kK, 3);
   state.counters["MB"] = double(bytes) / 1e6;

@@ -26,6 +26,13 @@ class ThreadLimit {
 // Threads a parallel loop may use now.
 int max_threads();
 
+// Rows per chunk for a pass that gives each parallel task a chunk of `rows` rows and pays a fixed cost at every
+// chunk's edges (herzog's boundary rows, drobot's band edges): `preferred` rows, the size that keeps that cost a
+// small share, unless that leaves fewer than two chunks per thread the task arena can run (min of the arena's
+// concurrency and ThreadLimit), then fewer rows, down to `smallest`; rounded up to a multiple of `align`. With
+// 8 chunks of 64 rows, 16 cores would leave half of them idle.
+int rows_per_chunk(int rows, int preferred, int smallest, int align = 1);
+
 // Calls body(y_begin, y_end) for bands of rows in [0, height), in parallel.
 template <typename Body>
 void parallel_rows(int height, Body&& body, int grain_rows = 4) {
