@@ -24,7 +24,7 @@ int max_threads() {
 
 int rows_per_chunk(int rows, int preferred, int smallest, int align) {
   const int threads = std::max(1, std::min(max_threads(), tbb::this_task_arena::max_concurrency()));
-  const int wanted = std::clamp(rows / (2 * threads), std::min(smallest, preferred), preferred);
+  const int wanted = std::clamp((rows + threads - 1) / threads, std::min(smallest, preferred), preferred);
   const int a = std::max(1, align);
   return std::max(a, (wanted + a - 1) / a * a);
 }
