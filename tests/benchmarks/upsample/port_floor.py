@@ -1,0 +1,273 @@
+#!/usr/bin/env python3
+"""Execution-port floor of an upsampling method: the cycles per pixel its instructions need on one core if every
+execution unit were busy every cycle, from what ran (callgrind, per instruction) and what each instruction occupies
+(llvm-mca's scheduling model of the CPU, per instruction).
+
+Why: issue 27 asks for speed ratios (herzog at most 2.5x spatial, drobot at most 4x its streaming bound) on the
+build machine, and where the arithmetic sets the floor, for the count instead of the claim. Instruction counts
+alone do not say that: an instruction that needs the floating-point multiply pipes (two on Zen 3: FP0, FP1) costs
+more than one that any of four vector pipes runs. This tool turns callgrind's exact count of every executed
+instruction into the busy cycles of each group of units, per function, and reports the largest (the function's
+floor: no schedule runs it faster) next to the instructions. Deterministic: the same binary gives the same numbers
+on any host, so a code change shows its effect without timing noise.
+
+What the floor leaves out (so measured time is above it): dependency chains (latency), memory and cache misses,
+branch misses, the front end. llvm-mca is a model; its Zen 3 tables are AMD's and LLVM's, not measurements here.
+
+Usage (a release build of upsample_benchmark, the `ci` preset):
+  tests/benchmarks/upsample/port_floor.py build/ci/tests/benchmarks/upsample/upsample_benchmark herzog
+  tests/benchmarks/upsample/port_floor.py BENCH spatial herzog drobot taau --scale 1 --cpu znver3 --isa v3
+Needs valgrind, binutils' objdump and llvm-mca (Debian: apt-get install valgrind binutils llvm); c++filt is not
+needed (callgrind demangles). Each method is one valgrind run of BM_PerPixel (one thread) with
+UPSAMPLE_BENCH_ITERATIONS=1 and =3 (the difference: two frames after 32 warm-up frames); at --scale 1 (1280x1024)
+about two minutes per run, four per method; at --scale 4 seconds.
+"""
+import argparse
+import collections
+import os
+import re
+import shutil
+import subprocess
+import sys
+import tempfile
+
+# Groups of identical units in llvm-mca's resource names (AMD Zen 3: Zn3FPP0 ...; the same idea for other models):
+# the busy cycles of a group are its units' summed pressure divided by the number of units.
+GROUPS = [
+    ("FP mul/FMA/cmp (FP0, FP1)", re.compile(r"FPP?[01]$")),
+    ("FP add (FP2, FP3)", re.compile(r"FPP?[23]$")),
+    ("FP store/convert (FP45)", re.compile(r"FPP?45")),
+    ("loads", re.compile(r"Load")),
+    ("stores", re.compile(r"Store$")),
+    ("integer ALU", re.compile(r"ALU\d")),
+    ("address (AGU)", re.compile(r"AGU\d")),
+]
+DISPATCH_WIDTH = {"znver3": 6, "znver2": 5, "znver4": 6, "skylake": 4, "icelake-server": 5, "sapphirerapids": 6}
+# Instructions llvm-mca cannot schedule on their own (control flow, prefixes): counted as instructions, no units.
+UNSCHEDULED = ("j", "call", "ret", "nop", "endbr", "ud2", "int3", "lock", "rep", "bnd", "notrack", "cs ", "ds ",
+               "data16", "xchg", "cmpxchg", "pause", "leave", "syscall")
+
+# The benchmark's sizes (upsample_benchmark.cpp): full size, and a quarter per axis.
+SIZE = {1: (1280, 1024), 4: (320, 256)}
+# Method table indices of BM_PerPixel's methods (upsample_benchmark --benchmark_list_tests shows them).
+
+
+def run(cmd, **kw):
+    return subprocess.run(cmd, check=True, capture_output=True, text=True, **kw).stdout
+
+
+def method_index(bench, name):
+    # BM_PerPixel/<index>/<scale>: the label of each printed line names the method; list and match by a dry run.
+    out = run([bench, "--benchmark_list_tests"])
+    ids = sorted({int(m.group(1)) for m in re.finditer(r"^BM_PerPixel/(\d+)/", out, re.M)})
+    for i in ids:
+        env = dict(os.environ, UPSAMPLE_BENCH_ITERATIONS="1")
+        o = run([bench, f"--benchmark_filter=BM_PerPixel/{i}/4/"], env=env)
+        if re.search(rf"per_pixel=\S+\s+{re.escape(name)} ", o):
+            return i
+    sys.exit(f"port_floor: {bench}: no BM_PerPixel entry for method '{name}' (BM_PerPixel runs spatial, temporal, "
+             "herzog, drobot, taau)")
+
+
+def normalise(fn):
+    # Function names without argument lists and clone suffixes, so that one function's parts group together.
+    prev = None
+    while prev != fn:
+        prev = fn
+        fn = re.sub(r"\([^()]*\)", "", fn)
+    return re.sub(r"\s*\[clone[^\]]*\]", "", fn).replace(" const", "").strip()
+
+
+def read_callgrind(path, binary):
+    """Per function of `binary`: {address: executed count}; the call graph; calls of Upsampler::process."""
+    counts = collections.defaultdict(collections.Counter)
+    callees = collections.defaultdict(set)
+    ob = fn = cfn = None
+    after_calls = False
+    process_calls = 0
+    real = os.path.realpath(binary)
+    with open(path) as f:
+        for line in f:
+            if line.startswith("ob="):
+                ob = os.path.realpath(line[3:].strip())
+            elif line.startswith("fn="):
+                fn = normalise(line[3:].strip())
+            elif line.startswith("cfn="):
+                cfn = normalise(line[4:].strip())
+            elif line.startswith("calls="):
+                after_calls = True
+                callees[fn].add(cfn)
+                if cfn.endswith("Upsampler::process") and not fn.endswith("Upsampler::process"):
+                    process_calls += int(line[6:].split()[0])
+            elif line.startswith("0x"):
+                if after_calls:  # the line after calls= is the call's inclusive cost, not an instruction
+                    after_calls = False
+                    continue
+                if ob != real:
+                    continue
+                addr, _, count = line.split()
+                counts[fn][int(addr, 16)] += int(count)
+    return counts, callees, process_calls
+
+
+def reachable(callees, root_suffix):
+    roots = [f for f in callees if f.endswith(root_suffix)]
+    seen, todo = set(roots), list(roots)
+    while todo:
+        for c in callees.get(todo.pop(), ()):
+            if c not in seen:
+                seen.add(c)
+                todo.append(c)
+    return seen
+
+
+def disassemble(binary):
+    text = {}
+    for line in run(["objdump", "-d", "--no-show-raw-insn", binary]).splitlines():
+        m = re.match(r"\s+([0-9a-f]+):\t(.*)", line)
+        if m:
+            text[int(m.group(1), 16)] = m.group(2).split("#")[0].split("<")[0].strip()
+    return text
+
+
+def unit_pressure(instructions, cpu):
+    """{instruction text: {group: busy cycles}} from one llvm-mca run over every distinct instruction."""
+    texts = sorted(instructions)
+    sched = [t for t in texts if not t.startswith(UNSCHEDULED)]
+    # An instruction llvm-mca does not parse stops the whole run: drop the lines it names and run again.
+    while True:
+        with tempfile.NamedTemporaryFile("w", suffix=".s", delete=False) as f:
+            f.write("\n".join(sched) + "\n")
+            src = f.name
+        try:
+            r = subprocess.run(["llvm-mca", f"-mcpu={cpu}", "-iterations=1", "-resource-pressure", "-timeline=false",
+                                "-instruction-info=false", src], capture_output=True, text=True)
+        finally:
+            os.unlink(src)
+        bad = {int(m.group(1)) - 1 for m in re.finditer(r"\.s:(\d+):\d+: error", r.stderr)}
+        if r.returncode == 0 and not bad:
+            out = r.stdout
+            break
+        if not bad:
+            sys.exit(f"port_floor: llvm-mca failed: {r.stderr.strip()[:400]}")
+        sched = [t for i, t in enumerate(sched) if i not in bad]
+    names = {m.group(1): m.group(2) for m in re.finditer(r"^\[([\d.]+)\]\s+-\s+(\S+)", out, re.M)}
+    table = out.split("Resource pressure by instruction:")[1].splitlines()
+    cols = re.findall(r"\[([\d.]+)\]", table[1])
+    col_group = []
+    for c in cols:
+        unit = names.get(c, c)
+        col_group.append(next((g for g, rx in GROUPS if rx.search(unit)), None))
+    units_per_group = collections.Counter(g for g in col_group if g)
+    rows = [l for l in table[2:] if l.strip()]
+    if len(rows) != len(sched):
+        sys.exit(f"port_floor: llvm-mca listed {len(rows)} instructions for {len(sched)}: its output format changed?")
+    pressure = {t: {} for t in texts}
+    for t, row in zip(sched, rows):
+        vals = row.split()[: len(cols)]
+        p = collections.Counter()
+        for g, v in zip(col_group, vals):
+            if g and v != "-":
+                p[g] += float(v) / units_per_group[g]
+        pressure[t] = p
+    return pressure
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("benchmark", help="path of upsample_benchmark (a release build)")
+    ap.add_argument("methods", nargs="+", help="spatial, temporal, herzog, drobot, taau")
+    ap.add_argument("--scale", type=int, choices=(1, 4), default=1, help="1: 1280x1024 (default), 4: 320x256")
+    ap.add_argument("--cpu", default="znver3", help="llvm-mca -mcpu (default znver3, the build VM's Zen 3)")
+    ap.add_argument("--isa", default="v3", help="TEMPORAL_ISA of the run (default v3: AVX2/FMA)")
+    ap.add_argument("--top", type=int, default=8, help="functions listed per method")
+    ap.add_argument("--keep", help="folder for the callgrind files (default: a temporary folder)")
+    a = ap.parse_args()
+    for tool in ("valgrind", "objdump", "llvm-mca"):
+        if not shutil.which(tool):
+            sys.exit(f"port_floor: {tool} not found: install it (Debian: apt-get install valgrind binutils llvm)")
+    bench = os.path.realpath(a.benchmark)
+    if not os.access(bench, os.X_OK):
+        sys.exit(f"port_floor: {a.benchmark}: not an executable: build the `ci` preset's upsample_benchmark first")
+    text = disassemble(bench)
+    width = DISPATCH_WIDTH.get(a.cpu, 6)
+    folder = a.keep or tempfile.mkdtemp(prefix="port_floor_")
+    os.makedirs(folder, exist_ok=True)
+    summary = []
+    for name in a.methods:
+        idx = method_index(bench, name)
+        # Two runs, 1 and 3 timed frames after the same 32 warm-up frames: the difference is two frames in the
+        # steady state, without the set-up (the inputs, the state's first allocation) that both runs share.
+        runs = []
+        for n in (1, 3):
+            out = os.path.join(folder, f"callgrind.{name}.{a.scale}.{n}")
+            env = dict(os.environ, UPSAMPLE_BENCH_ITERATIONS=str(n), TEMPORAL_ISA=a.isa)
+            subprocess.run(["valgrind", "--tool=callgrind", "--dump-instr=yes", "--compress-strings=no",
+                            "--compress-pos=no", f"--callgrind-out-file={out}", bench,
+                            f"--benchmark_filter=BM_PerPixel/{idx}/{a.scale}/"], env=env, check=True,
+                           stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+            runs.append(read_callgrind(out, bench))
+        (c1, _, n1), (c3, callees, n3) = runs
+        calls = n3 - n1
+        if calls <= 0:
+            sys.exit(f"port_floor: {folder}: no call of Upsampler::process recorded")
+        counts = {}
+        for f, d in c3.items():
+            diff = {x: c - c1.get(f, {}).get(x, 0) for x, c in d.items()}
+            counts[f] = {x: c for x, c in diff.items() if c > 0}
+        w, h = SIZE[a.scale]
+        pixels = float(calls) * w * h
+        inside = reachable(callees, "Upsampler::process")
+        pressure = unit_pressure({text.get(x, "nop") for f in inside for x in counts.get(f, {})}, a.cpu)
+        rows = []
+        total = collections.Counter()
+        unmapped = 0
+        for f in inside:
+            if f not in counts:
+                continue
+            busy = collections.Counter()
+            n = 0
+            for addr, c in counts[f].items():
+                n += c
+                t = text.get(addr)
+                if t is None:
+                    unmapped += c
+                    continue
+                for g, v in pressure[t].items():
+                    busy[g] += c * v
+            busy["dispatch"] = n / width
+            g, floor = max(busy.items(), key=lambda kv: kv[1])
+            rows.append((floor / pixels, n / pixels, g, f))
+            total["floor"] += floor
+            total["instructions"] += n
+            for k, v in busy.items():
+                total[k] += v
+        if unmapped > 0.01 * total["instructions"]:
+            print(f"port_floor: warning: {unmapped / total['instructions']:.1%} of the instructions are not in "
+                  f"{bench}'s disassembly (another build?)", file=sys.stderr)
+        rows.sort(reverse=True)
+        # The instruction-set copies that ran (temporal/core/isa.h: namespaces v2, v3, v4): TEMPORAL_ISA=v4 on a CPU
+        # without AVX-512 runs v3.
+        copies = sorted({m.group(1) for f in inside if f in counts for m in re.finditer(r"::(v[234])::", f)})
+        print(f"\n{name}: {calls} frames of {w}x{h} (steady state), TEMPORAL_ISA={a.isa} (copies run: "
+              f"{', '.join(copies) or 'none'}), llvm-mca -mcpu={a.cpu}")
+        print(f"  {'cycles/px':>9} {'instr/px':>8}  {'bound by':<26} function")
+        for floor, n, g, f in rows[: a.top]:
+            print(f"  {floor:9.2f} {n:8.2f}  {g:<26} {f[-90:]}")
+        print(f"  {total['floor'] / pixels:9.2f} {total['instructions'] / pixels:8.2f}  (sum over the functions "
+              f"inside Upsampler::process, each at its own floor)")
+        groups = "; ".join(f"{g} {total[g] / pixels:.2f}" for g, _ in GROUPS)
+        print(f"  busy cycles per pixel by unit group: {groups}; dispatch {total['dispatch'] / pixels:.2f}")
+        summary.append((name, total["floor"] / pixels, total["instructions"] / pixels))
+    if len(summary) > 1:
+        base = summary[0]
+        print(f"\nagainst {base[0]}:")
+        for name, fl, n in summary:
+            print(f"  {name:<8} floor {fl:6.2f} cycles/px ({fl / base[1]:.2f}x), {n:6.2f} instructions/px "
+                  f"({n / base[2]:.2f}x)")
+    if not a.keep:
+        shutil.rmtree(folder, ignore_errors=True)
+
+
+if __name__ == "__main__":
+    main()
