@@ -131,20 +131,24 @@ def disassemble(binary):
 
 
 def unit_pressure(instructions, cpu):
-    """{instruction text: {group: busy cycles}} from one llvm-mca run over every distinct instruction."""
+    """{instruction text: {group: busy cycles}}: each distinct instruction in a code region of its own, repeated
+    (llvm-mca -iterations), so that its cycles spread over every unit that can run it. (One region over all of
+    them would give each instruction the units left free by its neighbours in the list: a number that depends on
+    which other instructions the method happens to contain.)"""
     texts = sorted(instructions)
     sched = [t for t in texts if not t.startswith(UNSCHEDULED)]
     # An instruction llvm-mca does not parse stops the whole run: drop the lines it names and run again.
     while True:
         with tempfile.NamedTemporaryFile("w", suffix=".s", delete=False) as f:
-            f.write("\n".join(sched) + "\n")
+            for t in sched:  # instruction i on line 3 i + 2
+                f.write(f"# LLVM-MCA-BEGIN\n{t}\n# LLVM-MCA-END\n")
             src = f.name
         try:
-            r = subprocess.run(["llvm-mca", f"-mcpu={cpu}", "-iterations=1", "-resource-pressure", "-timeline=false",
+            r = subprocess.run(["llvm-mca", f"-mcpu={cpu}", "-iterations=100", "-resource-pressure", "-timeline=false",
                                 "-instruction-info=false", src], capture_output=True, text=True)
         finally:
             os.unlink(src)
-        bad = {int(m.group(1)) - 1 for m in re.finditer(r"\.s:(\d+):\d+: error", r.stderr)}
+        bad = {(int(m.group(1)) - 2) // 3 for m in re.finditer(r"\.s:(\d+):\d+: error", r.stderr)}
         if r.returncode == 0 and not bad:
             out = r.stdout
             break
@@ -152,21 +156,17 @@ def unit_pressure(instructions, cpu):
             sys.exit(f"port_floor: llvm-mca failed: {r.stderr.strip()[:400]}")
         sched = [t for i, t in enumerate(sched) if i not in bad]
     names = {m.group(1): m.group(2) for m in re.finditer(r"^\[([\d.]+)\]\s+-\s+(\S+)", out, re.M)}
-    table = out.split("Resource pressure by instruction:")[1].splitlines()
-    cols = re.findall(r"\[([\d.]+)\]", table[1])
-    col_group = []
-    for c in cols:
-        unit = names.get(c, c)
-        col_group.append(next((g for g, rx in GROUPS if rx.search(unit)), None))
+    tables = out.split("Resource pressure by instruction:")[1:]
+    if len(tables) != len(sched):
+        sys.exit(f"port_floor: llvm-mca reported {len(tables)} regions for {len(sched)}: its output format changed?")
+    cols = re.findall(r"\[([\d.]+)\]", tables[0].splitlines()[1])
+    col_group = [next((g for g, rx in GROUPS if rx.search(names.get(c, c))), None) for c in cols]
     units_per_group = collections.Counter(g for g in col_group if g)
-    rows = [l for l in table[2:] if l.strip()]
-    if len(rows) != len(sched):
-        sys.exit(f"port_floor: llvm-mca listed {len(rows)} instructions for {len(sched)}: its output format changed?")
     pressure = {t: {} for t in texts}
-    for t, row in zip(sched, rows):
-        vals = row.split()[: len(cols)]
+    for t, table in zip(sched, tables):
+        row = [l for l in table.splitlines()[2:] if l.strip()][0]
         p = collections.Counter()
-        for g, v in zip(col_group, vals):
+        for g, v in zip(col_group, row.split()[: len(cols)]):
             if g and v != "-":
                 p[g] += float(v) / units_per_group[g]
         pressure[t] = p
@@ -182,6 +182,9 @@ def main():
     ap.add_argument("--isa", default="v3", help="TEMPORAL_ISA of the run (default v3: AVX2/FMA)")
     ap.add_argument("--top", type=int, default=8, help="functions listed per method")
     ap.add_argument("--keep", help="folder for the callgrind files (default: a temporary folder)")
+    ap.add_argument("--reuse", action="store_true",
+                    help="read the callgrind files a run with the same --keep folder left there instead of running "
+                         "valgrind again (another --cpu model over the same counts)")
     a = ap.parse_args()
     for tool in ("valgrind", "objdump", "llvm-mca"):
         if not shutil.which(tool):
@@ -191,16 +194,23 @@ def main():
         sys.exit(f"port_floor: {a.benchmark}: not an executable: build the `ci` preset's upsample_benchmark first")
     text = disassemble(bench)
     width = DISPATCH_WIDTH.get(a.cpu, 6)
+    if a.reuse and not a.keep:
+        sys.exit("port_floor: --reuse needs --keep FOLDER (where the callgrind files are)")
     folder = a.keep or tempfile.mkdtemp(prefix="port_floor_")
     os.makedirs(folder, exist_ok=True)
     summary = []
     for name in a.methods:
-        idx = method_index(bench, name)
+        idx = None if a.reuse else method_index(bench, name)
         # Two runs, 1 and 3 timed frames after the same 32 warm-up frames: the difference is two frames in the
         # steady state, without the set-up (the inputs, the state's first allocation) that both runs share.
         runs = []
         for n in (1, 3):
             out = os.path.join(folder, f"callgrind.{name}.{a.scale}.{n}")
+            if a.reuse:
+                if not os.path.isfile(out):
+                    sys.exit(f"port_floor: {out}: not found: run once with --keep {folder} and without --reuse")
+                runs.append(read_callgrind(out, bench))
+                continue
             env = dict(os.environ, UPSAMPLE_BENCH_ITERATIONS=str(n), TEMPORAL_ISA=a.isa)
             subprocess.run(["valgrind", "--tool=callgrind", "--dump-instr=yes", "--compress-strings=no",
                             "--compress-pos=no", f"--callgrind-out-file={out}", bench,
