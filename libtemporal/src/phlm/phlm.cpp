@@ -65,25 +65,8 @@ struct FrameScratch {
 // bilinear model fetch, the RLS update and the predictions into FMAs (v2 has none): v2's outputs and states
 // differ from theirs in the last bits, amplified by the RLS over frames (tests/core/isa_test.cpp bounds it). v3 and
 // v4 run the same 8-lane vector code and give the same bits.
-// phlm_kernels.inc runs Algorithm 1 for kLanes pixels at once, one per vector lane: one SSE vector in the v2
-// copy, one AVX vector in v3 and v4 (v4 stays at 256 bits: phlm_kernels.inc says why). The kernel reads its copy's
-// value by unqualified lookup (a `#pragma GCC target` region does not define __AVX__ for the code in it).
-namespace v2 {
-[[maybe_unused]] constexpr int kLanes = 4;
-}
-namespace v3 {
-[[maybe_unused]] constexpr int kLanes = 8;
-}
-namespace v4 {
-[[maybe_unused]] constexpr int kLanes = 8;
-}
-namespace native {
-#ifdef __AVX__
-[[maybe_unused]] constexpr int kLanes = 8;
-#else
-[[maybe_unused]] constexpr int kLanes = 4;
-#endif
-}  // namespace native
+// phlm_kernels.inc runs Algorithm 1 for kLanes pixels at once, one per vector lane (lanes.inc: one SSE vector in
+// the v2 copy, one AVX vector in v3 and v4; v4 stays at 256 bits: phlm_kernels.inc says why).
 #define TEMPORAL_ISA_FILE "phlm_kernels.inc"
 #include "temporal/core/isa_copies.inc"
 

@@ -11,8 +11,10 @@
 
 #include <benchmark/benchmark.h>
 
+#include <cstdlib>
 #include <cstring>
 #include <random>
+#include <string>
 #include <vector>
 
 namespace {
@@ -119,15 +121,27 @@ void BM_PhlmStateStreamBound(benchmark::State& state) {
 
 // Args: motion (1: a G-buffer with fractional motion, bilinear / Catmull-Rom history fetches; 0: static
 // scene), threads (0: every core; 1: one thread, whose time is meaningful on a loaded machine).
-BENCHMARK(BM_Phlm)->ArgNames({"motion", "threads"})->Args({1, 0})->Args({0, 0})->Args({1, 1})
-    ->Unit(benchmark::kMillisecond)->UseRealTime();
-BENCHMARK(BM_PhlmCatmullRom)->ArgNames({"motion", "threads"})->Args({1, 0})->Args({1, 1})
-    ->Unit(benchmark::kMillisecond)->UseRealTime();
-BENCHMARK(BM_Taa)->ArgNames({"motion", "threads"})->Args({1, 0})->Args({0, 0})->Args({1, 1})
-    ->Unit(benchmark::kMillisecond)->UseRealTime();
-BENCHMARK(BM_Taa2014)->ArgNames({"motion", "threads"})->Args({1, 0})->Args({1, 1})
-    ->Unit(benchmark::kMillisecond)->UseRealTime();
-BENCHMARK(BM_Ema)->ArgNames({"motion", "threads"})->Args({1, 0})->Args({1, 1})->Unit(benchmark::kMillisecond)->UseRealTime();
-BENCHMARK(BM_Fxaa)->ArgNames({"threads"})->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->UseRealTime();
-BENCHMARK(BM_PhlmStateStreamBound)->ArgNames({"threads"})->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->UseRealTime();
-BENCHMARK_MAIN();
+// PHLM_BENCH_ITERATIONS=N fixes every benchmark's iteration count: tests/benchmarks/port_floor.py runs a filter
+// under callgrind with two counts and takes the difference (frames in the steady state, without the set-up).
+int main(int argc, char** argv) {
+  const char* fixed = std::getenv("PHLM_BENCH_ITERATIONS");
+  const benchmark::IterationCount n = fixed ? std::atoll(fixed) : 0;
+  auto ms = [&](benchmark::internal::Benchmark* b) {
+    b->Unit(benchmark::kMillisecond)->UseRealTime();
+    if (n > 0) b->Iterations(n);
+    return b;
+  };
+  const std::vector<std::string> motion_threads = {"motion", "threads"};
+  ms(benchmark::RegisterBenchmark("BM_Phlm", BM_Phlm))->ArgNames(motion_threads)->Args({1, 0})->Args({0, 0})->Args({1, 1});
+  ms(benchmark::RegisterBenchmark("BM_PhlmCatmullRom", BM_PhlmCatmullRom))->ArgNames(motion_threads)->Args({1, 0})->Args({1, 1});
+  ms(benchmark::RegisterBenchmark("BM_Taa", BM_Taa))->ArgNames(motion_threads)->Args({1, 0})->Args({0, 0})->Args({1, 1});
+  ms(benchmark::RegisterBenchmark("BM_Taa2014", BM_Taa2014))->ArgNames(motion_threads)->Args({1, 0})->Args({1, 1});
+  ms(benchmark::RegisterBenchmark("BM_Ema", BM_Ema))->ArgNames(motion_threads)->Args({1, 0})->Args({1, 1});
+  ms(benchmark::RegisterBenchmark("BM_Fxaa", BM_Fxaa))->ArgNames({"threads"})->Arg(0)->Arg(1);
+  ms(benchmark::RegisterBenchmark("BM_PhlmStateStreamBound", BM_PhlmStateStreamBound))->ArgNames({"threads"})->Arg(0)->Arg(1);
+  benchmark::Initialize(&argc, argv);
+  if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
+  benchmark::RunSpecifiedBenchmarks();
+  benchmark::Shutdown();
+  return 0;
+}

@@ -107,8 +107,73 @@ class ReadCallgrind(unittest.TestCase):
 class Normalise(unittest.TestCase):
     def test_arguments_clones_and_const_go(self):
         self.assertEqual(port_floor.normalise("a::f(int, float const*) const [clone .constprop.0]"), "a::f")
-        self.assertEqual(port_floor.normalise("void a::g<8>(int (*)(int), std::span<float const>)"), "void a::g<8>")
         self.assertEqual(port_floor.normalise("a::(anonymous namespace)::v3::h(int)"), "a::::v3::h")
+
+    def test_return_types_go(self):
+        # callgrind names template instances with their return type; perf does too, but not every function.
+        self.assertEqual(port_floor.normalise("void a::g<8>(int (*)(int), std::span<float const>)"), "a::g<8>")
+        self.assertEqual(port_floor.normalise("int r::run<true, true, 4, true>(float const*, int)"),
+                         "r::run<true, true, 4, true>")
+        self.assertEqual(port_floor.normalise("unsigned long a::n()"), "a::n")
+        self.assertEqual(port_floor.normalise("a::f::{lambda(int, int)#1}::operator()(int, int) const"),
+                         "a::f::{lambda#1}::operator")
+
+
+# `perf report --no-children --stdio --sort sym` of a one-thread run: two functions inside the method (one listed
+# twice, under two clones), set-up outside it, a kernel line.
+PERF_REPORT = """# Samples: 1K of event 'cpu-clock'
+#
+# Overhead  Symbol
+# ........  ......
+#
+    50.00%  [.] int temporal::upsample::(anonymous namespace)::v3::kernel_row(int, float const*)
+    10.00%  [.] temporal::upsample::(anonymous namespace)::v3::kernel_row(int, float const*) [clone .isra.0]
+    20.00%  [.] temporal::upsample::Upsampler::process(temporal::Image const&, temporal::Image const&, bool)
+    15.00%  [.] temporal::test::make_frame(temporal::test::SyntheticScene const&, int)
+     5.00%  [k] clear_page_erms
+"""
+
+
+class PerfJoin(unittest.TestCase):
+    def test_shares_by_normalised_name_without_the_kernel(self):
+        shares = port_floor.read_perf_report(PERF_REPORT)
+        self.assertAlmostEqual(shares["temporal::upsample::::v3::kernel_row"], 60.0)
+        self.assertAlmostEqual(shares["temporal::upsample::Upsampler::process"], 20.0)
+        self.assertNotIn("clear_page_erms", shares)
+        self.assertAlmostEqual(sum(shares.values()), 95.0)
+
+    def test_measured_time_split_over_the_functions_inside(self):
+        inside = {"temporal::upsample::::v3::kernel_row", "temporal::upsample::Upsampler::process"}
+        times, coverage = port_floor.function_times(port_floor.read_perf_report(PERF_REPORT), inside, 8.0)
+        # 60 and 20 of the 80 % inside: 3/4 and 1/4 of 8 ns; the set-up (15 %) is not the method's time.
+        self.assertAlmostEqual(times["temporal::upsample::::v3::kernel_row"], 6.0)
+        self.assertAlmostEqual(times["temporal::upsample::Upsampler::process"], 2.0)
+        self.assertNotIn("temporal::test::make_frame", times)
+        self.assertAlmostEqual(coverage, 80.0 / 95.0)
+
+    def test_median_time_per_pixel_from_the_benchmark_json(self):
+        doc = """{"benchmarks": [
+          {"name": "BM_PerPixel/2/1/real_time", "run_type": "iteration", "real_time": 9.0, "time_unit": "ms"},
+          {"name": "BM_PerPixel/2/1/real_time_mean", "run_type": "aggregate", "aggregate_name": "mean",
+           "real_time": 8.0, "time_unit": "ms"},
+          {"name": "BM_PerPixel/2/1/real_time_median", "run_type": "aggregate", "aggregate_name": "median",
+           "real_time": 6.5536, "time_unit": "ms"}]}"""
+        self.assertAlmostEqual(port_floor.median_ns_per_pixel(doc, 1280 * 1024), 5.0)
+
+
+class Frames(unittest.TestCase):
+    def test_calls_of_another_root(self):
+        # phlm_bench's frames are calls of PhlmFilter::process: none in the upsampling file.
+        fd, path = tempfile.mkstemp(suffix=".callgrind")
+        with os.fdopen(fd, "w") as f:
+            f.write(CALLGRIND.replace("temporal::upsample::Upsampler::process", "temporal::phlm::PhlmFilter::process"))
+        try:
+            _, callees, calls = port_floor.read_callgrind(path, BINARY, "PhlmFilter::process")
+            self.assertEqual(calls, 2)
+            self.assertEqual(port_floor.read_callgrind(path, BINARY)[2], 0)
+            self.assertIn("temporal::upsample::::v3::kernel_row", port_floor.reachable(callees, "PhlmFilter::process"))
+        finally:
+            os.unlink(path)
 
 
 if __name__ == "__main__":
