@@ -22,7 +22,7 @@ std::vector<test::SyntheticFrame> sequence(int n) { return test::upsample_gpu_se
 // Options with herzog's own options set by `set`.
 Options options_with(const std::function<void(HerzogOptions&)>& set) { return test::options_with("herzog", set); }
 
-// The arithmetic that can differ (herzog_gpu.cpp's file comment): the weights' and fast_exp2's multiply-adds, which
+// The arithmetic that can differ (herzog_gpu.cpp's file comment): the weights' and kernel_exp2's multiply-adds, which
 // the driver and GCC (-march=native) may contract into FMAs differently, and eq. 7's and the luminance's sums: a few
 // float ulps of a weight, normalised away in eq. 6 and eq. 7, and damped by the history (eq. 7 is a convex
 // combination, so a difference never grows from frame to frame). Every decision (hit, the gradient cell, a sample's

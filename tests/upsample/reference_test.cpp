@@ -1,7 +1,7 @@
 // Every method and named variant of the stage's table against its plain implementation (reference.h: the header
 // formulas, one pixel at a time) on small random sequences: random geometry with depth edges and material ids,
 // aligned (integer) and random (fractional, gathered) motion, NaN samples and motion, a camera cut, factors 4 and 3
-// (odd width). The fast kernels round differently (fast_exp2 for the kernel powers, reordered sums, FMA), so the
+// (odd width). The fast kernels round differently (polynomial kernel powers, reordered sums, FMA), so the
 // comparison has explicit tolerances; it passes on any CPU, unlike a bit-exact golden file.
 #include "reference.h"
 #include "synthetic.h"
@@ -125,7 +125,7 @@ double max_difference(const up::Options& o, const std::vector<Frame>& frames) {
 }
 
 // Payload values are in [0, 1]. The fast kernels differ from the plain loops by float rounding only: reordered
-// sums and products, FMA, fast_exp2 for herzog's kernel powers (relative error < 2e-6), pow(dot, 32) by squaring and
+// sums and products, FMA, kernel_exp2 for herzog's kernel powers (relative error < 2e-7), pow(dot, 32) by squaring and
 // a division instead of a reciprocal in drobot's Listing 7.1. Measured on this project's AVX-512 machine (GCC 12,
 // -march=native): at most 3.6e-7 for spatial, temporal and herzog, 3.4e-6 for taau (its Lanczos-2 sums cancel
 // between the negative lobes), and 5.2e-6 for drobot, whose Listing 7.2

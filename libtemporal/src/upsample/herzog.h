@@ -13,6 +13,13 @@
 
 namespace temporal::upsample {
 
+// The coefficients of q in the adaptive image kernel's 2^f = 1 + f q(f) on [0, 1), highest degree first: the
+// degree-4 q whose largest relative error over [0, 1) is smallest with the constant term of 2^f held at 1 (Remez
+// exchange; 1.6e-7 measured over the float inputs, herzog_impl.inc's kernel_exp2). The C++ kernels and the GLSL one
+// (herzog_gpu.cpp) evaluate it with the same multiply-adds.
+inline constexpr float kKernelExp2[5] = {0.0018671300724412605f, 0.009017030315885468f, 0.05579991310967993f,
+                                         0.24016445015286791f, 0.6931513118048799f};
+
 // herzog's parameters (seed 000 sections 3.3-3.5; the choices are in docs/upsample-st.md).
 struct HerzogOptions {
   float kernel_gamma = kMaxKernelGamma;      // gamma of k; 4 so that w_f = 1 reaches the cap

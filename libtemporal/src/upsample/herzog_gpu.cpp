@@ -4,7 +4,7 @@
 // device resumes on the other.
 //  A (full resolution): the kernel fall-off from the previous w_f at the motion-compensated cell, h~ and w~ of
 //    eq. 6 with the adaptive image kernel and w~' with the sharp one (the same host-computed tables as
-//    build_kernel_tables, and the same fast_exp2), the history fetch h_r, h_w through the shared GLSL reprojection,
+//    build_kernel_tables, and the same kernel_exp2), the history fetch h_r, h_w through the shared GLSL reprojection,
 //    the relative gradient of the luminance (section 3.5.1; the maximum where disoccluded, Figure 6).
 //  B (gradient grid): the average of A's gradients per cell, the temporal filter |(0.4, 0.3, 0.2, 0.1) . g| with
 //    the three previous gradients fetched at the cell centre's motion (written `precise`: herzog.cpp compiles it
@@ -14,7 +14,7 @@
 // herzog.cpp runs the same passes row by row in one sweep (its schedule only changes the order rows are computed
 // in); here each pass is a dispatch over the whole image, the results between them in scratch planes.
 // What can differ from the C++: where the driver and GCC (-march=native) contract a * b + c into an FMA
-// differently (the weights, the Horner polynomial of fast_exp2, eq. 7's sums), a few float ulps of a weight; every
+// differently (the weights, the Horner polynomial of kernel_exp2, eq. 7's sums), a few float ulps of a weight; every
 // decision (history hit, the cell a motion vector lands in) is the same. Bounds: docs/gpu.md.
 #include "gpu_methods.h"
 #include "herzog.h"
@@ -31,13 +31,14 @@
 namespace temporal::upsample {
 namespace {
 
-// The constants of herzog.cpp and upsample_internal.h's fast_exp2, printed exactly (%.9g round-trips a float).
+// The constants of herzog.cpp and of the kernel power's polynomial (kKernelExp2), printed exactly (%.9g
+// round-trips a float).
 std::string constants() {
   const auto line = gpu::glsl::float_constant;  // "const float NAME = VALUE;", the float exactly
   return line("kMaxGradient", kMaxGradient) + line("kG0", kGradientWeights[0]) + line("kG1", kGradientWeights[1]) +
-         line("kG2", kGradientWeights[2]) + line("kG3", kGradientWeights[3]) + line("kLn2", 0.69314718056f) +
-         line("kInv6", 1.0f / 6) + line("kInv24", 1.0f / 24) + line("kInv120", 1.0f / 120) +
-         line("kInv720", 1.0f / 720) + line("kInv5040", 1.0f / 5040);
+         line("kG2", kGradientWeights[2]) + line("kG3", kGradientWeights[3]) + line("kQ0", kKernelExp2[0]) +
+         line("kQ1", kKernelExp2[1]) + line("kQ2", kKernelExp2[2]) + line("kQ3", kKernelExp2[3]) +
+         line("kQ4", kKernelExp2[4]);
 }
 
 // Buffers of pass A: gb (0) and lowb (1) as GpuFrame; outb (2) this frame's output (C planes of h~, then eq. 7's h
@@ -63,17 +64,17 @@ uniform float u_luma[16];
 )";
 
 constexpr const char* kPassAMain = R"(
-// fast_exp2 of upsample_internal.h, bit for bit in its steps: the clamp to [-126, 0] on the bits, floor_vec, the
-// degree-7 Taylor polynomial of e^(f ln 2), the exponent built in the bits.
-float fast_exp2(float x) {
+// kernel_exp2 of herzog_impl.inc in its steps: the clamp to [-126, 0] on the bits, floor, 1 + f q(f) (kKernelExp2,
+// Horner's rule; the driver may fuse the multiply-adds as the v3 and v4 copies do), the exponent built in the bits.
+float kernel_exp2(float x) {
   uint u = floatBitsToUint(x);
   u &= uint(int(u) >> 31);
   u = u < 0xC2FC0000u ? u : 0xC2FC0000u;
   x = uintBitsToFloat(u);
   const float t = float(int(x));
   const float xi = t > x ? t - 1.0 : t;
-  const float f = (x - xi) * kLn2;
-  const float p = 1.0 + f * (1.0 + f * (0.5 + f * (kInv6 + f * (kInv24 + f * (kInv120 + f * (kInv720 + f * kInv5040))))));
+  const float f = x - xi;
+  const float p = 1.0 + f * (kQ4 + f * (kQ3 + f * (kQ2 + f * (kQ1 + f * kQ0))));
   const float scale = uintBitsToFloat(uint(int(xi) + 127) << 23);
   return p * scale;
 }
@@ -126,7 +127,7 @@ void main() {
     const float wc = w[0] * tab[kk * 4u + cell] + w[1] * tab[kk * 5u + cell] + w[2] * tab[kk * 6u + cell] +
                      w[3] * tab[kk * 7u + cell];
     for (int j = 0; j < 4; ++j)
-      w[j] = w[j] * (tab[kk * uint(8 + j) + cell] * fast_exp2(ek * tab[kk * uint(j) + cell]));
+      w[j] = w[j] * (tab[kk * uint(8 + j) + cell] * kernel_exp2(ek * tab[kk * uint(j) + cell]));
     const float wt = w[0] + w[1] + w[2] + w[3];
     float yc = 0.0;
     for (int c = 0; c < u_C; ++c) {  // eq. 6; an invalid sample's value (maybe NaN) is replaced by 0
