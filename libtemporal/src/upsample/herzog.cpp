@@ -41,6 +41,7 @@
 #include <cstring>
 #include <limits>
 #include <numeric>
+#include <type_traits>
 
 #if defined(__linux__)
 #include <sys/mman.h>
