@@ -241,9 +241,11 @@ TEST(UpsampleReference, DrobotWavefrontBands) {
 TEST(UpsampleReference, ChunksFollowTheThreadCount) {
   // herzog walks chunks of gradient rows and drobot's cache mode bands of cache rows in parallel, sized by the task
   // arena's threads (temporal::rows_per_chunk: 64 gradient rows, 32 cache rows, down to 16 where fewer would leave
-  // threads idle). At 40x276, k = 4 (138 gradient rows, 69 cache rows) one thread gets chunks of 64 and bands of 32,
-  // sixteen threads chunks and bands of 16, so other rows fall on the edges and go to the later phases. The output
-  // must be the same bits, and the small bands must still match the plain implementation.
+  // threads idle; herzog's chunks then shrink towards the end on several threads, guided self-scheduling). At 40x276,
+  // k = 4 (138 gradient rows, 69 cache rows) one thread gets chunks of 64 and bands of 32, two threads herzog chunks
+  // of 36, 28, 20, 16, 16, 16 and 6 rows, sixteen threads chunks and bands of 16, so other rows fall on the edges and
+  // go to the later phases. The output must be the same bits, and the small bands must still match the plain
+  // implementation.
   const auto frames = random_sequence(40, 276, 4, 8, 276u);
   const std::vector<std::string> rgb = {"R", "G", "B"};
   for (const char* method : {"herzog", "drobot"}) {
@@ -262,13 +264,17 @@ TEST(UpsampleReference, ChunksFollowTheThreadCount) {
       });
       return out;
     };
-    const std::vector<Image> one = run(1), sixteen = run(16);
+    const std::vector<Image> one = run(1), two = run(2), sixteen = run(16);
     ASSERT_EQ(one.size(), frames.size());
+    ASSERT_EQ(two.size(), frames.size());
     ASSERT_EQ(sixteen.size(), frames.size());
     for (std::size_t t = 0; t < frames.size(); ++t)
-      for (const auto& c : rgb)
+      for (const auto& c : rgb) {
+        EXPECT_EQ(std::memcmp(one[t].plane(c), two[t].plane(c), one[t].pixel_count() * sizeof(float)), 0)
+            << method << " frame " << t << " " << c << " (2 threads)";
         EXPECT_EQ(std::memcmp(one[t].plane(c), sixteen[t].plane(c), one[t].pixel_count() * sizeof(float)), 0)
-            << method << " frame " << t << " " << c;
+            << method << " frame " << t << " " << c << " (16 threads)";
+      }
     double d = 0;
     tbb::task_arena(16).execute([&] { d = max_difference(*o, frames); });
     std::printf("%s 40x276 k=4, 16 threads: max |fast - plain| = %.3g\n", method, d);

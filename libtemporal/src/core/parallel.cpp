@@ -22,8 +22,10 @@ int max_threads() {
   return int(tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism));
 }
 
+int parallel_threads() { return std::max(1, std::min(max_threads(), tbb::this_task_arena::max_concurrency())); }
+
 int rows_per_chunk(int rows, int preferred, int smallest, int align) {
-  const int threads = std::max(1, std::min(max_threads(), tbb::this_task_arena::max_concurrency()));
+  const int threads = parallel_threads();
   const int wanted = std::clamp((rows + threads - 1) / threads, std::min(smallest, preferred), preferred);
   const int a = std::max(1, align);
   return std::max(a, (wanted + a - 1) / a * a);

@@ -26,6 +26,9 @@ class ThreadLimit {
 // Threads a parallel loop may use now.
 int max_threads();
 
+// Threads a parallel loop started here can run on: max_threads(), at most the current task arena's concurrency.
+int parallel_threads();
+
 // Rows per chunk for a pass that gives each parallel task a chunk of `rows` rows and pays a fixed cost at every
 // chunk's edges (herzog's boundary rows, drobot's band edges): `preferred` rows, the size that keeps that cost a
 // small share, unless that leaves fewer chunks than threads the task arena can run (min of the arena's concurrency
