@@ -5,7 +5,11 @@
 
 #include <cmath>
 #include <cstdint>
+#include <filesystem>
+#include <fstream>
 #include <limits>
+#include <sstream>
+#include <string>
 
 namespace temporal {
 namespace {
@@ -31,6 +35,44 @@ TEST(Image, ChannelsArePlanarAndAligned) {
   EXPECT_EQ(image.uint_plane("R"), nullptr);
   EXPECT_EQ(image.uint_plane("id")[3], 7u);
   EXPECT_EQ(image.add_channel("id"), nullptr);
+}
+
+// The VmFlags of the mapping that holds p (/proc/self/smaps), "" when not found.
+std::string vm_flags_of(const void* p) {
+  std::ifstream smaps("/proc/self/smaps");
+  const auto a = reinterpret_cast<std::uintptr_t>(p);
+  bool inside = false;
+  for (std::string line; std::getline(smaps, line);) {
+    std::uintptr_t lo = 0, hi = 0;
+    char dash = 0;
+    std::istringstream head(line);
+    if (line.find(':') > line.find('-') && (head >> std::hex >> lo >> dash >> hi) && dash == '-') {
+      inside = lo <= a && a < hi;
+    } else if (inside && line.rfind("VmFlags:", 0) == 0) {
+      return line.substr(8) + " ";
+    }
+  }
+  return "";
+}
+
+TEST(Image, LargePlanesAskForHugePages) {
+  // Small planes: 64-byte aligned. 4 MiB and more: 2 MiB aligned and advised for transparent huge pages
+  // (allocate_plane_memory), the same for Image's channels and PlaneVector's planes.
+  PlaneVector<float> small(1000, 1.0f);
+  EXPECT_EQ(reinterpret_cast<std::uintptr_t>(small.data()) % 64, 0u);
+  PlaneVector<float> large(std::size_t(1280) * 1024);  // 5 MiB, zero-filled like std::vector
+  Image image(1280, 1024);
+  float* plane = image.add_channel("R", 3.0f);
+  ASSERT_NE(plane, nullptr);
+  for (const void* p : {static_cast<const void*>(large.data()), static_cast<const void*>(plane)})
+    EXPECT_EQ(reinterpret_cast<std::uintptr_t>(p) % (std::uintptr_t(2) << 20), 0u);
+  EXPECT_EQ(large[large.size() - 1], 0.0f);
+  EXPECT_EQ(plane[1280 * 1024 - 1], 3.0f);
+  if (!std::filesystem::exists("/sys/kernel/mm/transparent_hugepage/enabled"))
+    GTEST_SKIP() << "this kernel has no transparent huge pages: the advice is not checked";
+  // "hg": the mapping was advised MADV_HUGEPAGE (whether the kernel found free huge pages is its business).
+  EXPECT_NE(vm_flags_of(large.data()).find(" hg "), std::string::npos) << vm_flags_of(large.data());
+  EXPECT_NE(vm_flags_of(plane).find(" hg "), std::string::npos) << vm_flags_of(plane);
 }
 
 TEST(Image, CopyIsDeep) {

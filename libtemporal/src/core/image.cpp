@@ -6,15 +6,31 @@
 #include <cstring>
 #include <new>
 
+#if defined(__linux__)
+#include <sys/mman.h>
+#endif
+
 namespace temporal {
+
+void* allocate_plane_memory(std::size_t bytes) {
+  constexpr std::size_t kHuge = std::size_t(2) << 20;
+  bytes = std::max<std::size_t>(64, (bytes + 63) / 64 * 64);
+  const bool huge = bytes >= 2 * kHuge;
+  if (huge) bytes = (bytes + kHuge - 1) / kHuge * kHuge;
+  void* p = std::aligned_alloc(huge ? kHuge : 64, bytes);
+  if (!p) throw std::bad_alloc();
+#if defined(__linux__) && defined(MADV_HUGEPAGE)
+  if (huge) (void)madvise(p, bytes, MADV_HUGEPAGE);  // advice only: a refusal leaves 4 KiB pages
+#endif
+  return p;
+}
+
+void free_plane_memory(void* p) noexcept { std::free(p); }
+
 namespace {
 
-// 64-byte aligned planes: full cache lines and aligned vector loads at the start of every plane.
 std::shared_ptr<void> allocate_plane(std::size_t count) {
-  const std::size_t bytes = ((count * 4 + 63) / 64) * 64;
-  void* p = std::aligned_alloc(64, bytes == 0 ? 64 : bytes);
-  if (!p) throw std::bad_alloc();
-  return std::shared_ptr<void>(p, [](void* q) { std::free(q); });
+  return std::shared_ptr<void>(allocate_plane_memory(count * 4), [](void* q) { free_plane_memory(q); });
 }
 
 }  // namespace

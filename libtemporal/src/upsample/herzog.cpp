@@ -43,35 +43,11 @@
 #include <numeric>
 #include <type_traits>
 
-#if defined(__linux__)
-#include <sys/mman.h>
-#endif
-
 namespace temporal::upsample {
 
 const HerzogOptions& herzog_options(const Options& o) { return method_options<HerzogOptions>(o.per_method, "herzog"); }
 
 namespace {
-
-// Asks Linux to back the 2 MiB-aligned part of [p, p + bytes) with transparent huge pages: MADV_HUGEPAGE for the
-// pages faulted in later, MADV_COLLAPSE (Linux 6.1; an error before) for those already there. herzog reads or
-// writes 12 full-resolution planes of its own per frame besides the G-buffer's 8; at 4 KiB pages that is ~25000
-// pages per frame at 1280x1024, far more than the TLB holds, so each page's first touch in a frame is a page walk
-// (a nested one in a virtual machine; docs/upsample-st.md, "Issue 27: herzog's second pass"). With the host's THP
-// mode "madvise" only the regions that ask get huge pages. Only speed depends on it: errors (no THP, no free huge
-// page, another OS) are ignored.
-[[maybe_unused]] void advise_huge_pages(const void* p, std::size_t bytes) {
-#if defined(__linux__) && defined(MADV_HUGEPAGE)
-  constexpr std::uintptr_t kHuge = std::uintptr_t(2) << 20;
-  const auto b = reinterpret_cast<std::uintptr_t>(p);
-  const std::uintptr_t lo = (b + kHuge - 1) & ~(kHuge - 1), hi = (b + bytes) & ~(kHuge - 1);
-  if (!p || hi <= lo) return;
-  void* a = reinterpret_cast<void*>(lo);
-  (void)madvise(a, hi - lo, MADV_HUGEPAGE);
-  constexpr int kCollapse = 25;  // MADV_COLLAPSE (linux/mman.h; glibc 2.36 does not define it)
-  (void)madvise(a, hi - lo, kCollapse);
-#endif
-}
 
 // The frame code's copies, one per instruction set (temporal/core/isa.h); a state runs the copy of the level
 // active when it was made. v3 and v4 may contract multiply-adds into FMAs (v2 has none) outside the row kernels

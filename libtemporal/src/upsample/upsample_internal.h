@@ -82,8 +82,8 @@ void clear_low_geometry(FrameContext& f);
 
 // Depth and ids of the previous frame, for the disocclusion test of the history fetch.
 struct PreviousGeometry {
-  std::vector<float> z;
-  std::vector<std::uint32_t> id;  // empty when the G-buffer has no ids
+  PlaneVector<float> z;
+  PlaneVector<std::uint32_t> id;  // empty when the G-buffer has no ids
   void store(const FrameContext& f);
 };
 

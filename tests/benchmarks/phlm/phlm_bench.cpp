@@ -141,7 +141,7 @@ void BM_PhlmTaaInterleaved(benchmark::State& state) {
 void BM_PhlmStateStreamBound(benchmark::State& state) {
   ThreadLimit limit(int(state.range(0)));
   const std::size_t bytes = std::size_t(kW) * kH * std::size_t(phlm_state_floats(3)) * sizeof(float);
-  std::vector<char> src(bytes, 1), dst(bytes, 0);
+  PlaneVector<char> src(bytes, 1), dst(bytes, 0);  // the pages the filter's planes get (allocate_plane_memory)
   for (auto _ : state) {
     parallel_rows(kH, [&](int y0, int y1) {
       const std::size_t row = bytes / kH;

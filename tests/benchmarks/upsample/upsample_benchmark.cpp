@@ -181,7 +181,7 @@ std::size_t l3_bytes() {
 }
 
 struct AlignedFree {
-  void operator()(char* p) const { std::free(p); }
+  void operator()(char* p) const { temporal::free_plane_memory(p); }
 };
 
 // The copy of one method's bytes (see above): `pairs` buffer pairs, one copied per call of run().
@@ -193,8 +193,10 @@ class StreamCopy {
     const std::size_t n = lines_ * kLine;
     const std::size_t pairs = from_dram ? 1 + (2 * l3_bytes() + n - 1) / n : 1;
     for (std::size_t p = 0; p < pairs; ++p) {
-      src_.emplace_back(static_cast<char*>(std::aligned_alloc(4096, (n + 4095) / 4096 * 4096)));
-      dst_.emplace_back(static_cast<char*>(std::aligned_alloc(4096, (n + 4095) / 4096 * 4096)));
+      // The planes' memory (temporal::allocate_plane_memory: huge pages where the system gives them), as the
+      // methods' planes get: the bound is timed on the same pages.
+      src_.emplace_back(static_cast<char*>(temporal::allocate_plane_memory(n)));
+      dst_.emplace_back(static_cast<char*>(temporal::allocate_plane_memory(n)));
       if (!src_.back() || !dst_.back()) {
         src_.clear();
         dst_.clear();

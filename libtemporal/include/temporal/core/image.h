@@ -22,6 +22,30 @@
 
 namespace temporal {
 
+// Memory for pixel planes: 64-byte aligned; a plane of 4 MiB or more (a 1280x1024 float plane is 5 MiB) is
+// aligned to 2 MiB, rounded up to whole 2 MiB pages and advised for transparent huge pages (madvise
+// MADV_HUGEPAGE) before its first touch. On a system whose THP mode is `madvise` (this build VM's) planes otherwise
+// live on 4 KiB pages, and a row loop that reads twenty planes misses the TLB on each. Every plane the suite
+// allocates (Image's channels, the methods' state through PlaneVector, the benchmarks' streaming bounds) gets the
+// same pages, so that no method is timed on better memory than its baseline or its bound (issue 27).
+// allocate_plane_memory throws std::bad_alloc when the memory is not there; free_plane_memory releases it.
+void* allocate_plane_memory(std::size_t bytes);
+void free_plane_memory(void* p) noexcept;
+
+// std::vector's allocator for planes kept between frames (history, weights): allocate_plane_memory.
+template <typename T>
+struct PlaneAllocator {
+  using value_type = T;
+  PlaneAllocator() = default;
+  template <typename U>
+  PlaneAllocator(const PlaneAllocator<U>&) noexcept {}
+  T* allocate(std::size_t n) { return static_cast<T*>(allocate_plane_memory(n * sizeof(T))); }
+  void deallocate(T* p, std::size_t) noexcept { free_plane_memory(p); }
+  friend bool operator==(const PlaneAllocator&, const PlaneAllocator&) { return true; }
+};
+template <typename T>
+using PlaneVector = std::vector<T, PlaneAllocator<T>>;
+
 enum class ChannelType { Float, UInt };
 
 // A rectangle of pixels: [x, x + width) x [y, y + height).

@@ -97,7 +97,7 @@ class PhlmFilter final : public FrameFilter {
   PhlmParams params_;
   // Models after the last frame and those being written for this frame (swapped), one interleaved record of
   // phlm_state_floats(C) floats per pixel (see phlm.cpp, Layout).
-  std::vector<float> state_, next_;
+  PlaneVector<float> state_, next_;  // huge pages where the system gives them (temporal/core/image.h)
   int width_ = 0, height_ = 0;
   int channels_ = 0;
   bool have_state_ = false;
