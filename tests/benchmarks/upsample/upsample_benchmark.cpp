@@ -180,7 +180,7 @@ std::size_t l3_bytes() {
   return std::size_t(32) << 20;
 }
 
-struct AlignedFree {
+struct PlaneFree {
   void operator()(char* p) const { temporal::free_plane_memory(p); }
 };
 
@@ -195,13 +195,8 @@ class StreamCopy {
     for (std::size_t p = 0; p < pairs; ++p) {
       // The planes' memory (temporal::allocate_plane_memory: huge pages where the system gives them), as the
       // methods' planes get: the bound is timed on the same pages.
-      src_.emplace_back(static_cast<char*>(temporal::allocate_plane_memory(n)));
+      src_.emplace_back(static_cast<char*>(temporal::allocate_plane_memory(n)));  // throws when out of memory
       dst_.emplace_back(static_cast<char*>(temporal::allocate_plane_memory(n)));
-      if (!src_.back() || !dst_.back()) {
-        src_.clear();
-        dst_.clear();
-        return;
-      }
       std::memset(src_.back().get(), 1, n);
       std::memset(dst_.back().get(), 2, n);
     }
@@ -223,7 +218,7 @@ class StreamCopy {
  private:
   static constexpr std::size_t kLine = 64, kChunkLines = 1024;  // 64 KiB chunks
   std::size_t lines_ = 0, p_ = 0;
-  std::vector<std::unique_ptr<char, AlignedFree>> src_, dst_;
+  std::vector<std::unique_ptr<char, PlaneFree>> src_, dst_;
 };
 
 void stream(benchmark::State& state, bool from_dram) {
