@@ -1,6 +1,6 @@
 // The run-time instruction-set dispatch (temporal/core/isa.h): the levels this CPU reports, forcing a level,
 // and the dispatched kernels (FLIP, SSIM, the upsampling methods with the reprojection rows, filter-phlm's phlm
-// and taa, morph-120hz's didyk and warp) run at every level this machine supports, whose outputs must agree:
+// and taa, morph-120hz's didyk, warp and blend) run at every level this machine supports, whose outputs must agree:
 //  - v3 (AVX2) and v4 (AVX-512) run the same operations in the same order per pixel, with FMA contraction in
 //    both: bit-identical;
 //  - v2 (SSE4.2) has no FMA, so a * b + c is rounded twice where v3 rounds once: the results differ in the
@@ -504,8 +504,16 @@ std::vector<float> run_morph(Level level, const std::string& method) {
   o.factor = 3;
   o.debug_layers = true;
   morph::Morpher m(o);
+  // blend reads frame n + 1 itself: a different one (the colours 0.55 x + 0.2), so that (1 - a) p + a q mixes
+  // two values; the other methods see the same frame again.
+  Image next(color.width(), color.height());
+  for (const char* c : {"R", "G", "B"}) {
+    float* d = next.add_channel(c);
+    const float* p = color.plane(c);
+    for (std::size_t i = 0; i < color.pixel_count(); ++i) d[i] = 0.55f * p[i] + 0.2f;
+  }
   std::vector<Image> out;
-  const Status st = m.process(color, &gbuffer, &color, out);
+  const Status st = m.process(color, &gbuffer, method == "blend" ? &next : &color, out);
   EXPECT_TRUE(st.is_ok()) << method << ": " << st.error().message;
   std::vector<float> values;
   for (const Image& img : out)
@@ -517,16 +525,17 @@ std::vector<float> run_morph(Level level, const std::string& method) {
 TEST(Isa, MorphAgreesAtEveryLevel) {
   const std::vector<Level> here = levels_here();
   if (here.size() < 2) GTEST_SKIP() << "one kernel copy runs on this machine: nothing to compare";
-  for (const std::string method : {"didyk", "warp"}) {
+  for (const std::string method : {"didyk", "warp", "blend"}) {
     const auto runs = run_at(here, [&](Level l) { return run_morph(l, method); });
     ASSERT_FALSE(runs[0].empty()) << method;
     for (std::size_t k = 1; k < runs.size(); ++k) {
       ASSERT_EQ(runs[0].size(), runs[k].size()) << method;
       const Difference d = compare_runs(runs[0], runs[k]);
       // FMA contraction in v3 moves a value by an ulp or so (didyk's pyramid, compensation and interpolations;
-      // measured on this frame: 41226 of 184320 values differ, by 1.7e-6 at most; warp: bit-identical). Where it
-      // moved a pixel centre across a triangle edge (didyk) or a splat target across a pixel edge (warp), that
-      // pixel would take its neighbour's value, a difference of up to the image's local contrast (none here).
+      // measured on this frame: 41226 of 184320 values differ, by 1.7e-6 at most; warp: bit-identical; blend's
+      // (1 - a) p + a q: 8308 of 184320, by 6.0e-8 at most). Where it moved a pixel centre across a triangle edge
+      // (didyk) or a splat target across a pixel edge (warp), that pixel would take its neighbour's value, a
+      // difference of up to the image's local contrast (none here).
       // Those must stay rare: at most 1 value in 2000 may differ by more than 1e-5.
       std::size_t large = 0;
       for (std::size_t i = 0; i < runs[0].size(); ++i)

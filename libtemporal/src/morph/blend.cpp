@@ -1,6 +1,7 @@
 // `blend`: slot k = (1 - k/N) frame n + (k/N) frame n+1 in linear light. It needs frame n+1 before slot 1 of n
 // can be shown: one rendered frame of added latency. The last frame, without a successor, is repeated.
 #include "method_common.h"
+#include "temporal/core/isa.h"
 #include "temporal/core/parallel.h"
 #include "temporal/morph/gpu_methods.h"
 #include "temporal/morph/methods.h"
@@ -11,6 +12,16 @@ namespace temporal::morph {
 namespace {
 
 using namespace detail;
+
+// The interpolation copies, one per instruction set (temporal/core/isa.h). v3 and v4 contract (1 - a) p + a q
+// into a fused multiply-add (v2 has none): v2 differs from them in the last bit (tests/core/isa_test.cpp); v3 and
+// v4 are bit-identical.
+#define TEMPORAL_ISA_FILE "blend_kernels.inc"
+#include "temporal/core/isa_copies.inc"
+
+void lerp_plane_copy(const float* p, const float* q, float* d, std::size_t np, float a) {
+  TEMPORAL_ISA_CALL(copy, return copy::lerp_plane(p, q, d, np, a))
+}
 
 class Blend final : public MorphMethod {
  public:
@@ -25,9 +36,7 @@ class Blend final : public MorphMethod {
         float* d = out[std::size_t(k)].plane(ch);
         const float* p = color.plane(ch);
         const float* q = next ? next->plane(ch) : p;
-        parallel_chunks(np, [&](std::size_t i0, std::size_t i1) {
-          for (std::size_t i = i0; i < i1; ++i) d[i] = (1.0f - a) * p[i] + a * q[i];
-        });
+        lerp_plane_copy(p, q, d, np, a);
       }
     }
     t.morph_ms = ms_since(t0);
