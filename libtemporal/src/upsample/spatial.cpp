@@ -9,6 +9,11 @@
 #include "temporal/core/isa.h"
 #include "temporal/core/parallel.h"
 
+#include <immintrin.h>
+
+#include <cstdint>
+#include <cstring>
+
 namespace temporal::upsample {
 namespace {
 
