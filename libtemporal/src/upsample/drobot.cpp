@@ -25,6 +25,7 @@
 
 #include <atomic>
 #include <cstdint>
+#include <cstring>
 #include <limits>
 #if defined(__SSE2__)
 #include <immintrin.h>
@@ -35,22 +36,6 @@ namespace temporal::upsample {
 const DrobotOptions& drobot_options(const Options& o) { return method_options<DrobotOptions>(o.per_method, "drobot"); }
 
 namespace {
-
-// drobot_impl.inc's stream_row with 64-byte (AVX-512) and 32-byte (AVX) non-temporal stores, for the copies that have
-// them: m a multiple of the width, dst aligned to it. Compiled once with their own targets (GCC does not define
-// __AVX512F__ under the copies' target pragmas, so the copies cannot test for it) and called only by a state whose
-// copy's level has them (DrobotState::stream_width).
-#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
-#define TEMPORAL_DROBOT_WIDE_STREAM 1
-[[gnu::target("avx512f")]] void stream_row_avx512(const float* src, float* dst, int m) {
-  for (int i = 0; i < m; i += 16) _mm512_stream_ps(dst + i, _mm512_loadu_ps(src + i));
-}
-[[gnu::target("avx")]] void stream_row_avx(const float* src, float* dst, int m) {
-  for (int i = 0; i < m; i += 8) _mm256_stream_ps(dst + i, _mm256_loadu_ps(src + i));
-}
-#else
-#define TEMPORAL_DROBOT_WIDE_STREAM 0
-#endif
 
 // The frame code's copies, one per instruction set (temporal/core/isa.h); a state runs the copy of the level
 // active when it was made. v3 and v4 may contract multiply-adds into FMAs (v2 has none): v2's output can differ
