@@ -176,6 +176,23 @@ TEST(Image, CountsNonFinite) {
   EXPECT_EQ(count_non_finite(v), 3u);
 }
 
+// A plane longer than one 2^20-value block of the 32-bit counts: non-finite values at the blocks' edges, and
+// denormals and the largest floats, which are finite.
+TEST(Image, CountsNonFiniteInLargePlanes) {
+  std::vector<float> v((std::size_t(1) << 21) + 37, 1.0f);
+  const std::size_t at[] = {0, 1000, (std::size_t(1) << 20) - 1, std::size_t(1) << 20, (std::size_t(1) << 21) - 1,
+                            (std::size_t(1) << 21) + 36};
+  for (std::size_t i = 0; i < std::size(at); ++i)
+    v[at[i]] = i % 3 == 0 ? std::numeric_limits<float>::quiet_NaN()
+               : i % 3 == 1 ? std::numeric_limits<float>::infinity()
+                            : -std::numeric_limits<float>::infinity();
+  v[5] = std::numeric_limits<float>::denorm_min();
+  v[6] = std::numeric_limits<float>::max();
+  v[7] = -std::numeric_limits<float>::max();
+  EXPECT_EQ(count_non_finite(v), std::size(at));
+  EXPECT_EQ(count_non_finite({v.data() + 1, std::size_t(1) << 20}), 3u);  // 1000, 2^20 - 1, 2^20
+}
+
 TEST(Parallel, RowsCoverEveryRowOnce) {
   std::vector<int> hits(1000, 0);
   parallel_rows(1000, [&](int y0, int y1) {

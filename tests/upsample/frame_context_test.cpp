@@ -78,5 +78,29 @@ TEST(UpsampleFrameContext, DrobotCacheModeGathersItsOwnSampleGeometry) {
   }
 }
 
+// TapTable::build keeps a table it already holds (the frame's tables repeat: the cache grid's never change, the
+// samples' cycle through the jitter offsets) and rebuilds for any other (full, low, k, s): the entries are always those
+// of a fresh table.
+TEST(UpsampleFrameContext, TapTablesAreRebuiltOnlyForANewGrid) {
+  auto same = [](const TapTable& a, const TapTable& b) {
+    return a.i0 == b.i0 && a.i1 == b.i1 && a.d == b.d && a.v0 == b.v0 && a.v1 == b.v1;
+  };
+  TapTable t;
+  EXPECT_TRUE(t.build(77, 20, 4, 1));
+  EXPECT_FALSE(t.build(77, 20, 4, 1));
+  const int keys[][4] = {{77, 20, 4, 3}, {77, 20, 4, 1}, {76, 20, 4, 1}, {77, 19, 4, 1}, {77, 26, 3, 1}, {9, 20, 4, 1}};
+  for (const auto& key : keys) {
+    EXPECT_TRUE(t.build(key[0], key[1], key[2], key[3]));
+    TapTable fresh;
+    fresh.build(key[0], key[1], key[2], key[3]);
+    EXPECT_TRUE(same(t, fresh)) << key[0] << " " << key[1] << " " << key[2] << " " << key[3];
+    EXPECT_EQ(t.i0.size(), std::size_t(key[0]));
+  }
+  const TapTable copy = t;  // a copy holds the same table and knows it
+  TapTable c = copy;
+  EXPECT_FALSE(c.build(9, 20, 4, 1));
+  EXPECT_TRUE(same(c, copy));
+}
+
 }  // namespace
 }  // namespace temporal::upsample

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <cstdlib>
 #include <cstring>
 #include <new>
@@ -248,9 +249,16 @@ Status Image::from_interleaved(std::span<const std::string> names, std::span<con
 }
 
 std::size_t count_non_finite(std::span<const float> plane) {
-  std::size_t n = 0;
-  for (float v : plane) n += std::isfinite(v) ? 0 : 1;
-  return n;
+  // A 32-bit count per block of 2^20 values: the loop vectorises without widening every lane to 64 bits (it was 4
+  // floats and two 64-bit adds per step at x86-64-v2, in the serial start of every upsample-st frame).
+  std::size_t total = 0;
+  for (std::size_t b = 0; b < plane.size(); b += std::size_t(1) << 20) {
+    const std::size_t e = std::min(plane.size(), b + (std::size_t(1) << 20));
+    std::uint32_t n = 0;
+    for (std::size_t i = b; i < e; ++i) n += std::isfinite(plane[i]) ? 0u : 1u;
+    total += n;
+  }
+  return total;
 }
 
 }  // namespace temporal

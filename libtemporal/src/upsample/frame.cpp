@@ -22,7 +22,12 @@ Expected<std::vector<std::string>> select_channels(const Image& low, const std::
   return select_layers(low, layers, file);  // the --layer rule of every tool (temporal/core/image.h)
 }
 
-void TapTable::build(int full, int low, int k, int s) {
+bool TapTable::build(int full, int low, int k, int s) {
+  if (key_[0] == full && key_[1] == low && key_[2] == k && key_[3] == s) return false;
+  key_[0] = full;
+  key_[1] = low;
+  key_[2] = k;
+  key_[3] = s;
   i0.resize(full);
   i1.resize(full);
   d.resize(full);
@@ -36,6 +41,7 @@ void TapTable::build(int full, int low, int k, int s) {
     i0[X] = std::clamp(x0, 0, low - 1);
     i1[X] = std::clamp(x0 + 1, 0, low - 1);
   }
+  return true;
 }
 
 namespace {

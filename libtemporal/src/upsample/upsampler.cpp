@@ -7,6 +7,7 @@
 #include "temporal/gpu/device.h"
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <optional>
@@ -339,7 +340,18 @@ Expected<Image*> Upsampler::process(const Image& gbuffer, const Image& low, std:
   const FrameMetadata &gm = gbuffer.metadata(), &lm = low.metadata();
   if (cut || gm.camera_cut.value_or(false) || lm.camera_cut.value_or(false)) u.have_history = false;
   stats.history_reset = !u.have_history;
-  for (int c = 0; c < u.f.C; ++c) stats.non_finite_input += count_non_finite({u.f.low[c], std::size_t(u.f.lw) * u.f.lh});
+  {
+    // In parallel chunks: the first read of this frame's payload (from memory), serial before (~1 % of drobot's
+    // samples at 1280x1024, with the other core idle).
+    const std::size_t n = std::size_t(u.f.lw) * u.f.lh;
+    std::atomic<std::size_t> non_finite{0};
+    parallel_chunks(n, [&](std::size_t b, std::size_t e) {
+      std::size_t m = 0;
+      for (int c = 0; c < u.f.C; ++c) m += count_non_finite({u.f.low[c] + b, e - b});
+      non_finite.fetch_add(m, std::memory_order_relaxed);
+    }, std::size_t(1) << 14);
+    stats.non_finite_input += non_finite.load();
+  }
   if (u.options.demodulate) u.demodulate_low();
   if (u.state->gathers_low_geometry())
     clear_low_geometry(u.f);
