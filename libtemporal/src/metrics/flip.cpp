@@ -329,6 +329,13 @@ struct FastCbrt {
   float operator()(float t) const { return fast_math::cbrt(t); }
 };
 
+// flip_statistics' buckets: kPoolBuckets over [0, 1], a value's bucket growing with the value (the pooling
+// kernels and flip_statistics share it; defined for the baseline, inlined into every copy).
+constexpr int kPoolBuckets = 1024;
+constexpr std::size_t kPoolLanes = 4;  // FLIP values crowd into few buckets: four interleaved histograms keep the
+                                       // additions to one bucket from waiting on each other
+inline int pool_bucket(float v) { return std::clamp(int(v * float(kPoolBuckets)), 0, kPoolBuckets - 1); }
+
 // ---------------------------------------------------------------------------------------------------------
 // The kernel copies, one per instruction set (temporal/core/isa.h): the same source, flip_kernels.inc, with the
 // vector width and register count of the target. The copies differ only in FMA contraction (v2 has none).
@@ -368,14 +375,19 @@ struct Kernels {
   void (*image)(const RowInput&, int, int, const Filters&, Plane (&)[kHorizontal], Plane (&)[kProducts]);
   void (*combine)(bool, const Plane (&)[kProducts], const Plane (&)[kProducts], std::size_t, const std::uint8_t*,
                   float*, float*, float);
+  void (*pool_histogram)(const float*, const std::uint8_t*, std::size_t, std::size_t, double*, std::size_t&, float&,
+                         float&);
+  bool (*pool_block_hits)(const float*, std::size_t, std::size_t, const int (&)[3]);
 };
 
 const Kernels& kernels() {
 #if TEMPORAL_ISA_DISPATCH
-  static constexpr Kernels table[3] = {{v2::image, v2::combine}, {v3::image, v3::combine}, {v4::image, v4::combine}};
+  static constexpr Kernels table[3] = {{v2::image, v2::combine, v2::pool_histogram, v2::pool_block_hits},
+                                       {v3::image, v3::combine, v3::pool_histogram, v3::pool_block_hits},
+                                       {v4::image, v4::combine, v4::pool_histogram, v4::pool_block_hits}};
   return table[int(isa::active())];  // Level::V2, V3, V4 are 0, 1, 2
 #else
-  static constexpr Kernels table{native::image, native::combine};
+  static constexpr Kernels table{native::image, native::combine, native::pool_histogram, native::pool_block_hits};
   return table;
 #endif
 }
@@ -483,13 +495,11 @@ FlipStats flip_statistics(std::span<const float> map, const std::uint8_t* valid)
   // Two parallel passes over fixed chunks (merged in chunk order, so the result does not depend on the thread
   // count). A value's bucket grows with the value, so the bucket holding each weighted percentile follows from
   // the cumulative bucket sums of pass 1, and pass 2 collects only those buckets' values, which are sorted.
-  constexpr int kBuckets = 1024;
+  constexpr int kBuckets = kPoolBuckets;
   constexpr std::size_t kChunks = 32;
-  constexpr std::size_t kLanes = 4;  // FLIP values crowd into few buckets: four interleaved histograms keep the
-                                     // additions to one bucket from waiting on each other
   const std::size_t n = map.size();
-  auto bucket_of = [](float v) { return std::clamp(int(v * float(kBuckets)), 0, kBuckets - 1); };
   auto valid_at = [&](std::size_t i) { return !valid || valid[i] != 0; };
+  const Kernels& kern = kernels();
   struct Chunk {
     std::vector<double> sum;
     std::size_t count = 0;
@@ -502,17 +512,11 @@ FlipStats flip_statistics(std::span<const float> map, const std::uint8_t* valid)
       [&](std::size_t c0, std::size_t c1) {
         for (std::size_t c = c0; c < c1; ++c) {
           Chunk& ch = chunks[c];
-          std::vector<double> lanes(kLanes * kBuckets, 0.0);
-          for (std::size_t i = n * c / kChunks; i < n * (c + 1) / kChunks; ++i) {
-            if (!valid_at(i)) continue;
-            const float v = map[i];
-            lanes[(i % kLanes) * kBuckets + std::size_t(bucket_of(v))] += v;
-            ++ch.count;
-            ch.min = std::min(ch.min, v);
-            ch.max = std::max(ch.max, v);
-          }
+          std::vector<double> lanes(kPoolLanes * kBuckets, 0.0);
+          kern.pool_histogram(map.data(), valid, n * c / kChunks, n * (c + 1) / kChunks, lanes.data(), ch.count,
+                              ch.min, ch.max);
           ch.sum.assign(kBuckets, 0.0);
-          for (std::size_t l = 0; l < kLanes; ++l)
+          for (std::size_t l = 0; l < kPoolLanes; ++l)
             for (std::size_t b = 0; b < kBuckets; ++b) ch.sum[b] += lanes[l * kBuckets + b];
         }
       },
@@ -549,20 +553,14 @@ FlipStats flip_statistics(std::span<const float> map, const std::uint8_t* valid)
       [&](std::size_t c0, std::size_t c1) {
         for (std::size_t c = c0; c < c1; ++c) {
           const std::size_t i0 = n * c / kChunks, i1 = n * (c + 1) / kChunks;
-          const int t0 = target[0], t1 = target[1], t2 = target[2];
           // Blocks of 64 values: a vectorised test whether any is in a target bucket (rarely), then a scalar
           // look at the blocks that have one.
           for (std::size_t b0 = i0; b0 < i1; b0 += 64) {
             const std::size_t b1 = std::min(i1, b0 + 64);
-            int hit = 0;
-            for (std::size_t i = b0; i < b1; ++i) {
-              const int b = bucket_of(map[i]);
-              hit |= (b == t0) | (b == t1) | (b == t2);
-            }
-            if (!hit) continue;
+            if (!kern.pool_block_hits(map.data(), b0, b1, target)) continue;
             for (std::size_t i = b0; i < b1; ++i) {
               if (!valid_at(i)) continue;
-              const int b = bucket_of(map[i]);
+              const int b = pool_bucket(map[i]);
               for (int q = 0; q < 3; ++q)
                 if (b == target[q]) chunks[c].picked[q].push_back(map[i]);
             }
