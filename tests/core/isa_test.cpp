@@ -224,6 +224,39 @@ TEST(Isa, FlipAgreesAtEveryLevel) {
   }
 }
 
+// FLIP's pooling (flip_statistics: a histogram pass and the percentile buckets' block test, kernels of each copy
+// since issue 27) on one map at every level, over all pixels and over the valid ones: integer buckets and double
+// sums in the same order at every width, so the statistics are the same bit for bit.
+TEST(Isa, FlipPoolingAgreesAtEveryLevel) {
+  const std::vector<Level> here = levels_here();
+  if (here.size() < 2) GTEST_SKIP() << "one kernel copy runs on this machine: nothing to compare";
+  const Pair pair(1.0f);
+  const FlipRun map = run_flip(here[0]);
+  struct Pooled {
+    FlipStats all, valid;
+  };
+  std::vector<Pooled> pooled;
+  for (Level level : here) {
+    isa::ScopedLevel scope(level);
+    pooled.push_back({flip_statistics(map.ldr), flip_statistics(map.ldr, pair.valid.data())});
+  }
+  const FlipStats& a = pooled[0].all;
+  EXPECT_GT(a.weighted_quartile_1, 0.0) << "a map with its quartiles in different buckets is the point";
+  EXPECT_LT(a.weighted_quartile_1, a.weighted_quartile_3);
+  EXPECT_LT(pooled[0].valid.pixels, a.pixels) << "the mask must drop pixels";
+  for (std::size_t k = 1; k < pooled.size(); ++k)
+    for (const auto& [v2, r] : {std::pair{pooled[0].all, pooled[k].all}, std::pair{pooled[0].valid, pooled[k].valid}}) {
+      const std::string what = "v2 against " + std::string(isa::name(here[k]));
+      EXPECT_EQ(v2.pixels, r.pixels) << what;
+      EXPECT_EQ(v2.mean, r.mean) << what;
+      EXPECT_EQ(v2.min, r.min) << what;
+      EXPECT_EQ(v2.max, r.max) << what;
+      EXPECT_EQ(v2.weighted_quartile_1, r.weighted_quartile_1) << what;
+      EXPECT_EQ(v2.weighted_median, r.weighted_median) << what;
+      EXPECT_EQ(v2.weighted_quartile_3, r.weighted_quartile_3) << what;
+    }
+}
+
 struct SsimRun {
   SsimResult plain, weighted;
   std::vector<float> map;
