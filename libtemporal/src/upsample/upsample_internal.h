@@ -209,51 +209,8 @@ inline float sample_weight(float zi, float ax, float ay, float az, float lx, flo
   return w >= 0.0f ? w : 0.0f;
 }
 
-// For every pixel of full row Y, the geometric weights of its four taps (00, 01: low row i0, columns i0, i1;
-// 10, 11: low row i1) times the taps' existence (TapTable v0 / v1), read from the expanded low rows e0 / e1
-// (ExpandedLowRows, plane stride es) with unit stride: g_j[X] = geometric_weight(tap j) * cv_j[X] * vy_j.
-// Always inlined: its callers are the per-instruction-set copies of spatial and herzog (temporal/core/isa.h), and
-// GCC, which found it too large to inline, called the one out-of-line copy, compiled for the baseline (SSE4.2):
-// 41 % of spatial's time at AVX-512 against 30 % in a -march=native build.
-// kLower = false: the upper taps' weights only (g10 and g11 are not written), for a caller whose image kernel is
-// zero on the lower taps of the whole row (herzog's rows on the low-resolution sample row, HerzogFrame::lower_zero).
-template <bool kLower = true>
-[[gnu::always_inline]] inline void expanded_geometric_weights(const FrameContext& f, float inv_sn2, float inv_sd2,
-                                       int Y, const float* e0, const float* e1, std::size_t es,
-                                       float* __restrict g00, float* __restrict g01, float* __restrict g10,
-                                       float* __restrict g11) {
-  const int W = f.W, k = f.grid.k;
-  const std::size_t row = std::size_t(Y) * W;
-  const float vy0 = f.rows.v0[Y], vy1 = f.rows.v1[Y];
-  const float* __restrict z = f.z + row;
-  const float* __restrict nx = f.nx + row;
-  const float* __restrict ny = f.ny + row;
-  const float* __restrict nz = f.nz + row;
-  const float* __restrict cv0 = f.cols.v0.data();
-  const float* __restrict cv1 = f.cols.v1.data();
-  // Plane q (0..4: z, nx, ny, nz, valid) of tap t (0: column i0; 1: column i1, the i0 expansion shifted by k).
-  auto ex = [es, k](const float* e, int q, int t) { return e + std::size_t(q) * es + std::size_t(t) * k; };
-  const float *__restrict z00 = ex(e0, 0, 0), *__restrict z01 = ex(e0, 0, 1), *__restrict z10 = ex(e1, 0, 0),
-              *__restrict z11 = ex(e1, 0, 1);
-  const float *__restrict x00 = ex(e0, 1, 0), *__restrict x01 = ex(e0, 1, 1), *__restrict x10 = ex(e1, 1, 0),
-              *__restrict x11 = ex(e1, 1, 1);
-  const float *__restrict y00 = ex(e0, 2, 0), *__restrict y01 = ex(e0, 2, 1), *__restrict y10 = ex(e1, 2, 0),
-              *__restrict y11 = ex(e1, 2, 1);
-  const float *__restrict n00 = ex(e0, 3, 0), *__restrict n01 = ex(e0, 3, 1), *__restrict n10 = ex(e1, 3, 0),
-              *__restrict n11 = ex(e1, 3, 1);
-  const float *__restrict v00 = ex(e0, 4, 0), *__restrict v01 = ex(e0, 4, 1), *__restrict v10 = ex(e1, 4, 0),
-              *__restrict v11 = ex(e1, 4, 1);
-#pragma GCC ivdep
-  for (int X = 0; X < W; ++X) {
-    const float zi = z[X], ax = nx[X], ay = ny[X], az = nz[X];
-    g00[X] = sample_weight(zi, ax, ay, az, x00[X], y00[X], n00[X], z00[X], v00[X], inv_sn2, inv_sd2) * cv0[X] * vy0;
-    g01[X] = sample_weight(zi, ax, ay, az, x01[X], y01[X], n01[X], z01[X], v01[X], inv_sn2, inv_sd2) * cv1[X] * vy0;
-    if constexpr (kLower) {
-      g10[X] = sample_weight(zi, ax, ay, az, x10[X], y10[X], n10[X], z10[X], v10[X], inv_sn2, inv_sd2) * cv0[X] * vy1;
-      g11[X] = sample_weight(zi, ax, ay, az, x11[X], y11[X], n11[X], z11[X], v11[X], inv_sn2, inv_sd2) * cv1[X] * vy1;
-    }
-  }
-}
+// spatial's and herzog's geometric weights of a full row (expanded_geometric_weights) are in geometric_weights.inc,
+// compiled in each instruction-set copy.
 
 // Joint-bilateral upsampling (eq. 1-3, hat kernel) of full-resolution row Y, columns [X0, X1) (X1 < 0: to the
 // end of the row), into out[c][X0 .. X1) (out rows are indexed by X); `wsum` (a row indexed by X) receives the
