@@ -58,16 +58,21 @@ std::string vm_flags_of(const void* p) {
 }
 
 TEST(Image, LargePlanesAskForHugePages) {
-  // Small planes: 64-byte aligned. 4 MiB and more: 2 MiB aligned and advised for transparent huge pages
-  // (allocate_plane_memory), the same for Image's channels and PlaneVector's planes.
+  // Every plane 64-byte aligned. 4 MiB and more: in a 2 MiB-aligned block advised for transparent huge pages, at a
+  // staggered offset under 128 KiB into it (allocate_plane_memory), the same for Image's channels and PlaneVector's
+  // planes; two planes allocated one after the other start on different L1 sets (offsets mod 4096 differ).
   PlaneVector<float> small(1000, 1.0f);
   EXPECT_EQ(reinterpret_cast<std::uintptr_t>(small.data()) % 64, 0u);
   PlaneVector<float> large(std::size_t(1280) * 1024);  // 5 MiB, zero-filled like std::vector
   Image image(1280, 1024);
   float* plane = image.add_channel("R", 3.0f);
   ASSERT_NE(plane, nullptr);
-  for (const void* p : {static_cast<const void*>(large.data()), static_cast<const void*>(plane)})
-    EXPECT_EQ(reinterpret_cast<std::uintptr_t>(p) % (std::uintptr_t(2) << 20), 0u);
+  for (const void* p : {static_cast<const void*>(large.data()), static_cast<const void*>(plane)}) {
+    const auto a = reinterpret_cast<std::uintptr_t>(p);
+    EXPECT_EQ(a % 64, 0u);
+    EXPECT_LT(a % (std::uintptr_t(2) << 20), std::uintptr_t(128) << 10);
+  }
+  EXPECT_NE(reinterpret_cast<std::uintptr_t>(large.data()) % 4096, reinterpret_cast<std::uintptr_t>(plane) % 4096);
   EXPECT_EQ(large[large.size() - 1], 0.0f);
   EXPECT_EQ(plane[1280 * 1024 - 1], 3.0f);
   if (!std::filesystem::exists("/sys/kernel/mm/transparent_hugepage/enabled"))

@@ -1,6 +1,7 @@
 #include "temporal/core/image.h"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <cstdint>
 #include <cstdlib>
@@ -13,20 +14,47 @@
 
 namespace temporal {
 
+// Planes of 64 KiB or more start at a staggered offset into their block, from a counter: (33 n mod 64) cache lines
+// (a different set of a 4 KiB-periodic L1 for each of 64 successive planes) plus, for planes of 4 MiB or more,
+// (7 n mod 16) x 4 KiB (spread over the 64 KiB period of a 512 KiB 8-way L2); the base pointer is kept in the 8
+// bytes before the plane, for free_plane_memory. Without it every large plane began on a 2 MiB boundary and every
+// mid-sized one (glibc's mmap'd blocks) at the same offset into a 4 KiB page, so the planes a row loop reads side by
+// side at the same pixel (the history fetch: the previous frame's channels, depth and ids, this frame's motion, depth
+// and ids) had the same low address bits and fell on the same sets of the L1 and L2 caches: more streams than
+// their 8 ways. Issue 27, 2026-11-29: herzog's history fetch (fused_aligned_run) took 13-18 % less time with its
+// previous planes read at staggered offsets (a probe); docs/history/upsample-st-speed.md, "sixth session".
+namespace {
+std::atomic<std::size_t> stagger_counter{0};
+}  // namespace
+
 void* allocate_plane_memory(std::size_t bytes) {
   constexpr std::size_t kHuge = std::size_t(2) << 20;
   bytes = std::max<std::size_t>(64, (bytes + 63) / 64 * 64);
   const bool huge = bytes >= 2 * kHuge;
-  if (huge) bytes = (bytes + kHuge - 1) / kHuge * kHuge;
-  void* p = std::aligned_alloc(huge ? kHuge : 64, bytes);
-  if (!p) throw std::bad_alloc();
+  std::size_t offset = 64;  // room for the base pointer
+  if (bytes >= (std::size_t(64) << 10)) {
+    const std::size_t n = stagger_counter.fetch_add(1, std::memory_order_relaxed);
+    offset += (n * 33 % 64) * 64;
+    if (huge) offset += (n * 7 % 16) * 4096;
+  }
+  std::size_t total = bytes + offset;
+  if (huge) total = (total + kHuge - 1) / kHuge * kHuge;
+  void* base = std::aligned_alloc(huge ? kHuge : 64, total);
+  if (!base) throw std::bad_alloc();
 #if defined(__linux__) && defined(MADV_HUGEPAGE)
-  if (huge) (void)madvise(p, bytes, MADV_HUGEPAGE);  // advice only: a refusal leaves 4 KiB pages
+  if (huge) (void)madvise(base, total, MADV_HUGEPAGE);  // advice only: a refusal leaves 4 KiB pages
 #endif
-  return p;
+  char* plane = static_cast<char*>(base) + offset;
+  std::memcpy(plane - sizeof(void*), &base, sizeof(void*));
+  return plane;
 }
 
-void free_plane_memory(void* p) noexcept { std::free(p); }
+void free_plane_memory(void* p) noexcept {
+  if (!p) return;
+  void* base;
+  std::memcpy(&base, static_cast<char*>(p) - sizeof(void*), sizeof(void*));
+  std::free(base);
+}
 
 namespace {
 
