@@ -17,12 +17,13 @@ namespace temporal {
 // Planes of 64 KiB or more start at a staggered offset into their block, from a counter: (33 n mod 64) cache lines
 // (a different set of a 4 KiB-periodic L1 for each of 64 successive planes) plus, for planes of 4 MiB or more,
 // (7 n mod 16) x 4 KiB (spread over the 64 KiB period of a 512 KiB 8-way L2); the base pointer is kept in the 8
-// bytes before the plane, for free_plane_memory. Without it every large plane began on a 2 MiB boundary and every
-// mid-sized one (glibc's mmap'd blocks) at the same offset into a 4 KiB page, so the planes a row loop reads side by
-// side at the same pixel (the history fetch: the previous frame's channels, depth and ids, this frame's motion, depth
-// and ids) had the same low address bits and fell on the same sets of the L1 and L2 caches: more streams than
-// their 8 ways. Issue 27, 2026-11-29: herzog's history fetch (fused_aligned_run) took 13-18 % less time with its
-// previous planes read at staggered offsets (a probe); docs/history/upsample-st-speed.md, "sixth session".
+// bytes before the plane, for free_plane_memory. Without it every large plane began on a 2 MiB boundary (and
+// mid-sized ones, from glibc's page-aligned mmap'd blocks, likely at one offset into a 4 KiB page), so the planes a
+// row loop reads side by side at the same pixel (the history fetch: the previous frame's channels, depth and ids,
+// this frame's motion, depth and ids) had the same low address bits and fell on the same sets of the L1 and L2
+// caches: more streams than their 8 ways. Issue 27, 2026-11-29: herzog's history fetch (fused_aligned_run) took
+// 13-18 % less time with its previous planes read at staggered offsets (a probe); docs/history/upsample-st-speed.md,
+// "sixth session".
 namespace {
 std::atomic<std::size_t> stagger_counter{0};
 }  // namespace

@@ -25,8 +25,9 @@ namespace temporal {
 // Memory for pixel planes: 64-byte aligned; a plane of 4 MiB or more (a 1280x1024 float plane is 5 MiB) lies in a
 // block aligned to 2 MiB, rounded up to whole 2 MiB pages and advised for transparent huge pages (madvise
 // MADV_HUGEPAGE) before its first touch. Planes of 64 KiB or more start at staggered offsets into their blocks, so
-// that planes read side by side do not all map to the same cache sets (image.cpp). On a system whose THP mode is `madvise` (this build VM's) planes otherwise
-// live on 4 KiB pages: a row loop over twenty planes then needs a TLB entry per 4 KiB of each. Every plane the suite
+// that planes read side by side do not all map to the same cache sets (image.cpp). On a system whose THP mode is
+// `madvise` (this build VM's) planes otherwise live on 4 KiB pages: a row loop over twenty planes then needs a TLB
+// entry per 4 KiB of each. Every plane the suite
 // allocates (Image's channels, the methods' state through PlaneVector, the benchmarks' streaming bounds) gets the
 // same pages, so that no method is timed on better memory than its baseline or its bound (issue 27).
 // allocate_plane_memory throws std::bad_alloc when the memory is not there; free_plane_memory releases it.
