@@ -220,8 +220,9 @@ TEST(UpsampleReference, SyntheticScenes) {
 
 TEST(UpsampleReference, DrobotWavefrontBands) {
   // drobot's cache mode runs a frame as a wavefront in bands of 32 cache rows (run_cache: the cache update, Listing
-  // 7.3's vertical pass 4 rows behind it and the full rows behind that), the rows around the bands' edges in two
-  // later phases; the sizes above have at most 32 cache rows, one band. Tall frames: 69 cache rows (bands of 32, 32
+  // 7.3's vertical pass 4 rows behind it and the full rows behind that), the rows around each edge between two bands
+  // once both bands got far enough, or, next to a band shorter than twice the filter's reach, in two later phases;
+  // the sizes above have at most 32 cache rows, one band. Tall frames: 69 cache rows (on one thread bands of 32, 32
   // and 5, the last shorter than the filter's reach on both sides), 33 (a last band of one row) and 37 at k = 3. A
   // full row upsampled before its cache rows were filtered, or an edge row left out, reads the frame before last's
   // cache (the ping-pong buffer) and differs by 1e-3 to 1.
@@ -241,11 +242,13 @@ TEST(UpsampleReference, DrobotWavefrontBands) {
 TEST(UpsampleReference, ChunksFollowTheThreadCount) {
   // herzog walks chunks of gradient rows and drobot's cache mode bands of cache rows in parallel, sized by the task
   // arena's threads (temporal::rows_per_chunk: 64 gradient rows, 32 cache rows, down to 16 where fewer would leave
-  // threads idle; herzog's chunks then shrink towards the end on several threads, guided self-scheduling). At 40x276,
-  // k = 4 (138 gradient rows, 69 cache rows) one thread gets chunks of 64 and bands of 32, two threads herzog chunks
-  // of 36, 28, 20, 16, 16, 16 and 6 rows, sixteen threads chunks and bands of 16, so other rows fall on the edges and
-  // go to the later phases. The output must be the same bits, and the small bands must still match the plain
-  // implementation.
+  // threads idle; both then shrink towards the end on several threads, guided self-scheduling, the threads taking
+  // them in order from a counter). At 40x276, k = 4 (138 gradient rows, 69 cache rows) one thread gets chunks of 64
+  // and bands of 32; two threads herzog chunks of 36, 28, 20, 16, 16, 16 and 6 rows, drobot bands of 18, 16, 16, 16
+  // and 3 (its last edge, next to a band shorter than the filter's reach, left to the later phases; the others run
+  // between bands, by whichever thread is free); three threads bands of 16, 16, 16, 16 and 5; sixteen threads chunks
+  // and bands of 16, so other rows fall on the edges. The output must be the same bits, and the small bands must
+  // still match the plain implementation.
   const auto frames = random_sequence(40, 276, 4, 8, 276u);
   const std::vector<std::string> rgb = {"R", "G", "B"};
   for (const char* method : {"herzog", "drobot"}) {
@@ -264,14 +267,17 @@ TEST(UpsampleReference, ChunksFollowTheThreadCount) {
       });
       return out;
     };
-    const std::vector<Image> one = run(1), two = run(2), sixteen = run(16);
+    const std::vector<Image> one = run(1), two = run(2), three = run(3), sixteen = run(16);
     ASSERT_EQ(one.size(), frames.size());
     ASSERT_EQ(two.size(), frames.size());
+    ASSERT_EQ(three.size(), frames.size());
     ASSERT_EQ(sixteen.size(), frames.size());
     for (std::size_t t = 0; t < frames.size(); ++t)
       for (const auto& c : rgb) {
         EXPECT_EQ(std::memcmp(one[t].plane(c), two[t].plane(c), one[t].pixel_count() * sizeof(float)), 0)
             << method << " frame " << t << " " << c << " (2 threads)";
+        EXPECT_EQ(std::memcmp(one[t].plane(c), three[t].plane(c), one[t].pixel_count() * sizeof(float)), 0)
+            << method << " frame " << t << " " << c << " (3 threads)";
         EXPECT_EQ(std::memcmp(one[t].plane(c), sixteen[t].plane(c), one[t].pixel_count() * sizeof(float)), 0)
             << method << " frame " << t << " " << c << " (16 threads)";
       }

@@ -23,10 +23,13 @@
 #include "temporal/core/isa.h"
 #include "temporal/core/parallel.h"
 
+#include <algorithm>
 #include <atomic>
 #include <cstdint>
 #include <cstring>
 #include <limits>
+#include <thread>
+#include <vector>
 #if defined(__SSE2__)
 #include <immintrin.h>
 #endif
