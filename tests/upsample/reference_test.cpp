@@ -6,6 +6,7 @@
 #include "reference.h"
 #include "synthetic.h"
 
+#include "temporal/core/parallel.h"
 #include "temporal/upsample/methods.h"
 #include "temporal/upsample/upsample.h"
 
@@ -256,6 +257,9 @@ TEST(UpsampleReference, ChunksFollowTheThreadCount) {
     ASSERT_TRUE(o.has_value()) << o.error().message;
     auto run = [&](int threads) {
       std::vector<Image> out;
+      // The arena's concurrency counts only up to TBB's allowed parallelism (the machine's cores by default): raised,
+      // so that the chunks are those of `threads` threads on a 2-core machine too.
+      const temporal::ThreadLimit limit(threads);
       tbb::task_arena arena(threads);
       arena.execute([&] {
         up::Upsampler u(*o);
@@ -282,7 +286,10 @@ TEST(UpsampleReference, ChunksFollowTheThreadCount) {
             << method << " frame " << t << " " << c << " (16 threads)";
       }
     double d = 0;
-    tbb::task_arena(16).execute([&] { d = max_difference(*o, frames); });
+    {
+      const temporal::ThreadLimit limit(16);
+      tbb::task_arena(16).execute([&] { d = max_difference(*o, frames); });
+    }
     std::printf("%s 40x276 k=4, 16 threads: max |fast - plain| = %.3g\n", method, d);
     EXPECT_LE(d, tolerance(method)) << method;
   }

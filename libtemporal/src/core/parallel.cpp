@@ -31,4 +31,20 @@ int rows_per_chunk(int rows, int preferred, int smallest, int align) {
   return std::max(a, (wanted + a - 1) / a * a);
 }
 
+void guided_chunks(int rows, int preferred, int smallest, int align, std::vector<int>& bounds) {
+  const int a = std::max(1, align);
+  const int most = rows_per_chunk(rows, preferred, smallest, a);
+  const int threads = parallel_threads();
+  bounds.assign(1, 0);
+  for (int r = 0; r < rows;) {
+    int size = most;
+    if (threads > 1) {
+      const int guided = (rows - r + 2 * threads - 1) / (2 * threads);
+      size = std::clamp((guided + a - 1) / a * a, std::min(most, smallest), most);
+    }
+    r = std::min(rows, r + size);
+    bounds.push_back(r);
+  }
+}
+
 }  // namespace temporal

@@ -4,6 +4,7 @@
 
 #include <cstddef>
 #include <memory>
+#include <vector>
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -38,6 +39,13 @@ int parallel_threads();
 // gradient rows, 20.6-27.2 with 32, 23.4-26.0 with 16; drobot 12.9-14.4 ms with bands of 32 cache rows, 10.8-13.8
 // with 16: no cost above this VM's noise.)
 int rows_per_chunk(int rows, int preferred, int smallest, int align = 1);
+
+// The boundaries of the chunks of [0, rows) for tasks that take them in order from a shared counter: `bounds` gets
+// 0, the end of each chunk, ..., rows. On one thread every chunk has rows_per_chunk's size; on several they shrink
+// towards the end (guided self-scheduling: the rows left / (twice the threads), rounded up to `align`, at most
+// rows_per_chunk's size and at least `smallest`), so that the threads run out of work together instead of one
+// finishing its last large chunk alone (herzog's chunks, drobot's wavefront bands; issue 27).
+void guided_chunks(int rows, int preferred, int smallest, int align, std::vector<int>& bounds);
 
 // Calls body(y_begin, y_end) for bands of rows in [0, height), in parallel.
 template <typename Body>
