@@ -141,7 +141,8 @@ void BM_PerPixel(benchmark::State& state) {
 //   uses of one pair exceed twice the L3 (64 MB on the build machine's 32 MB L3: 5 pairs for drobot). One pair
 //   copied again and again (BM_StreamL3, the old bound's way) reads part of its source from L3, a share that
 //   depends on what else runs on the host: drobot's old bound (42.6 MB) moved between 0.7 and 1.95 ms in runs
-//   of the same binary, BM_StreamL3 between 0.44 and 0.81 ms (docs/upsample-st.md, "Issue 27, third pass").
+//   of the same binary, BM_StreamL3 between 0.44 and 0.81 ms (docs/history/upsample-st-speed.md, "Issue 27, third
+//   pass").
 // - Every buffer is written before the timed loop (no page faults inside it); the chunks are 64 KiB of whole
 //   cache lines, shared dynamically by the threads (a thread held up by another process does not leave half
 //   the copy waiting).
