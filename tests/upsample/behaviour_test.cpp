@@ -479,24 +479,30 @@ TEST(Upsample, AntialiasingVariantDownsamples) {
 // temporal counts its holes and history hits as w_t = 0 for every pixel, then takes the pixels this frame shaded
 // out of whichever count they were in (temporal_impl.inc): its disocclusion mask and its counts must agree on every
 // frame, through disocclusions (the moving square), the screen edge (the pan) and the shaded pixels among them.
-TEST(Upsample, TemporalDisocclusionMaskMatchesItsCounts) {
+// The two methods whose shaded pixels (one in k x k) take this frame's sample and are neither hole nor hit: temporal,
+// and drobot's refresh mode (Figure 7.12). Both count and mask in loops over the whole row and then correct the shaded
+// pixels (temporal_impl.inc; drobot_impl.inc's refresh_row), which this checks frame by frame.
+TEST(Upsample, DisocclusionMaskMatchesItsCounts) {
   SyntheticScene scene;
   scene.camera_velocity = {1.25f, 0.5f};
   scene.object = true;
   scene.object_velocity = {2.0f, 0.0f};
-  up::Options o = options_for("temporal");
-  o.debug_layers = true;
-  for (int frames = 1; frames <= 6; ++frames) {
-    const SeqRun r = run_seq(scene, o, frames);
-    const float* d = r.output.plane("debug.disocclusion");
-    ASSERT_NE(d, nullptr);
-    std::size_t ones = 0;
-    for (std::size_t i = 0; i < r.output.pixel_count(); ++i) ones += d[i] > 0.5f;
-    EXPECT_EQ(ones, r.stats.hole_pixels) << "frame " << frames - 1;
-    EXPECT_GT(ones, 0u) << "frame " << frames - 1;
-    // Every pixel is shaded, a history hit or a hole: exactly one of them (all samples here are finite).
-    const std::size_t shaded = std::size_t(scene.width / scene.k) * (scene.height / scene.k);
-    EXPECT_EQ(r.stats.hole_pixels + r.stats.history_pixels + shaded, r.output.pixel_count()) << "frame " << frames - 1;
+  for (const char* method : {"temporal", "drobot"}) {
+    up::Options o = std::string(method) == "drobot" ? options_for("drobot", {"--mode", "refresh"}) : options_for(method);
+    o.debug_layers = true;
+    for (int frames = 1; frames <= 6; ++frames) {
+      const SeqRun r = run_seq(scene, o, frames);
+      const float* d = r.output.plane("debug.disocclusion");
+      ASSERT_NE(d, nullptr) << method;
+      std::size_t ones = 0;
+      for (std::size_t i = 0; i < r.output.pixel_count(); ++i) ones += d[i] > 0.5f;
+      EXPECT_EQ(ones, r.stats.hole_pixels) << method << ", frame " << frames - 1;
+      EXPECT_GT(ones, 0u) << method << ", frame " << frames - 1;
+      // Every pixel is shaded, a history hit or a hole: exactly one of them (all samples here are finite).
+      const std::size_t shaded = std::size_t(scene.width / scene.k) * (scene.height / scene.k);
+      EXPECT_EQ(r.stats.hole_pixels + r.stats.history_pixels + shaded, r.output.pixel_count())
+          << method << ", frame " << frames - 1;
+    }
   }
 }
 

@@ -9,8 +9,17 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
+#if defined(__SSE2__)
+#include <immintrin.h>
+#endif
 
 namespace temporal::upsample {
+
+namespace {
+// The methods' non-temporal row copy (stream_row.inc), compiled here for the baseline: 16-byte streaming stores.
+constexpr int kCopyVectorFloats = 4;
+#include "stream_row.inc"
+}  // namespace
 
 std::string join_names(const std::vector<std::string>& names) {
   std::string s;
@@ -144,9 +153,17 @@ void PreviousGeometry::store(const FrameContext& f) {
     id.resize(n);
   else
     id.clear();
+  // Non-temporal stores (stream_row): the next frame reads these planes, this one does not. memcpy's chunks of 64 KiB
+  // are below glibc's non-temporal threshold, so they stored through the cache and read every line of the two
+  // planes from memory first (write-allocate, 10.5 MB per frame at 1280x1024). Frames of the two versions
+  // interleaved in one process (issue 27, 2026-11-30): temporal 3-4 % faster on two threads and on one,
+  // drobot-refresh 1-3 % (docs/history/upsample-st-speed.md, "ninth session"). The same bytes.
   parallel_chunks(n, [&](std::size_t b, std::size_t e) {
-    std::memcpy(z.data() + b, f.z + b, (e - b) * sizeof(float));
-    if (f.id) std::memcpy(id.data() + b, f.id + b, (e - b) * sizeof(*f.id));
+    stream_row(z.data() + b, f.z + b, int(e - b));
+    if (f.id) stream_row(id.data() + b, f.id + b, int(e - b));
+#if defined(__SSE2__)
+    _mm_sfence();  // this task's streamed stores are visible before the join hands the planes on
+#endif
   }, std::size_t(1) << 14);
 }
 

@@ -6,10 +6,12 @@
 // BM_StreamL3: the same copy of one buffer pair, part of it from L3). Targets (issue 4): herzog <= 1.5x
 // spatial, and within 2.5x of its streaming bound.
 // BM_Interleaved: issue 27's ratios (herzog and taau against spatial, drobot against its bound) from frames of the
-// two methods and copies of the bound interleaved in one sequence.
+// two methods and copies of the bound interleaved in one sequence. BM_Dispatch: what the run-time dispatch of the
+// kernel copies buys each method (the x86-64-v2 copies against the active level's, interleaved the same way).
 #include "synthetic.h"
 #include "upsample_variants.h"
 
+#include "temporal/core/isa.h"
 #include "temporal/core/parallel.h"
 #include "temporal/upsample/methods.h"
 #include "temporal/upsample/upsample.h"
@@ -286,6 +288,68 @@ void BM_Interleaved(benchmark::State& state) {
   state.counters["bound_ms"] = t_copy / it * 1e3;
 }
 
+// What the run-time dispatch buys each method (issue 27): frames of method m run by the x86-64-v2 kernel copies (the
+// portable baseline, what every x86-64 CPU runs) and by the copies of the active level (v3: AVX2 and FMA; v4:
+// AVX-512), interleaved in one sequence as in BM_Interleaved: per iteration one frame at each level, in alternating
+// order, each after a copy of the method's bytes (which replaces most of the L3). Each level has its own Upsampler
+// (its own history), and every call of a v2 frame runs under isa::ScopedLevel, so the state and the kernels that
+// dispatch per call (the reprojection module's) all run their v2 copies (frame.cpp's code has one copy only). x_v2 =
+// v2 time / active time, both summed over the iterations. A ratio near 1 says the method spends its time in code
+// compiled for the baseline only (temporal's frame code until 2026-11-29, found then by
+// tests/benchmarks/portable_vs_native.sh). The reported time is the active level's. Skipped in a build without
+// dispatch (TEMPORAL_NATIVE) or on a CPU without v3.
+void BM_Dispatch(benchmark::State& state) {
+  namespace isa = temporal::isa;
+  if (!isa::dispatching() || !isa::supported(isa::Level::V3) || isa::active() == isa::Level::V2) {
+    state.SkipWithError("no kernel copies above x86-64-v2 to compare with (TEMPORAL_NATIVE build, CPU without AVX2, "
+                        "or TEMPORAL_ISA=v2)");
+    return;
+  }
+  const int m = int(state.range(0));
+  const Inputs& in = inputs();
+  up::Upsampler base(options(m)), top(options(m));
+  StreamCopy copy(m, true);
+  if (!copy.ok()) {
+    state.SkipWithError("out of memory for the stream buffers");
+    return;
+  }
+  auto run = [&](bool v2, const Image& low) {
+    if (!v2) return top.process(in.gbuffer, low, kRGB, false);
+    isa::ScopedLevel level(isa::Level::V2);
+    return base.process(in.gbuffer, low, kRGB, false);
+  };
+  std::size_t t = 0;
+  for (int i = 0; i < 2 * kK * kK; ++i, ++t) {  // warm the histories and buffers
+    (void)run(true, in.low[t % in.low.size()]);
+    (void)run(false, in.low[t % in.low.size()]);
+  }
+  using Clock = std::chrono::steady_clock;
+  auto seconds = [](Clock::time_point a, Clock::time_point b) { return std::chrono::duration<double>(b - a).count(); };
+  double t_v2 = 0.0, t_top = 0.0;
+  bool v2_first = false;
+  for (auto _ : state) {
+    const Image& low = in.low[t++ % in.low.size()];
+    v2_first = !v2_first;
+    double frame_top = 0.0;
+    for (int r = 0; r < 2; ++r) {
+      const bool v2 = (r == 0) == v2_first;
+      copy.run();
+      const auto c0 = Clock::now();
+      auto out = run(v2, low);
+      const auto c1 = Clock::now();
+      benchmark::DoNotOptimize(out);
+      (v2 ? t_v2 : frame_top) += seconds(c0, c1);
+    }
+    t_top += frame_top;
+    state.SetIterationTime(frame_top);
+  }
+  state.SetLabel(std::string(name(m)) + ": v2 copies against " + std::string(isa::name(isa::active())));
+  const double it = double(std::max<benchmark::IterationCount>(1, state.iterations()));
+  state.counters["v2_ms"] = t_v2 / it * 1e3;
+  state.counters["active_ms"] = t_top / it * 1e3;
+  state.counters["x_v2"] = t_top > 0.0 ? t_v2 / t_top : 0.0;
+}
+
 void BM_Stream(benchmark::State& state) { stream(state, true); }
 void BM_StreamL3(benchmark::State& state) { stream(state, false); }
 
@@ -310,6 +374,11 @@ int main(int argc, char** argv) {
                 ->Arg(variant_index("taau"))
                 ->Unit(benchmark::kMillisecond)
                 ->UseManualTime();
+  // The v2 copies against the active level's, every method and variant.
+  auto* g = benchmark::RegisterBenchmark("BM_Dispatch", BM_Dispatch)
+                ->DenseRange(0, last)
+                ->Unit(benchmark::kMillisecond)
+                ->UseManualTime();
   // One thread's time per pixel of spatial, temporal, herzog, drobot and taau.
   const std::vector<int64_t> per_pixel = {variant_index("spatial"), variant_index("temporal"), variant_index("herzog"),
                                           variant_index("drobot"), variant_index("taau")};
@@ -323,6 +392,7 @@ int main(int argc, char** argv) {
     d->Iterations(n);
     p->Iterations(n);
     v->Iterations(n);
+    g->Iterations(n);
   }
   benchmark::Initialize(&argc, argv);
   if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
