@@ -133,8 +133,17 @@ Image PlainUpsampler::process(const Image& g, const Image& low, const std::vecto
   for (const auto& c : channels) f.low.push_back(low.plane(c));
   f.depth_range = *g.metadata().far_clip - *g.metadata().near_clip;
   f.sigma_d = options_.sigma_depth > 0 ? options_.sigma_depth : options_.sigma_depth_fraction * f.depth_range;
-  for (const auto& c : channels)
-    f.luma.push_back(c == "R" ? 0.2126f : c == "G" ? 0.7152f : c == "B" ? 0.0722f : 1.0f / float(f.C));
+  // The gradient's scalar norm (docs/upsample-st.md): Rec. 709 luminance for R, G, B (also as the last letter of a
+  // layer, "diffuse.R"), the mean over it and the other layers: weight 1 for each other layer, then all / their sum.
+  float luma_total = 0.0f;
+  for (const auto& c : channels) {
+    const bool rgb_layer = c.size() == 1 || (c.size() > 2 && c[c.size() - 2] == '.');
+    const char last = c.back();
+    const float w = !rgb_layer ? 1.0f : last == 'R' ? 0.2126f : last == 'G' ? 0.7152f : last == 'B' ? 0.0722f : 1.0f;
+    f.luma.push_back(w);
+    luma_total += w;
+  }
+  for (auto& w : f.luma) w /= luma_total;
   f.valid.resize(std::size_t(f.lw) * f.lh);
   for (int y = 0; y < f.lh; ++y)
     for (int x = 0; x < f.lw; ++x) {

@@ -106,8 +106,8 @@ std::vector<Frame> random_sequence(int W, int H, int k, int count, unsigned seed
 
 // Largest difference between the production and the plain result over every frame and channel; NaN anywhere
 // counts as infinite.
-double max_difference(const up::Options& o, const std::vector<Frame>& frames) {
-  const std::vector<std::string> rgb = {"R", "G", "B"};
+double max_difference(const up::Options& o, const std::vector<Frame>& frames,
+                      const std::vector<std::string>& rgb = {"R", "G", "B"}) {
   up::Upsampler fast(o);
   temporal::test::PlainUpsampler plain(o);
   double worst = 0;
@@ -178,6 +178,34 @@ TEST(UpsampleReference, NoIdsAndOtherParameters) {
     for (const auto& a : run) name += a + " ";
     const double d = max_difference(*o, frames);
     std::printf("%s: max |fast - plain| = %.3g\n", name.c_str(), d);
+    EXPECT_LE(d, tolerance(run[0])) << name;
+  }
+}
+
+// More than four payload channels: the history methods' one-pass fetch (reproject_gather_row) takes up to four
+// planes and falls back to the reprojection's two steps above (herzog fetches h_w and the channels: six planes from
+// five channels), and herzog's eq. 6 and drobot's Listings 7.1 and 7.3 run their channels in groups of three. R, G,
+// B and two more random channels (the gradient's norm then mixes the luminance with the other layers), every history
+// method and drobot's refresh mode, against the plain loops.
+TEST(UpsampleReference, FiveChannels) {
+  auto frames = random_sequence(48, 40, 4, 10, 11);
+  const std::vector<std::string> five = {"R", "G", "B", "U", "V"};
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<float> u01(0.0f, 1.0f);
+  for (Frame& f : frames)
+    for (const char* c : {"U", "V"}) {
+      float* p = f.low.add_channel(c);
+      for (std::size_t j = 0; j < f.low.pixel_count(); ++j) p[j] = u01(rng);
+    }
+  const std::vector<std::vector<std::string>> runs = {
+      {"temporal"}, {"herzog"}, {"drobot"}, {"drobot", "--mode", "refresh"}};
+  for (const auto& run : runs) {
+    auto o = up::make_options(run[0], std::vector<std::string>(run.begin() + 1, run.end()));
+    ASSERT_TRUE(o.has_value()) << o.error().message;
+    std::string name;
+    for (const auto& a : run) name += a + " ";
+    const double d = max_difference(*o, frames, five);
+    std::printf("%s(5 channels): max |fast - plain| = %.3g\n", name.c_str(), d);
     EXPECT_LE(d, tolerance(run[0])) << name;
   }
 }
