@@ -51,6 +51,13 @@ struct TapTable {
   // frame's tables repeat: the cache grid's never change, the samples' cycle through the k jitter offsets; four
   // scalar loops with a division per entry, serial at the start of every frame, were ~1 % of drobot's samples).
   bool build(int full, int low, int k, int s);
+  // The entries X with d[X] == 0 into `out`: the full-resolution columns (rows) that hold this frame's samples, one
+  // in k (temporal and drobot's refresh mode write their samples there after the row's vector loops).
+  void sample_entries(std::vector<int>& out) const {
+    out.clear();
+    for (std::size_t X = 0; X < d.size(); ++X)
+      if (d[X] == 0) out.push_back(int(X));
+  }
 
  private:
   int key_[4] = {-1, -1, -1, -1};
