@@ -132,6 +132,18 @@ TEST(DrobotGpu, LoadNamesAMissingPlane) {
   EXPECT_NE(error.find("cache.G"), std::string::npos) << error;
 }
 
+// Cache mode's payload and frame counts must be finite (as drobot.cpp's load); its depth may be anything.
+TEST(DrobotGpu, LoadRefusesANonFiniteCache) {
+  TEMPORAL_GPU_CONTEXT_OR_SKIP(ctx);
+  const std::vector<std::string> planes = {"cache.R", "cache.G", "cache.B", "cache.depth", "cache.frames"};
+  for (const char* damaged : {"cache.B", "cache.frames"}) {
+    const std::string error = test::load_error_with_nan(ctx, make_drobot_state_gpu, options_with(nullptr), planes,
+                                                        damaged);
+    EXPECT_NE(error.find("'" + std::string(damaged) + "'"), std::string::npos) << error;
+  }
+  EXPECT_EQ(test::load_error_with_nan(ctx, make_drobot_state_gpu, options_with(nullptr), planes, "cache.depth"), "");
+}
+
 // The registry's "gpu" implementation of drobot (what --device gpu picks): the same kernels on the shared context.
 TEST(DrobotGpu, IsRegisteredAsTheGpuImplementation) {
   TEMPORAL_GPU_CONTEXT_OR_SKIP(ctx);

@@ -285,6 +285,25 @@ inline std::string load_error_with_only(const std::shared_ptr<gpu::Context>& ctx
   return st ? std::string() : st.error().message;
 }
 
+// The same for a state that holds every plane of `planes` (zeros) with a NaN in `damaged` (one of them): a plane
+// that every --state-out writes finite must be refused by name (get_plane's StateValues::Finite), as the C++
+// states refuse it (tests/upsample/state_test.cpp).
+inline std::string load_error_with_nan(const std::shared_ptr<gpu::Context>& ctx, GpuStateFactory make_gpu,
+                                       const upsample::Options& o, const std::vector<std::string>& planes,
+                                       const std::string& damaged) {
+  const upsample::Geometry g = geometry_of(upsample_gpu_sequence(1)[0]);
+  auto gpu = make_gpu(ctx, o, g);
+  EXPECT_TRUE(gpu) << gpu.error().message;
+  if (!gpu) return gpu.error().message;
+  Image state(g.W, g.H);
+  for (const auto& n : planes) state.add_channel(n);
+  EXPECT_TRUE(state.plane(damaged)) << damaged;
+  // At (1, 1): inside every plane's corner (the low-resolution planes fill the top-left lw x lh of the channel).
+  if (float* p = state.plane(damaged)) p[std::size_t(g.W) + 1] = std::numeric_limits<float>::quiet_NaN();
+  const Status st = (*gpu)->load(state);
+  return st ? std::string() : st.error().message;
+}
+
 // One case of a method's state round trips: the options, the planes its state file must hold, and the suffix of the
 // measured figure's test property (round_trip_max_abs_<gpu_cpu|cpu_gpu><suffix>).
 struct ResumeCase {

@@ -65,4 +65,15 @@ TEST(TemporalGpu, LoadNamesAMissingPlane) {
   EXPECT_NE(error.find("history.G"), std::string::npos) << error;
 }
 
+// The GPU histories' load (GpuHistoryState::load_history, shared by temporal, herzog, drobot-refresh and taau)
+// refuses a NaN in the payload by name; the previous depth may hold anything (infinite depth is the background).
+TEST(TemporalGpu, LoadRefusesANonFiniteHistory) {
+  TEMPORAL_GPU_CONTEXT_OR_SKIP(ctx);
+  const std::vector<std::string> planes = {"history.R", "history.G", "history.B", "prev.depth"};
+  const std::string error = test::load_error_with_nan(ctx, make_temporal_state_gpu, Options{}, planes, "history.G");
+  EXPECT_NE(error.find("'history.G'"), std::string::npos) << error;
+  EXPECT_NE(error.find("not finite"), std::string::npos) << error;
+  EXPECT_EQ(test::load_error_with_nan(ctx, make_temporal_state_gpu, Options{}, planes, "prev.depth"), "");
+}
+
 }  // namespace

@@ -759,3 +759,30 @@ TEST(Upsample, WarpedDepthStillDetectsDisocclusion) {
     EXPECT_LT(r.stats.hole_pixels, square / 4) << m;
   }
 }
+
+// The streaming bound's bytes (Upsampler::streamed_bytes, the benchmark's copy), by hand for 128x64, k = 4, three
+// channels: a full plane f = 128 * 64 * 4 = 32768 bytes, a low-resolution one l = f / 16 = 2048. drobot's cache grid
+// reads the motion (two planes) and the ids at one pixel in four of every fourth row: every 64-byte line of those
+// rows crosses the bus (f / 4 per plane), not the samples' f / 16; with k = 32 the samples lie 128 bytes apart and
+// only their own lines cross (2 rows x 4 lines x 64 bytes).
+TEST(Upsample, StreamedBytesCountTheLinesEachMethodMoves) {
+  const std::size_t f = 32768, l = 2048;
+  auto bytes = [](const std::string& method, const std::vector<std::string>& args, int k) {
+    return up::Upsampler::streamed_bytes(options_for(method, args), 128, 64, k, 3);
+  };
+  // depth + N, payload in and out
+  EXPECT_EQ(bytes("spatial", {}, 4), 4 * f + 3 * l + 3 * f);
+  // + motion, ids, the previous depth and ids read and written, the history read
+  EXPECT_EQ(bytes("temporal", {}, 4), 4 * f + 3 * l + 3 * f + 2 * f + f + 4 * f + 3 * f);
+  // + h_w read and written
+  EXPECT_EQ(bytes("herzog", {}, 4), 4 * f + 3 * l + 3 * f + 2 * f + f + 4 * f + 3 * f + 2 * f);
+  // + weight, lock lifetime and lock luminance read and written
+  EXPECT_EQ(bytes("taau", {}, 4), 4 * f + 3 * l + 3 * f + 2 * f + f + 4 * f + 3 * f + 6 * f);
+  // drobot's refresh mode reads the motion and ids everywhere: as temporal
+  EXPECT_EQ(bytes("drobot", {"--mode", "refresh"}, 4), 4 * f + 3 * l + 3 * f + 2 * f + f + 4 * f + 3 * f);
+  // cache mode: the grid's motion and ids (3 x f / 4) and the low-resolution cache (values, depth, count, id: 6
+  // planes) read and written
+  EXPECT_EQ(bytes("drobot", {}, 4), 4 * f + 3 * l + 3 * f + 3 * (f / 4) + 2 * 6 * l);
+  // k = 32: a low-resolution plane is f / 1024 = 32 bytes; the grid's 2 rows hold 4 samples each, one line apiece
+  EXPECT_EQ(bytes("drobot", {}, 32), 4 * f + 3 * 32 + 3 * f + 3 * (2 * 4 * 64) + 2 * 6 * 32);
+}

@@ -184,6 +184,31 @@ TEST(UpsampleCli, StateFilesResumeBitIdentically) {
   }
 }
 
+// A --state-in file whose history holds a NaN (a damaged file: --state-out never writes one) stops the run before
+// it writes anything, with exit code 2 (bad input) and a message that names the file and the channel; the intact
+// file resumes (tests/upsample/state_test.cpp has every method and channel).
+TEST(UpsampleCli, DamagedStateIsRefused) {
+  const fs::path dir = write_sequence("upsample_cli_damaged_state", 5);
+  const std::string base = tool() + " --gbuffer " + (dir / "gbuffer.####.exr").string() + " --input " +
+                           (dir / "shade.####.exr").string() + " --method temporal";
+  const std::string state = (dir / "state.exr").string(), damaged = (dir / "damaged.exr").string();
+  std::string output;
+  const std::string first = base + " --out " + (dir / "a.####.exr").string() + " --frames 0-2 --state-out " + state;
+  ASSERT_EQ(temporal::test::run_command(first, &output), 0) << output;
+  auto image = temporal::read_exr(state);
+  ASSERT_TRUE(image.has_value());
+  ASSERT_NE(image->plane("history.R"), nullptr);
+  image->plane("history.R")[image->width() + 1] = std::nanf("");
+  ASSERT_TRUE(temporal::write_exr(damaged, *image));
+  const fs::path out = dir / "b";
+  const std::string resume = base + " --out " + (out / "b.####.exr").string() + " --frames 3-4 --state-in ";
+  EXPECT_EQ(temporal::test::run_command(resume + damaged, &output), 2) << output;
+  EXPECT_NE(output.find("'history.R'"), std::string::npos) << output;
+  EXPECT_NE(output.find("damaged.exr"), std::string::npos) << output;
+  EXPECT_FALSE(fs::exists(out / "b.0003.exr")) << output;
+  EXPECT_EQ(temporal::test::run_command(resume + state, &output), 0) << output;
+}
+
 TEST(UpsampleCli, ListMethods) {
   std::string output;
   ASSERT_EQ(temporal::test::run_command(tool() + " --list-methods", &output), 0) << output;

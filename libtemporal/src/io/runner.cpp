@@ -368,7 +368,7 @@ Expected<RunSummary> run_sequence(const SequenceOptions& options, FrameStage& st
   if (!options.state_in.empty()) {
     auto state = read_exr(options.state_in);
     if (!state) return state.error();
-    if (Status s = stage.load_state(*state); !s) {
+    if (Status s = stage.load_state(*state, options.state_in); !s) {
       Error e = s.error();
       if (e.file.empty()) e.file = options.state_in;
       return e;

@@ -46,12 +46,13 @@ class FilterStage final : public FrameStage {
     return state;
   }
   // The channel count is known at the first frame: the state is applied there.
-  Status load_state(const Image& state) override {
+  Status load_state(const Image& state, const std::string& source) override {
     auto of = state.metadata().extra.find("phlmStateOf");
     if (of != state.metadata().extra.end() && of->second != method_.info.name)
       return Error::usage("the state was written by --method " + of->second + ", not " + method_.info.name +
                           ": resume with the same method");
     pending_state_ = state;
+    pending_source_ = source;
     return Status::ok();
   }
 
@@ -63,7 +64,11 @@ class FilterStage final : public FrameStage {
       if (state.width() != f.input->width() || state.height() != f.input->height())
         return Error::input(f.input_path, "the --state-in state is " + dims(state.width(), state.height()) +
                                               " but the input is " + dims(f.input->width(), f.input->height()));
-      if (Status s = filter_->set_state(state, int(channels->size())); !s) return s;
+      if (Status s = filter_->set_state(state, int(channels->size())); !s) {
+        Error e = s.error();
+        if (e.file.empty()) e.file = pending_source_;  // the state's error, not the input's
+        return e;
+      }
       pending_state_.reset();
     }
     FilterInput in;
@@ -110,6 +115,7 @@ class FilterStage final : public FrameStage {
   std::unique_ptr<FrameFilter> filter_;
   StageInputs inputs_;
   std::optional<Image> pending_state_;
+  std::string pending_source_;  // the --state-in file, for the errors set_state finds
   std::string parameters_;  // "--lambda=0.998 --p-init=1000 ..." (temporal:methodParameters)
   Image output_;
   FilterStats stats_;

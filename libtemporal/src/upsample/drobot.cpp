@@ -56,8 +56,9 @@ std::size_t streamed_bytes(const Options& o, int W, int H, int k, int C) {
   std::size_t b = 4 * full + C * low + C * full;  // depth + N, payload in, payload out
   if (drobot_options(o).refresh())
     b += 2 * full + full + 2 * (2 * full) + C * full;  // motion, id; previous depth and id read and written; history
-  else
-    b += 3 * low + 2 * (C + 3) * low;  // motion and id at the blocks; low-res cache (values, depth, count, id) r+w
+  else  // motion and id at the blocks (whole cache lines: cache_grid_read_bytes); the low-resolution cache (values,
+        // depth, count, id) read and written
+    b += 3 * cache_grid_read_bytes(W, H, k, 64) + 2 * (C + 3) * low;
   return b;
 }
 

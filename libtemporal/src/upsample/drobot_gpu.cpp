@@ -401,9 +401,10 @@ class DrobotStateGpu final : public GpuHistoryState {
     }
     const int b = (C + 3) * cur_;
     for (int c = 0; c < C; ++c)
-      if (Status s = load_plane(state, "cache." + g_.channels[std::size_t(c)], cache_, b + c); !s) return s;
+      if (Status s = load_plane(state, "cache." + g_.channels[std::size_t(c)], cache_, b + c, StateValues::Finite); !s)
+        return s;
     if (Status s = load_plane(state, "cache.depth", cache_, b + C); !s) return s;
-    if (Status s = load_plane(state, "cache.frames", cache_, b + C + 1); !s) return s;
+    if (Status s = load_plane(state, "cache.frames", cache_, b + C + 1, StateValues::Finite); !s) return s;
     // DrobotState::load clears the ids when the state has none; the next run() zero-fills them (its resize).
     std::vector<std::uint32_t> ids(std::size_t(g_.lw) * g_.lh, 0u);
     has_cache_id_ = state.uint_plane("cache.id") != nullptr;
@@ -555,9 +556,10 @@ class DrobotStateGpu final : public GpuHistoryState {
     timing_.kernel_ms = timer_.stop_ms();
     timing_.clock = timer_.clock();
     const double full = double(f.W) * f.H * 4.0, low = double(ln) * 4.0;
-    // drobot.cpp's streamed_bytes (cache mode) plus CB and the filter's passes (low resolution).
-    timing_.bytes_moved = 4 * full + C * low + C * full + 3 * low + 2 * (C + 3) * low + 4 * (C + 4) * low +
-                          (f.debug ? 4.0 * full : 0.0);
+    // drobot.cpp's streamed_bytes (cache mode; the motion and ids at the blocks in 32-byte sectors) plus CB and the
+    // filter's passes (low resolution).
+    timing_.bytes_moved = 4 * full + C * low + C * full + 3.0 * double(cache_grid_read_bytes(f.W, f.H, k, 32)) +
+                          2 * (C + 3) * low + 4 * (C + 4) * low + (f.debug ? 4.0 * full : 0.0);
     static const char* const kNames[4] = {"debug.confidence", "debug.disocclusion", "debug.convergence",
                                           "debug.historyWeight"};
     if (Status s = download_result(f, kNames); !s) return s;

@@ -7,6 +7,8 @@
 #include "temporal/core/method.h"
 #include "temporal/core/params.h"
 
+#include <algorithm>
+#include <cstddef>
 #include <string>
 
 namespace temporal::upsample {
@@ -44,5 +46,19 @@ struct DrobotOptions {
 
 // The run's drobot options (the defaults when the run has none).
 const DrobotOptions& drobot_options(const Options& o);
+
+// The bytes of a W x H plane of 4-byte values that cross the memory bus when cache mode's grid reads it: one pixel
+// in k (column k x + k/2) of every k-th row (k y + k/2), the motion and the ids (drobot.cpp's cache_grid_row, the
+// GLSL cache update), fetched in whole transfers of `transfer` bytes (a CPU's 64-byte cache line, a GPU's 32-byte
+// sector). While a transfer holds at least one sample (4 k <= transfer) every transfer of those rows is read, so
+// the plane costs 1 / k of its bytes, not the 1 / k^2 its samples fill (k = 4: 5.2 of 21 MB per 1280x1024 plane,
+// not 1.3); beyond that, one transfer per sample. Rows start on a transfer boundary (W 4 bytes is a multiple of
+// 64 for the suite's widths; plane memory is 64-byte aligned).
+inline std::size_t cache_grid_read_bytes(int W, int H, int k, std::size_t transfer) {
+  const std::size_t kk = std::size_t(k);
+  const std::size_t rows = (std::size_t(H) + kk - 1) / kk, samples = (std::size_t(W) + kk - 1) / kk;
+  const std::size_t row_transfers = (std::size_t(W) * 4 + transfer - 1) / transfer;
+  return rows * std::min(row_transfers, samples) * transfer;
+}
 
 }  // namespace temporal::upsample

@@ -208,10 +208,16 @@ void put_plane(Image& state, const std::string& name, const float* src, int w, i
 void put_uint_plane(Image& state, const std::string& name, const std::uint32_t* src, int w, int h) {
   copy_in(state.add_uint_channel(name), src, w, h, state.width());
 }
-Status get_plane(const Image& state, const std::string& name, float* dst, int w, int h) {
+Status get_plane(const Image& state, const std::string& name, float* dst, int w, int h, StateValues values) {
   const float* p = state.plane(name);
   if (!p) return missing(state, name);
   copy_out(dst, p, w, h, state.width());
+  if (values == StateValues::Finite)
+    if (const std::size_t bad = count_non_finite({dst, std::size_t(w) * std::size_t(h)}); bad > 0)
+      return Error::input({}, "the state's channel '" + name + "' holds " + std::to_string(bad) +
+                                  " values that are not finite (NaN or infinity), which --state-out never writes: "
+                                  "the file is damaged; pass an intact --state-out file, or drop --state-in to "
+                                  "start without history");
   return Status::ok();
 }
 Status get_uint_plane(const Image& state, const std::string& name, std::uint32_t* dst, int w, int h) {

@@ -82,7 +82,8 @@ void set_luma_uniform(const gpu::Program& program, const FrameContext& f);
 // into the state as `name` (put_plane; save() cannot report an error: a failed download leaves the plane out, and
 // load() names it), and back (get_plane: an Input error names a missing plane).
 void save_plane(const gpu::ImageBuffer& buffer, int p, Image& state, const std::string& name);
-Status load_plane(const Image& state, const std::string& name, gpu::ImageBuffer& buffer, int p);
+Status load_plane(const Image& state, const std::string& name, gpu::ImageBuffer& buffer, int p,
+                  StateValues values = StateValues::Any);
 
 // A state file's previous depth (and ids, when it has them) into planes 0 and 1 of `prevg` (the C++ states'
 // PreviousGeometry, read by get_previous); `has_prev_id` says whether the ids were there.

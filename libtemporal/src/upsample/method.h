@@ -64,8 +64,13 @@ inline std::vector<LayerNeed> history_method_layers(const Options& o) {
 // Stores a w x h plane in the top-left corner of channel `name` of `state` (w <= width, h <= height).
 void put_plane(Image& state, const std::string& name, const float* src, int w, int h);
 void put_uint_plane(Image& state, const std::string& name, const std::uint32_t* src, int w, int h);
-// Reads it back into dst (w x h); Input error when the channel is missing.
-Status get_plane(const Image& state, const std::string& name, float* dst, int w, int h);
+// Reads it back into dst (w x h); Input error when the channel is missing. StateValues::Finite: also when a value
+// is NaN or infinite - for the planes that every --state-out writes finite (the histories' and drobot's cache's
+// payload, its frame counts), where such a value would flow into the output (temporal and drobot did: a damaged
+// file's NaN reached thousands of output pixels within three frames); the message names the channel and the count.
+enum class StateValues { Any, Finite };
+Status get_plane(const Image& state, const std::string& name, float* dst, int w, int h,
+                 StateValues values = StateValues::Any);
 Status get_uint_plane(const Image& state, const std::string& name, std::uint32_t* dst, int w, int h);
 
 // The previous frame's depth and ids as `prev.depth` / `prev.id` of a state.

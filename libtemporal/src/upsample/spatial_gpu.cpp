@@ -157,9 +157,9 @@ void save_plane(const gpu::ImageBuffer& buffer, int p, Image& state, const std::
   if (buffer.download(p, plane.data())) put_plane(state, name, plane.data(), buffer.width(), buffer.height());
 }
 
-Status load_plane(const Image& state, const std::string& name, gpu::ImageBuffer& buffer, int p) {
+Status load_plane(const Image& state, const std::string& name, gpu::ImageBuffer& buffer, int p, StateValues values) {
   std::vector<float> plane(buffer.pixel_count());
-  if (Status s = get_plane(state, name, plane.data(), buffer.width(), buffer.height()); !s) return s;
+  if (Status s = get_plane(state, name, plane.data(), buffer.width(), buffer.height(), values); !s) return s;
   return buffer.upload(p, plane.data());
 }
 
@@ -170,7 +170,8 @@ void GpuHistoryState::save_history(Image& state) const {
 
 Status GpuHistoryState::load_history(const Image& state) {
   for (int c = 0; c < int(g_.channels.size()); ++c)
-    if (Status s = load_plane(state, "history." + g_.channels[std::size_t(c)], out_[cur_], c); !s) return s;
+    if (Status s = load_plane(state, "history." + g_.channels[std::size_t(c)], out_[cur_], c, StateValues::Finite); !s)
+      return s;
   return Status::ok();
 }
 

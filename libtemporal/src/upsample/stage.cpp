@@ -31,8 +31,8 @@ UpsampleStage::UpsampleStage(Options options) : upsampler_(std::move(options)) {
   inputs_.gbuffer_scale = 0;  // k from the input's temporal:jitterFactor
 }
 
-Status UpsampleStage::load_state(const Image& state) {
-  if (Status s = upsampler_.load_state(state); !s) return s;
+Status UpsampleStage::load_state(const Image& state, const std::string& source) {
+  if (Status s = upsampler_.load_state(state, source); !s) return s;
   resume_after_ = state.metadata().frame;
   return Status::ok();
 }

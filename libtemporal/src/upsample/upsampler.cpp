@@ -61,6 +61,7 @@ struct Upsampler::Impl {
   std::shared_ptr<gpu::Context> gpu;  // --device gpu: the run's context (made with the first state)
   bool have_history = false;
   std::optional<Image> pending;  // a loaded state, applied at the next frame
+  std::string pending_source;    // the file it came from (load_state), for the errors found when it is applied
   Demodulation demod;
   Image aa;  // antialiasing variant: downsampled output
 
@@ -233,7 +234,11 @@ Status Upsampler::Impl::prepare_state(std::span<const std::string> channels, con
                                      "channels " + chans + ", but this frame is " + size_text(g) + " with channels " +
                                      join_names(g.channels) + ": resume with the sequence and --layer the state was "
                                      "written for");
-  if (Status s = state->load(*pending); !s) return s;
+  if (Status s = state->load(*pending); !s) {
+    Error e = s.error();
+    if (e.file.empty()) e.file = pending_source;  // the state file's error, not the frame's
+    return e;
+  }
   pending.reset();
   have_history = true;
   return Status::ok();
@@ -388,7 +393,7 @@ Expected<Image> Upsampler::save_state() const {
   return state;
 }
 
-Status Upsampler::load_state(const Image& state) {
+Status Upsampler::load_state(const Image& state, std::string source) {
   Impl& u = *impl_;
   if (!has_state()) return Error::usage("--method " + u.options.method + " keeps no state: drop --state-in / --state-out");
   const auto& extra = state.metadata().extra;
@@ -408,6 +413,7 @@ Status Upsampler::load_state(const Image& state) {
     return Error::usage(std::string("the state was written ") + (u.options.demodulate ? "without" : "with") +
                         " --demodulate: resume with the same --demodulate setting");
   u.pending = state;
+  u.pending_source = std::move(source);
   return Status::ok();
 }
 

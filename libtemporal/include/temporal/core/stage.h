@@ -71,10 +71,12 @@ class FrameStage {
   // Processes one frame; appends its outputs (usually one; morph-120hz: `factor` of them) to `out`.
   virtual Status process(const StageFrame& frame, std::vector<StageOutput>& out) = 0;
   // Persistent state (histories, models), for --state-out / --state-in. Stages without state return an empty
-  // image from save_state and refuse load_state.
+  // image from save_state and refuse load_state. `source` (the --state-in file) names the file in the errors a
+  // stage finds when it applies the state later, at the first frame, whose size it needs: without it they would
+  // name that frame's input.
   virtual bool has_state() const { return false; }
   virtual Expected<Image> save_state() const { return Image(); }
-  virtual Status load_state(const Image& state) {
+  virtual Status load_state(const Image& state, const std::string& /*source*/) {
     return Error::usage("this method has no state: drop --state-in / --state-out");
   }
   // One line for --verbose after each frame ("3.1 ms, 120 pixels without history").

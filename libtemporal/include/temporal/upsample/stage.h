@@ -26,7 +26,7 @@ class UpsampleStage : public FrameStage {
   bool has_state() const override { return upsampler_.has_state(); }
   Expected<Image> save_state() const override { return upsampler_.save_state(); }
   // Also remembers the frame the state was written after: the first frame of the run must be the next one.
-  Status load_state(const Image& state) override;
+  Status load_state(const Image& state, const std::string& source) override;
   std::string frame_summary() const override;
 
   // Sums over the frames processed so far.

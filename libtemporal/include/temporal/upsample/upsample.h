@@ -160,8 +160,10 @@ class Upsampler {
   Expected<Image> save_state() const;
   // Resumes from a save_state() image: the next process() continues as if the frames before had just been
   // processed. Checked now: the method and its options that shape the state; at the next process(): the frame
-  // size, k and channels (an Input error there names --state-in).
-  Status load_state(const Image& state);
+  // size, k and channels (an Input error there names --state-in), the planes the method reads and their values
+  // (an Input error for a missing plane or a non-finite value where --state-out writes none: histories, drobot's
+  // cache). `source` names the file in those later errors (the frame's input otherwise).
+  Status load_state(const Image& state, std::string source = {});
 
   // Bytes per frame a method must read and write at this size (streaming bound of the benchmark).
   static std::size_t streamed_bytes(const Options& options, int full_width, int full_height, int k, int channels);
