@@ -1,7 +1,8 @@
 // Resumable state (--state-in / --state-out): for every method and named variant, a run interrupted after a few
 // frames and resumed from its saved state (written to an EXR file and read back, as the tool does) gives the same
 // bits as the uninterrupted run; states of another method, other options or another size are refused with a
-// message that says what differs.
+// message that says what differs, and damaged ones (NaN or infinity in a plane) are refused or kept out of the
+// output.
 #include "synthetic.h"
 
 #include "temporal/io/exr.h"
@@ -11,11 +12,10 @@
 #include <gtest/gtest.h>
 #include <test_support.h>
 
+#include <cmath>
 #include <cstring>
 #include <filesystem>
 #include <limits>
-#include <cmath>
-#include <cstdio>
 
 namespace up = temporal::upsample;
 using temporal::Image;
