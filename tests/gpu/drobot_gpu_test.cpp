@@ -137,11 +137,11 @@ TEST(DrobotGpu, LoadRefusesANonFiniteCache) {
   TEMPORAL_GPU_CONTEXT_OR_SKIP(ctx);
   const std::vector<std::string> planes = {"cache.R", "cache.G", "cache.B", "cache.depth", "cache.frames"};
   for (const char* damaged : {"cache.B", "cache.frames"}) {
-    const std::string error = test::load_error_with_nan(ctx, make_drobot_state_gpu, options_with(nullptr), planes,
+    const std::string error = test::load_error_with_only(ctx, make_drobot_state_gpu, options_with(nullptr), planes,
                                                         damaged);
     EXPECT_NE(error.find("'" + std::string(damaged) + "'"), std::string::npos) << error;
   }
-  EXPECT_EQ(test::load_error_with_nan(ctx, make_drobot_state_gpu, options_with(nullptr), planes, "cache.depth"), "");
+  EXPECT_EQ(test::load_error_with_only(ctx, make_drobot_state_gpu, options_with(nullptr), planes, "cache.depth"), "");
 }
 
 // The registry's "gpu" implementation of drobot (what --device gpu picks): the same kernels on the shared context.

@@ -5,7 +5,7 @@
 // (expect_state_agreement), in every mode and for every option variant (expect_agreement_in_every_mode,
 // expect_every_variant_agrees), after a state file moved between the devices (resume_on_the_other_device,
 // expect_resumes_on_either_device), through the registry's implementations (compare_registered), and what load()
-// says of a state file that lacks a plane (load_error_with_only).
+// says of a state file that lacks a plane or holds a NaN (load_error_with_only).
 #pragma once
 
 #include "gpu_methods.h"  // libtemporal/src/upsample (internal)
@@ -272,34 +272,24 @@ inline Agreement resume_on_the_other_device(const std::shared_ptr<gpu::Context>&
 }
 
 // What a new GPU state's load() says of a state file (the synthetic sequence's size) that holds only the float
-// planes `planes`: the error's message, empty when it loaded.
-inline std::string load_error_with_only(const std::shared_ptr<gpu::Context>& ctx, GpuStateFactory make_gpu,
-                                        const upsample::Options& o, const std::vector<std::string>& planes) {
-  const upsample::Geometry g = geometry_of(upsample_gpu_sequence(1)[0]);
-  auto gpu = make_gpu(ctx, o, g);
-  EXPECT_TRUE(gpu) << gpu.error().message;
-  if (!gpu) return gpu.error().message;
-  Image state(g.W, g.H);
-  for (const auto& n : planes) state.add_channel(n);
-  const Status st = (*gpu)->load(state);
-  return st ? std::string() : st.error().message;
-}
-
-// The same for a state that holds every plane of `planes` (zeros) with a NaN in `damaged` (one of them): a plane
-// that every --state-out writes finite must be refused by name (get_plane's StateValues::Finite), as the C++
+// planes `planes` (zeros): the error's message, empty when it loaded. `damaged` (one of `planes`, or empty) gets a
+// NaN at (1, 1), inside every plane's corner (the low-resolution planes fill the top-left lw x lh of the channel): a
+// plane that every --state-out writes finite must be refused by name (get_plane's StateValues::Finite), as the C++
 // states refuse it (tests/upsample/state_test.cpp).
-inline std::string load_error_with_nan(const std::shared_ptr<gpu::Context>& ctx, GpuStateFactory make_gpu,
-                                       const upsample::Options& o, const std::vector<std::string>& planes,
-                                       const std::string& damaged) {
+inline std::string load_error_with_only(const std::shared_ptr<gpu::Context>& ctx, GpuStateFactory make_gpu,
+                                        const upsample::Options& o, const std::vector<std::string>& planes,
+                                        const std::string& damaged = {}) {
   const upsample::Geometry g = geometry_of(upsample_gpu_sequence(1)[0]);
   auto gpu = make_gpu(ctx, o, g);
   EXPECT_TRUE(gpu) << gpu.error().message;
   if (!gpu) return gpu.error().message;
   Image state(g.W, g.H);
   for (const auto& n : planes) state.add_channel(n);
-  EXPECT_TRUE(state.plane(damaged)) << damaged;
-  // At (1, 1): inside every plane's corner (the low-resolution planes fill the top-left lw x lh of the channel).
-  if (float* p = state.plane(damaged)) p[std::size_t(g.W) + 1] = std::numeric_limits<float>::quiet_NaN();
+  if (!damaged.empty()) {
+    float* p = state.plane(damaged);
+    EXPECT_TRUE(p) << damaged;
+    if (p) p[std::size_t(g.W) + 1] = std::numeric_limits<float>::quiet_NaN();
+  }
   const Status st = (*gpu)->load(state);
   return st ? std::string() : st.error().message;
 }
